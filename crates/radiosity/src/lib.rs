@@ -1,0 +1,36 @@
+//! # radiosity
+//!
+//! A radiosity renderer after De Angelis, *Radiosity: A Study in Photorealistic Rendering*
+//! (1998), built as a library. The pipeline, one module per stage:
+//!
+//! ```text
+//! scene file --scene--> Scene --mesh--> Mesh --form_factor--> FormFactorMatrix
+//!   --solve--> element radiosity B (per RGB band) --shade--> vertex radiosity
+//!   --render--> image
+//! ```
+//!
+//! * [`scene`]: the paper's Appendix A scene format (reader, writer, built-in Cornell box).
+//! * [`geometry`]: planar convex polygon helpers (normal, area, planarity, convexity).
+//! * [`mesh`]: area-based subdivision of surfaces into elements (paper 2.4).
+//! * [`visibility`]: BVH ray queries over triangles (occlusion and closest hit).
+//! * [`form_factor`]: form factors F_ij (paper 1.2, 2.3) and their file format (paper 2.8).
+//! * [`solve`]: (I - rho F) B = E per band, by LU or Gauss-Seidel (paper figure 6).
+//! * [`shade`]: vertex radiosities, exposure and gamma (paper 2.5, 2.7).
+//! * [`render`]: a CPU ray-cast camera that writes PNG images (paper 2.6).
+//! * [`progress`]: the one interface long work reports through.
+//! * [`solution`]: the per-element solution as CSV or JSON.
+//!
+//! Conventions used throughout: F_ij is the fraction of the energy leaving element i that
+//! arrives at element j; radiosity B and emission E are exitances in the scene's own units
+//! (for example W/m^2), per red, green and blue band; reflectance rho is in [0, 1).
+#![deny(missing_docs)]
+
+mod atomic_write;
+pub mod form_factor;
+pub mod geometry;
+pub mod mesh;
+pub mod progress;
+pub mod scene;
+pub mod visibility;
+
+pub use atomic_write::write_atomically;

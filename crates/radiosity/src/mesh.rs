@@ -1,0 +1,603 @@
+//! Area-based subdivision of surfaces into elements (paper section 2.4).
+//!
+//! Every surface whose area exceeds `MAX_PATCH_AREA` is cut into elements of at most that
+//! area with aspect ratio near 1: a quadrilateral into an m x n grid of quadrilaterals (the
+//! bilinear map of the unit square), a triangle into m^2 triangles (each edge cut into m), and
+//! a polygon of five or more corners first into a fan of triangles from its centroid, each
+//! cut the same way. Elements of one surface share their corner vertices, so the mesh is
+//! conforming within a surface; surfaces never share vertices (shading does not cross
+//! surface boundaries, as in the paper). Neighbours (elements sharing an edge on the same
+//! surface) are recorded for shading.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use glam::DVec3;
+
+use crate::geometry;
+use crate::scene::Scene;
+
+/// One element: a planar convex triangle or quadrilateral, a piece of one surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Element {
+    /// Index of the scene surface this element belongs to.
+    pub surface: u32,
+    corners: [u32; 4],
+    corner_count: u8,
+    /// Area (scene units squared).
+    pub area: f64,
+    /// Area centroid.
+    pub centroid: DVec3,
+    /// Unit front normal (the surface's normal).
+    pub normal: DVec3,
+}
+
+impl Element {
+    /// Indices into [`Mesh::vertices`] of the 3 or 4 corners, counter-clockwise from the front.
+    pub fn corners(&self) -> &[u32] {
+        &self.corners[..self.corner_count as usize]
+    }
+
+    /// True for a quadrilateral element.
+    pub fn is_quad(&self) -> bool {
+        self.corner_count == 4
+    }
+}
+
+/// Surfaces cut into elements.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Corner positions. Each surface has its own vertices (see [`Mesh::surface_vertices`]).
+    pub vertices: Vec<DVec3>,
+    /// All elements, surface by surface.
+    pub elements: Vec<Element>,
+    /// For each surface, the range of its elements in [`Mesh::elements`].
+    pub surface_elements: Vec<Range<u32>>,
+    /// For each surface, the range of its vertices in [`Mesh::vertices`].
+    pub surface_vertices: Vec<Range<u32>>,
+    neighbour_offsets: Vec<u32>,
+    neighbour_list: Vec<u32>,
+}
+
+/// Meshing cannot proceed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum MeshError {
+    /// `MAX_PATCH_AREA` is not a positive finite number.
+    #[error("MAX_PATCH_AREA must be a positive number, got {0}")]
+    BadMaxArea(f64),
+    /// The subdivision would make more elements than the limit.
+    #[error(
+        "meshing with MAX_PATCH_AREA = {max_area} would make {count} elements, more than the \
+         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.4}"
+    )]
+    TooManyElements {
+        /// The requested maximum element area.
+        max_area: f64,
+        /// The element count it would give.
+        count: u64,
+        /// The largest element count allowed.
+        limit: u64,
+        /// A maximum area that would stay within the limit.
+        suggested: f64,
+    },
+}
+
+/// The most elements [`mesh_scene`] will make; a dense form-factor matrix of this size would
+/// already take 40 GB in f32, so larger requests are refused before any allocation.
+pub const MAX_ELEMENTS: u64 = 100_000;
+
+/// How one surface is cut.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Plan {
+    /// A quadrilateral cut into `nu` x `nv` quadrilaterals.
+    QuadGrid { nu: u32, nv: u32 },
+    /// A fan of `fans` triangles (1 for a triangle), each cut into `m`^2 triangles.
+    TriangleFan { fans: u32, m: u32 },
+}
+
+impl Plan {
+    fn element_count(self) -> u64 {
+        match self {
+            Plan::QuadGrid { nu, nv } => nu as u64 * nv as u64,
+            Plan::TriangleFan { fans, m } => fans as u64 * (m as u64).pow(2),
+        }
+    }
+}
+
+/// Plans the cut of one polygon so that no element exceeds `max_area`.
+fn plan(vertices: &[DVec3], max_area: f64) -> Plan {
+    let area = geometry::polygon_area(vertices);
+    match vertices.len() {
+        4 => {
+            // Grid counts follow the mean lengths of opposite edges, so elements are near
+            // square; grow the finer direction until the largest bilinear cell fits.
+            let [a, b, c, d] = [vertices[0], vertices[1], vertices[2], vertices[3]];
+            let lu = 0.5 * ((b - a).length() + (c - d).length());
+            let lv = 0.5 * ((d - a).length() + (c - b).length());
+            let target = (area / max_area).ceil().max(1.0);
+            let mut nu = ((target * lu / lv).sqrt().round() as u32).max(1);
+            let mut nv = ((target / nu as f64).ceil() as u32).max(1);
+            while max_quad_cell_area(vertices, nu, nv) > max_area * (1.0 + 1e-12) {
+                if lu / nu as f64 >= lv / nv as f64 {
+                    nu += 1;
+                } else {
+                    nv += 1;
+                }
+            }
+            Plan::QuadGrid { nu, nv }
+        }
+        k => {
+            let fans = if k == 3 { 1 } else { k as u32 };
+            let fan_areas =
+                fan_triangles(vertices).map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length());
+            let largest = fan_areas.fold(0.0, f64::max);
+            let m = ((largest / max_area).sqrt().ceil() as u32).max(1);
+            Plan::TriangleFan { fans, m }
+        }
+    }
+}
+
+/// The triangles a polygon is cut into before subdivision: itself for a triangle, otherwise
+/// a fan from the area centroid (so the fan triangles are as fat as the polygon allows).
+fn fan_triangles(vertices: &[DVec3]) -> impl Iterator<Item = [DVec3; 3]> + '_ {
+    let k = vertices.len();
+    let centre = geometry::polygon_centroid(vertices);
+    let fans = if k == 3 { 1 } else { k };
+    (0..fans).map(move |i| {
+        if k == 3 {
+            [vertices[0], vertices[1], vertices[2]]
+        } else {
+            [centre, vertices[i], vertices[(i + 1) % k]]
+        }
+    })
+}
+
+/// The point of the bilinear patch with corners `q` at parameters (u, v) in [0, 1]^2:
+/// (0,0) -> q0, (1,0) -> q1, (1,1) -> q2, (0,1) -> q3.
+pub fn bilinear(q: &[DVec3], u: f64, v: f64) -> DVec3 {
+    (1.0 - u) * (1.0 - v) * q[0] + u * (1.0 - v) * q[1] + u * v * q[2] + (1.0 - u) * v * q[3]
+}
+
+fn max_quad_cell_area(q: &[DVec3], nu: u32, nv: u32) -> f64 {
+    // The Jacobian of a planar bilinear map is linear in u and v, so the largest cell lies
+    // in a corner of the grid.
+    let mut worst: f64 = 0.0;
+    for (i, j) in [(0, 0), (nu - 1, 0), (0, nv - 1), (nu - 1, nv - 1)] {
+        let p = |a: u32, b: u32| bilinear(q, a as f64 / nu as f64, b as f64 / nv as f64);
+        let cell = [p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)];
+        worst = worst.max(geometry::polygon_area(&cell));
+    }
+    worst
+}
+
+/// Cuts every surface of `scene` into elements of at most `max_area` (scene units squared).
+///
+/// Refuses, before allocating, a cut that would make more than [`MAX_ELEMENTS`] elements.
+pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
+    if !(max_area.is_finite() && max_area > 0.0) {
+        return Err(MeshError::BadMaxArea(max_area));
+    }
+    let plans: Vec<Plan> = scene
+        .surfaces
+        .iter()
+        .map(|s| plan(&s.vertices, max_area))
+        .collect();
+    let count: u64 = plans.iter().map(|p| p.element_count()).sum();
+    if count > MAX_ELEMENTS {
+        let suggested = max_area * count as f64 / MAX_ELEMENTS as f64 * 1.05;
+        return Err(MeshError::TooManyElements {
+            max_area,
+            count,
+            limit: MAX_ELEMENTS,
+            suggested,
+        });
+    }
+
+    let mut mesh = Mesh {
+        elements: Vec::with_capacity(count as usize),
+        ..Mesh::default()
+    };
+    for (s, (surface, plan)) in scene.surfaces.iter().zip(&plans).enumerate() {
+        let first_vertex = mesh.vertices.len() as u32;
+        let first_element = mesh.elements.len() as u32;
+        let normal = geometry::polygon_normal(&surface.vertices).unwrap_or(DVec3::Z);
+        match *plan {
+            Plan::QuadGrid { nu, nv } => {
+                mesh.add_quad_grid(s as u32, &surface.vertices, nu, nv, normal)
+            }
+            Plan::TriangleFan { m, .. } => {
+                let mut shared = HashMap::new();
+                for tri in fan_triangles(&surface.vertices) {
+                    mesh.add_subdivided_triangle(s as u32, tri, m, normal, &mut shared);
+                }
+            }
+        }
+        mesh.surface_vertices
+            .push(first_vertex..mesh.vertices.len() as u32);
+        mesh.surface_elements
+            .push(first_element..mesh.elements.len() as u32);
+    }
+    mesh.build_neighbours();
+    Ok(mesh)
+}
+
+impl Mesh {
+    /// The number of elements.
+    pub fn len(&self) -> usize {
+        self.elements.len()
+    }
+
+    /// True when the mesh has no elements.
+    pub fn is_empty(&self) -> bool {
+        self.elements.is_empty()
+    }
+
+    /// The corner positions of element `e`.
+    pub fn corner_positions(&self, e: usize) -> impl ExactSizeIterator<Item = DVec3> + '_ {
+        self.elements[e]
+            .corners()
+            .iter()
+            .map(|&v| self.vertices[v as usize])
+    }
+
+    /// The elements that share an edge with element `e` on the same surface.
+    pub fn neighbours(&self, e: usize) -> &[u32] {
+        let lo = self.neighbour_offsets[e] as usize;
+        let hi = self.neighbour_offsets[e + 1] as usize;
+        &self.neighbour_list[lo..hi]
+    }
+
+    /// The total area of all elements.
+    pub fn total_area(&self) -> f64 {
+        self.elements.iter().map(|e| e.area).sum()
+    }
+
+    /// Appends to `out` the `k` x `k` midpoint-rule integration points of element `e` with
+    /// their area weights (which sum to the element's area).
+    ///
+    /// A quadrilateral is sampled at the centres of a k x k grid in its bilinear parameters,
+    /// weighted by the bilinear Jacobian; a triangle at the centroids of its k^2 congruent
+    /// sub-triangles, each weighted area / k^2.
+    pub fn integration_points(&self, e: usize, k: u32, out: &mut Vec<(DVec3, f64)>) {
+        let el = &self.elements[e];
+        let p: Vec<DVec3> = self.corner_positions(e).collect();
+        let kf = k as f64;
+        if el.is_quad() {
+            let start = out.len();
+            let mut total = 0.0;
+            for j in 0..k {
+                for i in 0..k {
+                    let (u, v) = ((i as f64 + 0.5) / kf, (j as f64 + 0.5) / kf);
+                    // |d/du x d/dv| of the bilinear map, times the cell's parameter area.
+                    let du = (1.0 - v) * (p[1] - p[0]) + v * (p[2] - p[3]);
+                    let dv = (1.0 - u) * (p[3] - p[0]) + u * (p[2] - p[1]);
+                    let w = du.cross(dv).length() / (kf * kf);
+                    total += w;
+                    out.push((bilinear(&p, u, v), w));
+                }
+            }
+            // Rescale so the weights sum exactly to the element area (the midpoint Jacobian
+            // is exact for parallelograms and second-order accurate otherwise).
+            let scale = if total > 0.0 { el.area / total } else { 0.0 };
+            for (_, w) in &mut out[start..] {
+                *w *= scale;
+            }
+        } else {
+            let w = el.area / (kf * kf);
+            for_each_subtriangle([p[0], p[1], p[2]], k, |t| {
+                out.push(((t[0] + t[1] + t[2]) / 3.0, w))
+            });
+        }
+    }
+
+    fn push_element(&mut self, surface: u32, corners: &[u32], normal: DVec3) {
+        let pos: Vec<DVec3> = corners.iter().map(|&c| self.vertices[c as usize]).collect();
+        let mut c = [u32::MAX; 4];
+        c[..corners.len()].copy_from_slice(corners);
+        self.elements.push(Element {
+            surface,
+            corners: c,
+            corner_count: corners.len() as u8,
+            area: geometry::polygon_area(&pos),
+            centroid: geometry::polygon_centroid(&pos),
+            normal,
+        });
+    }
+
+    fn add_quad_grid(&mut self, surface: u32, q: &[DVec3], nu: u32, nv: u32, normal: DVec3) {
+        let base = self.vertices.len() as u32;
+        for j in 0..=nv {
+            for i in 0..=nu {
+                self.vertices
+                    .push(bilinear(q, i as f64 / nu as f64, j as f64 / nv as f64));
+            }
+        }
+        let id = |i: u32, j: u32| base + j * (nu + 1) + i;
+        for j in 0..nv {
+            for i in 0..nu {
+                self.push_element(
+                    surface,
+                    &[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)],
+                    normal,
+                );
+            }
+        }
+    }
+
+    /// Cuts triangle `t` into m^2 triangles on the lattice of points
+    /// t0 + (a/m)(t1 - t0) + (b/m)(t2 - t0). Lattice points are shared through `shared`
+    /// (keyed by exact position), so fan triangles of one surface meet conformingly.
+    fn add_subdivided_triangle(
+        &mut self,
+        surface: u32,
+        t: [DVec3; 3],
+        m: u32,
+        normal: DVec3,
+        shared: &mut HashMap<[u64; 3], u32>,
+    ) {
+        let mf = m as f64;
+        let mut index = |mesh: &mut Mesh, a: u32, b: u32| -> u32 {
+            // Edge points are computed from the edge's two ends only, so that the fan
+            // triangle on the other side of the edge computes bit-identical positions.
+            let p = lattice_point(t, a, b, mf);
+            let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+            *shared.entry(key).or_insert_with(|| {
+                mesh.vertices.push(p);
+                mesh.vertices.len() as u32 - 1
+            })
+        };
+        for b in 0..m {
+            for a in 0..m - b {
+                let (p00, p10, p01) = (
+                    index(self, a, b),
+                    index(self, a + 1, b),
+                    index(self, a, b + 1),
+                );
+                self.push_element(surface, &[p00, p10, p01], normal);
+                if a + b + 1 < m {
+                    let p11 = index(self, a + 1, b + 1);
+                    self.push_element(surface, &[p10, p11, p01], normal);
+                }
+            }
+        }
+    }
+
+    fn build_neighbours(&mut self) {
+        // Two elements are neighbours when they share an edge (a pair of corner indices);
+        // corner indices are per surface, so neighbours never cross surfaces.
+        let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+        for (e, el) in self.elements.iter().enumerate() {
+            let c = el.corners();
+            for i in 0..c.len() {
+                let (a, b) = (c[i], c[(i + 1) % c.len()]);
+                edges
+                    .entry((a.min(b), a.max(b)))
+                    .or_default()
+                    .push(e as u32);
+            }
+        }
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); self.elements.len()];
+        for owners in edges.values() {
+            for &x in owners {
+                for &y in owners {
+                    if x != y {
+                        lists[x as usize].push(y);
+                    }
+                }
+            }
+        }
+        self.neighbour_offsets = Vec::with_capacity(lists.len() + 1);
+        self.neighbour_offsets.push(0);
+        self.neighbour_list.clear();
+        for mut l in lists {
+            l.sort_unstable();
+            l.dedup();
+            self.neighbour_list.extend_from_slice(&l);
+            self.neighbour_offsets
+                .push(self.neighbour_list.len() as u32);
+        }
+    }
+}
+
+/// The lattice point (a, b) of triangle `t` cut into `m` along each edge. Points on an edge
+/// are interpolated between that edge's two ends alone, so neighbouring triangles that share
+/// the edge compute bit-identical positions.
+fn lattice_point(t: [DVec3; 3], a: u32, b: u32, m: f64) -> DVec3 {
+    let (a, b) = (a as f64, b as f64);
+    let c = m - a - b;
+    if b == 0.0 {
+        t[0] + (a / m) * (t[1] - t[0])
+    } else if a == 0.0 {
+        t[0] + (b / m) * (t[2] - t[0])
+    } else if c == 0.0 {
+        t[1] + (b / m) * (t[2] - t[1])
+    } else {
+        (c * t[0] + a * t[1] + b * t[2]) / m
+    }
+}
+
+/// Calls `f` with each of the k^2 congruent sub-triangles of `t`.
+pub fn for_each_subtriangle(t: [DVec3; 3], k: u32, mut f: impl FnMut([DVec3; 3])) {
+    let kf = k as f64;
+    let p = |a: u32, b: u32| lattice_point(t, a, b, kf);
+    for b in 0..k {
+        for a in 0..k - b {
+            f([p(a, b), p(a + 1, b), p(a, b + 1)]);
+            if a + b + 1 < k {
+                f([p(a + 1, b), p(a + 1, b + 1), p(a, b + 1)]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{MeshSettings, Rgb, Surface};
+    use glam::dvec3;
+
+    fn scene_of(polys: Vec<Vec<DVec3>>) -> Scene {
+        Scene {
+            settings: MeshSettings {
+                max_patch_area: 1.0,
+                integral_steps: 1,
+            },
+            surfaces: polys
+                .into_iter()
+                .enumerate()
+                .map(|(i, vertices)| Surface {
+                    name: format!("s{i}"),
+                    emission: Rgb::BLACK,
+                    reflectance: Rgb([0.5; 3]),
+                    vertices,
+                })
+                .collect(),
+            camera: None,
+        }
+    }
+
+    fn rect(w: f64, h: f64) -> Vec<DVec3> {
+        vec![
+            dvec3(0., 0., 0.),
+            dvec3(w, 0., 0.),
+            dvec3(w, h, 0.),
+            dvec3(0., h, 0.),
+        ]
+    }
+
+    fn check_invariants(scene: &Scene, mesh: &Mesh, max_area: f64) {
+        for (s, surf) in scene.surfaces.iter().enumerate() {
+            let range = mesh.surface_elements[s].clone();
+            let sum: f64 = range.clone().map(|e| mesh.elements[e as usize].area).sum();
+            let a = geometry::polygon_area(&surf.vertices);
+            assert!(
+                (sum - a).abs() < 1e-9 * a,
+                "surface {s}: elements cover {sum}, surface {a}"
+            );
+            for e in range {
+                let el = &mesh.elements[e as usize];
+                assert!(
+                    el.area <= max_area * (1.0 + 1e-9),
+                    "element {e} area {} > {max_area}",
+                    el.area
+                );
+                assert!(el.area > 0.0);
+                let pos: Vec<DVec3> = mesh.corner_positions(e as usize).collect();
+                assert!(geometry::is_convex(&pos), "element {e} not convex");
+                assert!((geometry::polygon_normal(&pos).unwrap() - el.normal).length() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn rectangle_grid_is_near_square() {
+        let scene = scene_of(vec![rect(4.0, 1.0)]);
+        let mesh = mesh_scene(&scene, 0.25).unwrap();
+        assert_eq!(mesh.len(), 16); // 8 x 2 cells of 0.5 x 0.5
+        check_invariants(&scene, &mesh, 0.25);
+        for el in &mesh.elements {
+            assert!((el.area - 0.25).abs() < 1e-12);
+        }
+        assert_eq!(mesh.vertices.len(), 9 * 3);
+    }
+
+    #[test]
+    fn small_surface_is_one_element() {
+        let scene = scene_of(vec![rect(1.0, 1.0)]);
+        let mesh = mesh_scene(&scene, 2.0).unwrap();
+        assert_eq!(mesh.len(), 1);
+        assert!(mesh.neighbours(0).is_empty());
+    }
+
+    #[test]
+    fn trapezoid_cells_all_fit() {
+        let q = vec![
+            dvec3(0., 0., 0.),
+            dvec3(10., 0., 0.),
+            dvec3(7., 3., 0.),
+            dvec3(2., 3., 0.),
+        ];
+        let scene = scene_of(vec![q]);
+        let mesh = mesh_scene(&scene, 0.7).unwrap();
+        check_invariants(&scene, &mesh, 0.7);
+    }
+
+    #[test]
+    fn triangle_and_pentagon_are_conforming() {
+        let tri = vec![dvec3(0., 0., 0.), dvec3(3., 0., 0.), dvec3(0., 3., 1.)];
+        let pent: Vec<DVec3> = (0..5)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 5.0;
+                dvec3(2.0 * a.cos(), 2.0 * a.sin(), 5.0)
+            })
+            .collect();
+        let scene = scene_of(vec![tri, pent]);
+        let mesh = mesh_scene(&scene, 0.3).unwrap();
+        check_invariants(&scene, &mesh, 0.3);
+        // Conforming: every interior edge is shared by exactly two elements, so Euler's
+        // formula for a disc holds: V - E + F = 1 on each surface.
+        for s in 0..2 {
+            let mut edges = std::collections::HashSet::new();
+            for e in mesh.surface_elements[s].clone() {
+                let c = mesh.elements[e as usize].corners();
+                for i in 0..c.len() {
+                    let (a, b) = (c[i], c[(i + 1) % c.len()]);
+                    edges.insert((a.min(b), a.max(b)));
+                }
+            }
+            let v = mesh.surface_vertices[s].len() as i64;
+            let f = mesh.surface_elements[s].len() as i64;
+            assert_eq!(
+                v - edges.len() as i64 + f,
+                1,
+                "surface {s} is not a conforming disc"
+            );
+        }
+    }
+
+    #[test]
+    fn neighbours_of_grid_cell() {
+        let scene = scene_of(vec![rect(3.0, 3.0)]);
+        let mesh = mesh_scene(&scene, 1.0).unwrap();
+        assert_eq!(mesh.len(), 9);
+        assert_eq!(mesh.neighbours(4), &[1, 3, 5, 7]); // the centre cell
+        assert_eq!(mesh.neighbours(0), &[1, 3]);
+    }
+
+    #[test]
+    fn integration_weights_sum_to_area() {
+        let q = vec![
+            dvec3(0., 0., 0.),
+            dvec3(10., 0., 0.),
+            dvec3(7., 3., 0.),
+            dvec3(2., 3., 0.),
+        ];
+        let tri = vec![dvec3(0., 0., 0.), dvec3(3., 0., 0.), dvec3(0., 3., 1.)];
+        let scene = scene_of(vec![q, tri]);
+        let mesh = mesh_scene(&scene, 100.0).unwrap();
+        for e in 0..mesh.len() {
+            for k in 1..5 {
+                let mut pts = Vec::new();
+                mesh.integration_points(e, k, &mut pts);
+                assert_eq!(pts.len(), (k * k) as usize);
+                let w: f64 = pts.iter().map(|p| p.1).sum();
+                assert!((w - mesh.elements[e].area).abs() < 1e-12 * w);
+                // The weighted mean of the points is the centroid for a triangle exactly;
+                // for the trapezoid the midpoint rule is within its O(1/k^2) error.
+                let c = pts.iter().map(|p| p.0 * p.1).sum::<DVec3>() / w;
+                assert!((c - mesh.elements[e].centroid).length() < 0.2 / (k * k) as f64);
+            }
+        }
+    }
+
+    #[test]
+    fn refuses_too_many_elements_before_allocating() {
+        let scene = scene_of(vec![rect(1000.0, 1000.0)]);
+        let err = mesh_scene(&scene, 1e-3).unwrap_err();
+        assert!(matches!(err, MeshError::TooManyElements { count, .. } if count >= 1_000_000_000));
+        assert_eq!(
+            mesh_scene(&scene, 0.0).unwrap_err(),
+            MeshError::BadMaxArea(0.0)
+        );
+    }
+}

@@ -1,0 +1,83 @@
+//! The one interface that long work reports progress through.
+//!
+//! Every long stage (meshing, form factors, solving, rendering) calls a [`Progress`] sink:
+//! the command-line program draws a progress bar from it, a window can redraw between calls,
+//! and a distributed runner can forward the calls to its coordinator. The library never
+//! prints.
+
+use std::time::Duration;
+
+/// A stage of the pipeline, as reported to a [`Progress`] sink.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// Reading and checking the scene file.
+    Parse,
+    /// Subdividing surfaces into elements.
+    Mesh,
+    /// Building the ray-query acceleration structure.
+    Bvh,
+    /// Computing form factors (work unit: one matrix row).
+    FormFactors,
+    /// Solving the radiosity system (work unit: one band or one iteration).
+    Solve,
+    /// Computing vertex radiosities.
+    Shade,
+    /// Rendering the image (work unit: one image row).
+    Render,
+    /// Writing output files.
+    Write,
+}
+
+impl Stage {
+    /// A short human-readable name, as printed in timings.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Parse => "parse",
+            Stage::Mesh => "mesh",
+            Stage::Bvh => "bvh",
+            Stage::FormFactors => "form factors",
+            Stage::Solve => "solve",
+            Stage::Shade => "shade",
+            Stage::Render => "render",
+            Stage::Write => "write",
+        }
+    }
+}
+
+/// Receives progress reports. Implementations must be cheap: `advance` may be called from
+/// many threads, once per unit of work (for example once per form-factor row).
+pub trait Progress: Sync {
+    /// A stage begins; `total` units of work are expected (0 when unknown).
+    fn start(&self, stage: Stage, total: u64);
+    /// `done` more units of work of the current stage have finished.
+    fn advance(&self, done: u64);
+    /// The current stage ended after `elapsed` wall-clock time.
+    fn finish(&self, stage: Stage, elapsed: Duration);
+    /// An informational message (for example the reciprocity error found).
+    fn message(&self, _text: &str) {}
+}
+
+/// A sink that ignores every report.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn start(&self, _stage: Stage, _total: u64) {}
+    fn advance(&self, _done: u64) {}
+    fn finish(&self, _stage: Stage, _elapsed: Duration) {}
+}
+
+/// Runs `work` as `stage`, reporting its start and its end (with the elapsed time) to
+/// `progress`, and returns its result.
+pub fn run_stage<T>(
+    progress: &dyn Progress,
+    stage: Stage,
+    total: u64,
+    work: impl FnOnce() -> T,
+) -> T {
+    let start = std::time::Instant::now();
+    progress.start(stage, total);
+    let out = work();
+    progress.finish(stage, start.elapsed());
+    out
+}

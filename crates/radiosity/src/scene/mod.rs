@@ -1,0 +1,98 @@
+//! Scenes: surfaces with emission and reflectance, in the paper's Appendix A format.
+//!
+//! A [`Scene`] is what a scene file says, after parsing and checking: meshing settings and a
+//! list of planar convex [`Surface`]s. Each surface is one-sided: it emits and reflects only
+//! on its front, the side from which its vertices run counter-clockwise (the right-hand-rule
+//! normal points out of the front). Every surface occludes from both sides.
+
+use glam::DVec3;
+
+/// A colour triple in linear red, green, blue bands.
+///
+/// Used both for emission (exitance per band, scene units) and reflectance (fraction in [0, 1)).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rgb(pub [f64; 3]);
+
+impl Rgb {
+    /// All three bands zero.
+    pub const BLACK: Rgb = Rgb([0.0; 3]);
+
+    /// The value of band `b` (0 red, 1 green, 2 blue).
+    pub fn band(self, b: usize) -> f64 {
+        self.0[b]
+    }
+
+    /// The largest of the three bands.
+    pub fn max_band(self) -> f64 {
+        self.0[0].max(self.0[1]).max(self.0[2])
+    }
+}
+
+/// The meshing and integration settings at the top of a scene file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshSettings {
+    /// `MAX_PATCH_AREA`: surfaces larger than this (scene units squared) are subdivided into
+    /// elements of at most this area.
+    pub max_patch_area: f64,
+    /// `INTEGRAL_STEPS`: k, the number of sample points along each axis of each element in
+    /// the double area integral (paper 2.8; 1 means one point per element).
+    pub integral_steps: u32,
+}
+
+/// One planar convex polygon of the scene, as written in a `PATCHBEGIN` ... `PATCHEND` block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    /// The patch's `#NAME` line, without the `#`.
+    pub name: String,
+    /// Emitted exitance E per band (scene units, >= 0).
+    pub emission: Rgb,
+    /// Diffuse reflectance rho per band, in [0, 1).
+    pub reflectance: Rgb,
+    /// The corners, counter-clockwise seen from the front; at least 3, planar and convex.
+    pub vertices: Vec<DVec3>,
+}
+
+/// A checked scene: settings and surfaces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Meshing and integration settings.
+    pub settings: MeshSettings,
+    /// The surfaces, in file order (a box primitive contributes six).
+    pub surfaces: Vec<Surface>,
+    /// A suggested camera, for scenes that come with one (the built-in Cornell box).
+    pub camera: Option<CameraHint>,
+}
+
+/// A camera that a scene suggests for rendering it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraHint {
+    /// Eye position.
+    pub eye: DVec3,
+    /// Point looked at.
+    pub look_at: DVec3,
+    /// Up direction.
+    pub up: DVec3,
+    /// Vertical field of view in degrees.
+    pub fov_y_degrees: f64,
+}
+
+impl Scene {
+    /// The smallest axis-aligned box holding every vertex, as (min, max).
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in self.surfaces.iter().flat_map(|s| s.vertices.iter()) {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        (lo, hi)
+    }
+
+    /// The total area of all surfaces (scene units squared).
+    pub fn total_area(&self) -> f64 {
+        self.surfaces
+            .iter()
+            .map(|s| crate::geometry::polygon_area(&s.vertices))
+            .sum()
+    }
+}

@@ -1,0 +1,289 @@
+//! Ray queries against planar convex polygons through a bounding volume hierarchy.
+//!
+//! One [`PolygonBvh`] answers both queries the pipeline needs: "is the segment from p to q
+//! blocked?" (an any-hit query, for form-factor occlusion) and "what does this ray hit
+//! first?" (closest hit, for rendering). The hierarchy is obvhs's compressed wide BVH
+//! (CWBVH, Ylitie et al. 2017), a maintained pure-Rust crate that needs no system library.
+//!
+//! The primitives are whole convex polygons, not triangles: obvhs's triangle test is not
+//! watertight (a ray through the diagonal shared by two triangles of one quad can pass
+//! between them, and form-factor sample points lie on such diagonals by symmetry), so the
+//! leaf test here is written by hand: the ray meets the polygon's plane in f64, and the
+//! point is inside when it is on the inner side of every edge (edges included).
+
+use std::time::Duration;
+
+use glam::{DVec3, Vec3A};
+use obvhs::{
+    aabb::Aabb, cwbvh::builder::build_cwbvh, cwbvh::CwBvh, ray::Ray, ray::RayHit, Boundable,
+    BvhBuildParams,
+};
+
+/// A polygon as the BVH builder sees it: its bounding box.
+struct Bounds(Aabb);
+
+impl Boundable for Bounds {
+    fn aabb(&self) -> Aabb {
+        self.0
+    }
+}
+
+/// One polygon, ready for ray tests.
+#[derive(Clone, Debug)]
+struct Polygon {
+    /// Unit normal (front side).
+    normal: DVec3,
+    /// Plane offset: normal . x = offset on the plane.
+    offset: f64,
+    /// First corner in `PolygonBvh::corners`.
+    first: u32,
+    /// Number of corners.
+    count: u32,
+    /// Caller's id.
+    id: u32,
+}
+
+/// Planar convex polygons, each tagged with a caller's id (for example the surface or the
+/// element it is), in a BVH.
+pub struct PolygonBvh {
+    bvh: CwBvh,
+    /// Polygons in BVH primitive order, so a leaf's primitive index is a direct lookup.
+    polygons: Vec<Polygon>,
+    corners: Vec<DVec3>,
+    /// Length of the bounding-box diagonal of all polygons, for relative tolerances.
+    scale: f64,
+}
+
+/// The first thing a ray hits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the (unit) ray direction.
+    pub t: f64,
+    /// The caller's id of the polygon hit.
+    pub id: u32,
+}
+
+impl PolygonBvh {
+    /// Builds the hierarchy over `polygons` (each planar and convex, at least 3 corners),
+    /// each tagged with the id at the same index of `ids`.
+    ///
+    /// # Panics
+    /// If `polygons` and `ids` differ in length.
+    pub fn new<P: AsRef<[DVec3]>>(polygons: &[P], ids: &[u32]) -> PolygonBvh {
+        assert_eq!(polygons.len(), ids.len());
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in polygons.iter().flat_map(|p| p.as_ref().iter()) {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        let scale = if polygons.is_empty() {
+            1.0
+        } else {
+            (hi - lo).length().max(f64::MIN_POSITIVE)
+        };
+        // Pad boxes so that flat, axis-aligned polygons get boxes of non-zero thickness.
+        let pad = (1e-6 * scale) as f32;
+        let bounds: Vec<Bounds> = polygons
+            .iter()
+            .map(|p| {
+                let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| to_f32(*v)).collect();
+                let b = Aabb::from_points(&pts);
+                Bounds(Aabb::new(
+                    b.min - Vec3A::splat(pad),
+                    b.max + Vec3A::splat(pad),
+                ))
+            })
+            .collect();
+        let mut corners = Vec::new();
+        let mut records = Vec::with_capacity(polygons.len());
+        for (p, &id) in polygons.iter().zip(ids) {
+            let v = p.as_ref();
+            let normal = crate::geometry::polygon_normal(v).unwrap_or(DVec3::Z);
+            let offset = normal.dot(crate::geometry::vertex_mean(v));
+            records.push(Polygon {
+                normal,
+                offset,
+                first: corners.len() as u32,
+                count: v.len() as u32,
+                id,
+            });
+            corners.extend_from_slice(v);
+        }
+        if bounds.is_empty() {
+            return PolygonBvh {
+                bvh: CwBvh::default(),
+                polygons: records,
+                corners,
+                scale,
+            };
+        }
+        let bvh = build_cwbvh(
+            &bounds,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let polygons = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| records[i as usize].clone())
+            .collect();
+        PolygonBvh {
+            bvh,
+            polygons,
+            corners,
+            scale,
+        }
+    }
+
+    /// The number of polygons.
+    pub fn len(&self) -> usize {
+        self.polygons.len()
+    }
+
+    /// True when there are no polygons.
+    pub fn is_empty(&self) -> bool {
+        self.polygons.is_empty()
+    }
+
+    /// The length of the bounding-box diagonal of all polygons.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// Where the ray `origin + t dir` meets polygon `k` with `t_min <= t <= t_max`.
+    #[inline]
+    fn intersect(
+        &self,
+        k: usize,
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        t_max: f64,
+    ) -> Option<f64> {
+        let poly = &self.polygons[k];
+        let denom = poly.normal.dot(dir);
+        if denom == 0.0 {
+            return None;
+        }
+        let t = (poly.offset - poly.normal.dot(origin)) / denom;
+        if !(t >= t_min && t <= t_max) {
+            return None;
+        }
+        let x = origin + t * dir;
+        let c = &self.corners[poly.first as usize..(poly.first + poly.count) as usize];
+        // Inside (edges included, to 1e-9 of the scene size) when on the inner side of
+        // every edge; the corners run counter-clockwise about the normal.
+        let tol = 1e-9 * self.scale;
+        let mut a = c[c.len() - 1];
+        for &b in c {
+            let edge = b - a;
+            if edge.cross(x - a).dot(poly.normal) < -tol * edge.length() {
+                return None;
+            }
+            a = b;
+        }
+        Some(t)
+    }
+
+    /// True when some polygon crosses the open segment from `p` to `q`.
+    ///
+    /// The segment's ends are trimmed by 1e-7 of the scene's diagonal, so surfaces that
+    /// `p` and `q` lie on, and surfaces that meet them at a shared edge, do not block it.
+    pub fn segment_blocked(&self, p: DVec3, q: DVec3) -> bool {
+        if self.polygons.is_empty() {
+            return false;
+        }
+        let d = q - p;
+        let len = d.length();
+        let eps = 1e-7 * self.scale;
+        if len <= 2.0 * eps {
+            return false;
+        }
+        let dir = d / len;
+        let ray = Ray::new(to_f32(p), to_f32(dir), 0.0, len as f32 * 1.001 + eps as f32);
+        !self.bvh.ray_traverse_miss(ray, |_, k| {
+            match self.intersect(k, p, dir, eps, len - eps) {
+                Some(t) => t as f32,
+                None => f32::INFINITY,
+            }
+        })
+    }
+
+    /// The first polygon hit by the ray from `origin` along unit `dir`, with `t_min <= t <= t_max`.
+    pub fn closest_hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
+        if self.polygons.is_empty() {
+            return None;
+        }
+        let ray = Ray::new(to_f32(origin), to_f32(dir), 0.0, t_max as f32 * 1.001);
+        let mut hit = RayHit::none();
+        let mut best: Option<(f64, u32)> = None;
+        self.bvh.ray_traverse(ray, &mut hit, |_, k| {
+            let limit = best.map_or(t_max, |b| b.0);
+            match self.intersect(k, origin, dir, t_min, limit) {
+                Some(t) => {
+                    best = Some((t, self.polygons[k].id));
+                    // Report a t just inside the f32 ray's range so the traversal keeps
+                    // shrinking its interval; the exact t is kept in f64 in `best`.
+                    t as f32
+                }
+                None => f32::INFINITY,
+            }
+        });
+        best.map(|(t, id)| Hit { t, id })
+    }
+}
+
+/// Converts to f32, turning -0.0 into +0.0: obvhs picks the traversal octant from the sign
+/// bits of the direction, and a -0.0 component makes its slab tests miss (found by the unit
+/// test `closest_hit_reports_nearest_id`, which shoots along -Z).
+fn to_f32(v: DVec3) -> Vec3A {
+    Vec3A::new(v.x as f32 + 0.0, v.y as f32 + 0.0, v.z as f32 + 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::dvec3;
+
+    fn square_at_z(z: f64, id: u32) -> (Vec<Vec<DVec3>>, Vec<u32>) {
+        let (a, b, c, d) = (
+            dvec3(0., 0., z),
+            dvec3(1., 0., z),
+            dvec3(1., 1., z),
+            dvec3(0., 1., z),
+        );
+        (vec![vec![a, b, c, d]], vec![id])
+    }
+
+    #[test]
+    fn segment_through_square_is_blocked() {
+        let (t, ids) = square_at_z(1.0, 7);
+        let bvh = PolygonBvh::new(&t, &ids);
+        assert!(bvh.segment_blocked(dvec3(0.5, 0.5, 0.0), dvec3(0.5, 0.5, 2.0)));
+        assert!(!bvh.segment_blocked(dvec3(0.5, 0.5, 0.0), dvec3(0.5, 0.5, 0.9)));
+        assert!(!bvh.segment_blocked(dvec3(1.5, 0.5, 0.0), dvec3(1.5, 0.5, 2.0)));
+        // The square's centre and edges block too (no gaps between pieces).
+        assert!(bvh.segment_blocked(dvec3(0.5, 0.5, 0.0), dvec3(0.5, 0.5, 2.0)));
+        assert!(bvh.segment_blocked(dvec3(1.0, 0.5, 0.0), dvec3(1.0, 0.5, 2.0)));
+        // A segment that ends on the square itself is not blocked by it.
+        assert!(!bvh.segment_blocked(dvec3(0.5, 0.5, 0.0), dvec3(0.3, 0.3, 1.0)));
+    }
+
+    #[test]
+    fn closest_hit_reports_nearest_id() {
+        let (mut t, mut ids) = square_at_z(1.0, 1);
+        let (t2, ids2) = square_at_z(2.0, 2);
+        t.extend(t2);
+        ids.extend(ids2);
+        let bvh = PolygonBvh::new(&t, &ids);
+        let hit = bvh
+            .closest_hit(dvec3(0.25, 0.5, 3.0), -DVec3::Z, 0.0, 10.0)
+            .unwrap();
+        assert_eq!(hit.id, 2);
+        assert!((hit.t - 1.0).abs() < 1e-6);
+        assert!(bvh
+            .closest_hit(dvec3(5.0, 0.5, 3.0), -DVec3::Z, 0.0, 10.0)
+            .is_none());
+    }
+}
