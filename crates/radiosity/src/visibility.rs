@@ -13,7 +13,7 @@
 
 use std::time::Duration;
 
-use glam::{DVec3, Vec3A};
+use glam::{DVec3, UVec2, Vec3A};
 use obvhs::{
     aabb::Aabb, cwbvh::builder::build_cwbvh, cwbvh::CwBvh, ray::Ray, ray::RayHit, Boundable,
     BvhBuildParams,
@@ -41,6 +41,9 @@ struct Polygon {
     count: u32,
     /// Caller's id.
     id: u32,
+    /// Bounding box.
+    lo: DVec3,
+    hi: DVec3,
 }
 
 /// Planar convex polygons, each tagged with a caller's id (for example the surface or the
@@ -101,12 +104,18 @@ impl PolygonBvh {
             let v = p.as_ref();
             let normal = crate::geometry::polygon_normal(v).unwrap_or(DVec3::Z);
             let offset = normal.dot(crate::geometry::vertex_mean(v));
+            let lo = v.iter().fold(DVec3::splat(f64::INFINITY), |a, b| a.min(*b));
+            let hi = v
+                .iter()
+                .fold(DVec3::splat(f64::NEG_INFINITY), |a, b| a.max(*b));
             records.push(Polygon {
                 normal,
                 offset,
                 first: corners.len() as u32,
                 count: v.len() as u32,
                 id,
+                lo,
+                hi,
             });
             corners.extend_from_slice(v);
         }
@@ -184,6 +193,67 @@ impl PolygonBvh {
             a = b;
         }
         Some(t)
+    }
+
+    /// Appends to `out` every polygon (as an index for [`PolygonBvh::segment_blocked_by`])
+    /// whose bounding box overlaps the box from `lo` to `hi`: a BVH box query. Together
+    /// with the segment test below this gives shaft-style culling: the segments between two
+    /// elements stay inside the box around both, so only these polygons can block them.
+    pub fn overlapping(&self, lo: DVec3, hi: DVec3, out: &mut Vec<u32>) {
+        if self.polygons.is_empty() {
+            return;
+        }
+        let pad = 1e-6 * self.scale;
+        let query = Aabb::new(
+            to_f32(lo - DVec3::splat(pad)),
+            to_f32(hi + DVec3::splat(pad)),
+        );
+        let bvh = &self.bvh;
+        let mut state = bvh.new_traversal(Vec3A::ZERO);
+        let mut node;
+        obvhs::traverse!(
+            bvh,
+            node,
+            state,
+            node.intersect_aabb(&query, state.oct_inv4),
+            {
+                out.push(state.primitive_id);
+            }
+        );
+    }
+
+    /// The bounding box (min, max) of polygon `index` (an index from
+    /// [`PolygonBvh::overlapping`]).
+    pub fn box_of(&self, index: u32) -> (DVec3, DVec3) {
+        let poly = &self.polygons[index as usize];
+        (poly.lo, poly.hi)
+    }
+
+    /// The caller's id of polygon `index` (an index from [`PolygonBvh::overlapping`]).
+    pub fn id_of(&self, index: u32) -> u32 {
+        self.polygons[index as usize].id
+    }
+
+    /// The corners of polygon `index` (an index from [`PolygonBvh::overlapping`]).
+    pub fn corners_of(&self, index: u32) -> &[DVec3] {
+        let poly = &self.polygons[index as usize];
+        &self.corners[poly.first as usize..(poly.first + poly.count) as usize]
+    }
+
+    /// True when one of the polygons `candidates` (indices from [`PolygonBvh::overlapping`])
+    /// crosses the open segment from `p` to `q`, trimmed as in [`PolygonBvh::segment_blocked`].
+    #[inline]
+    pub fn segment_blocked_by(&self, candidates: &[u32], p: DVec3, q: DVec3) -> bool {
+        let d = q - p;
+        let len = d.length();
+        let eps = 1e-7 * self.scale;
+        if len <= 2.0 * eps {
+            return false;
+        }
+        let dir = d / len;
+        candidates
+            .iter()
+            .any(|&k| self.intersect(k as usize, p, dir, eps, len - eps).is_some())
     }
 
     /// True when some polygon crosses the open segment from `p` to `q`.

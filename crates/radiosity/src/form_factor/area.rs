@@ -11,47 +11,188 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::{ElementSamples, FormFactorContext, RayCounter};
+use super::{FormFactorContext, RayCounter};
 
-/// A_i F_ij by the midpoint rule over the precomputed samples of elements i and j, with
-/// occlusion. Emission and reflection are one-sided, so a point pair contributes only when
-/// each point is in front of the other's element.
-pub(super) fn coupling(
-    ctx: &FormFactorContext,
-    samples: &ElementSamples,
-    i: usize,
-    j: usize,
-    rays: &RayCounter,
-) -> f64 {
-    let ei = &ctx.mesh.elements[i];
-    let ej = &ctx.mesh.elements[j];
-    // Coplanar elements of one surface, or elements that face away from each other
-    // entirely, exchange nothing: skip their rays.
-    if ei.surface == ej.surface {
-        return 0.0;
-    }
-    let (ni, nj) = (ei.normal, ej.normal);
-    let mut sum = 0.0;
-    let mut cast = 0;
-    for &(p, wp) in samples.of(i) {
-        for &(q, wq) in samples.of(j) {
-            let d = q - p;
-            let r2 = d.length_squared();
-            let cos_p = ni.dot(d);
-            let cos_q = -nj.dot(d);
-            if cos_p <= 0.0 || cos_q <= 0.0 || r2 == 0.0 {
-                continue;
-            }
-            cast += 1;
-            if ctx.occluders.segment_blocked(p, q) {
-                continue;
-            }
-            // cos_p and cos_q carry a factor |d| each: divide by r^4 in all.
-            sum += cos_p * cos_q / (PI * r2 * r2) * wp * wq;
+/// Everything the area integral precomputes once per matrix: integration points and
+/// bounding boxes of the elements, bounding boxes of the surfaces.
+pub(super) struct AreaIntegrator<'a> {
+    ctx: &'a FormFactorContext<'a>,
+    /// k^2 points per element with their area weights.
+    per_element: usize,
+    points: Vec<(DVec3, f64)>,
+    /// Bounding box (min, max) of each element.
+    element_box: Vec<(DVec3, DVec3)>,
+    /// Bounding box of each surface (of its elements).
+    surface_box: Vec<(DVec3, DVec3)>,
+}
+
+/// Scratch space for one worker thread, reused across rows.
+#[derive(Default)]
+pub(super) struct Scratch {
+    /// Occluder candidates between the current row's element and the current surface.
+    surface_candidates: Vec<u32>,
+    /// Those of `surface_candidates` whose boxes meet the current pair's box.
+    pair_candidates: Vec<u32>,
+}
+
+fn bounds(points: impl Iterator<Item = DVec3>) -> (DVec3, DVec3) {
+    points.fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
+}
+
+fn boxes_overlap(a: (DVec3, DVec3), b: (DVec3, DVec3), pad: f64) -> bool {
+    a.0.cmple(b.1 + pad).all() && b.0.cmple(a.1 + pad).all()
+}
+
+impl<'a> AreaIntegrator<'a> {
+    pub fn new(ctx: &'a FormFactorContext<'a>, k: u32) -> AreaIntegrator<'a> {
+        let mesh = ctx.mesh;
+        let mut points = Vec::with_capacity(mesh.len() * (k * k) as usize);
+        for e in 0..mesh.len() {
+            mesh.integration_points(e, k, &mut points);
+        }
+        let element_box = (0..mesh.len())
+            .map(|e| bounds(mesh.corner_positions(e)))
+            .collect();
+        let surface_box = mesh
+            .surface_vertices
+            .iter()
+            .map(|r| {
+                bounds(
+                    mesh.vertices[r.start as usize..r.end as usize]
+                        .iter()
+                        .copied(),
+                )
+            })
+            .collect();
+        AreaIntegrator {
+            ctx,
+            per_element: (k * k) as usize,
+            points,
+            element_box,
+            surface_box,
         }
     }
-    rays.add(cast);
-    sum
+
+    fn samples(&self, e: usize) -> &[(DVec3, f64)] {
+        &self.points[e * self.per_element..(e + 1) * self.per_element]
+    }
+
+    /// G_ij = A_i F_ij for every j in `columns` (0 where j == i).
+    pub fn couplings(
+        &self,
+        i: usize,
+        columns: std::ops::Range<usize>,
+        rays: &RayCounter,
+        scratch: &mut Scratch,
+    ) -> Vec<f64> {
+        let mesh = self.ctx.mesh;
+        let mut out = Vec::with_capacity(columns.len());
+        let mut current_surface = u32::MAX;
+        for j in columns {
+            let s = mesh.elements[j].surface;
+            if s != current_surface {
+                current_surface = s;
+                self.surface_candidates(i, s as usize, &mut scratch.surface_candidates);
+            }
+            out.push(if i == j {
+                0.0
+            } else {
+                self.coupling(i, j, rays, scratch)
+            });
+        }
+        out
+    }
+
+    /// The occluders that could block a segment from element i to any element of surface
+    /// s: a BVH box query around both, less the two surfaces themselves (a segment leaves
+    /// its plane at once) and surfaces wholly behind the plane of i or of s (segments run
+    /// in front of both).
+    fn surface_candidates(&self, i: usize, s: usize, out: &mut Vec<u32>) {
+        let occ = self.ctx.occluders;
+        let ei = &self.ctx.mesh.elements[i];
+        let (eb, sb) = (self.element_box[i], self.surface_box[s]);
+        out.clear();
+        occ.overlapping(eb.0.min(sb.0), eb.1.max(sb.1), out);
+        let first = self.ctx.mesh.surface_elements[s].start as usize;
+        let (ns, ps) = (
+            self.ctx.mesh.elements[first].normal,
+            self.ctx.mesh.elements[first].centroid,
+        );
+        let (ni, pi) = (ei.normal, ei.centroid);
+        let tol = 1e-9 * occ.scale();
+        out.retain(|&k| {
+            let id = occ.id_of(k);
+            if id == ei.surface || id as usize == s {
+                return false;
+            }
+            let corners = occ.corners_of(k);
+            corners.iter().any(|c| ni.dot(*c - pi) > tol)
+                && corners.iter().any(|c| ns.dot(*c - ps) > tol)
+        });
+    }
+
+    /// A_i F_ij by the midpoint rule over the samples of elements i and j, with occlusion
+    /// against `scratch.surface_candidates` (see [`AreaIntegrator::surface_candidates`]).
+    /// Emission and reflection are one-sided, so a point pair contributes only when each
+    /// point is in front of the other's element.
+    fn coupling(&self, i: usize, j: usize, rays: &RayCounter, scratch: &mut Scratch) -> f64 {
+        let mesh = self.ctx.mesh;
+        let (ei, ej) = (&mesh.elements[i], &mesh.elements[j]);
+        // Coplanar elements of one surface exchange nothing.
+        if ei.surface == ej.surface {
+            return 0.0;
+        }
+        let (ni, nj) = (ei.normal, ej.normal);
+        // Elements wholly behind each other's planes exchange nothing.
+        let in_front = |n: DVec3, origin: DVec3, e: usize| {
+            mesh.corner_positions(e).any(|c| n.dot(c - origin) > 0.0)
+        };
+        if !in_front(ni, ei.centroid, j) || !in_front(nj, ej.centroid, i) {
+            return 0.0;
+        }
+        // Of the surface's candidates, keep those whose boxes meet the box around i and j:
+        // every segment between the two elements stays inside that box.
+        let occ = self.ctx.occluders;
+        let pair_box = {
+            let (a, b) = (self.element_box[i], self.element_box[j]);
+            (a.0.min(b.0), a.1.max(b.1))
+        };
+        let pad = 1e-6 * occ.scale();
+        scratch.pair_candidates.clear();
+        for &k in &scratch.surface_candidates {
+            if boxes_overlap(occ.box_of(k), pair_box, pad) {
+                scratch.pair_candidates.push(k);
+            }
+        }
+        let candidates = &scratch.pair_candidates;
+
+        let mut sum = 0.0;
+        let mut cast = 0;
+        for &(p, wp) in self.samples(i) {
+            for &(q, wq) in self.samples(j) {
+                let d = q - p;
+                let r2 = d.length_squared();
+                let cos_p = ni.dot(d);
+                let cos_q = -nj.dot(d);
+                if cos_p <= 0.0 || cos_q <= 0.0 || r2 == 0.0 {
+                    continue;
+                }
+                if !candidates.is_empty() {
+                    cast += 1;
+                    if occ.segment_blocked_by(candidates, p, q) {
+                        continue;
+                    }
+                }
+                // cos_p and cos_q carry a factor |d| each: divide by r^4 in all.
+                sum += cos_p * cos_q / (PI * r2 * r2) * wp * wq;
+            }
+        }
+        rays.add(cast);
+        sum
+    }
 }
 
 /// The unoccluded area-integral form factor F_12 from polygon 1 to polygon 2 (each planar
@@ -80,6 +221,7 @@ pub fn area_integral_pair(poly1: &[DVec3], poly2: &[DVec3], k: u32) -> f64 {
         mesh: &mesh,
         occluders: &empty,
     };
-    let samples = ElementSamples::new(&mesh, k);
-    coupling(&ctx, &samples, 0, 1, &RayCounter::default()) / mesh.elements[0].area
+    let integrator = AreaIntegrator::new(&ctx, k);
+    integrator.couplings(0, 1..2, &RayCounter::default(), &mut Scratch::default())[0]
+        / mesh.elements[0].area
 }

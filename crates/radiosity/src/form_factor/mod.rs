@@ -214,29 +214,6 @@ pub fn occluder_bvh(scene: &Scene) -> PolygonBvh {
     PolygonBvh::new(&tris, &ids)
 }
 
-/// Precomputed integration points of every element, k^2 per element.
-pub(crate) struct ElementSamples {
-    pub per_element: usize,
-    pub points: Vec<(DVec3, f64)>,
-}
-
-impl ElementSamples {
-    pub fn new(mesh: &Mesh, k: u32) -> ElementSamples {
-        let mut points = Vec::with_capacity(mesh.len() * (k * k) as usize);
-        for e in 0..mesh.len() {
-            mesh.integration_points(e, k, &mut points);
-        }
-        ElementSamples {
-            per_element: (k * k) as usize,
-            points,
-        }
-    }
-
-    pub fn of(&self, e: usize) -> &[(DVec3, f64)] {
-        &self.points[e * self.per_element..(e + 1) * self.per_element]
-    }
-}
-
 /// Counts the rays cast, for rays-per-second figures.
 #[derive(Debug, Default)]
 pub struct RayCounter(AtomicU64);
@@ -280,14 +257,12 @@ pub fn compute_matrix(
     let areas: Vec<f64> = ctx.mesh.elements.iter().map(|e| e.area).collect();
     run_stage(progress, Stage::FormFactors, n as u64, || {
         let FormFactorMethod::AreaIntegral { steps } = method;
-        let samples = ElementSamples::new(ctx.mesh, steps);
+        let integrator = area::AreaIntegrator::new(ctx, steps);
         // Upper triangle, row by row: row i holds G_ij for j > i in columns i+1..n.
         let upper: Vec<Vec<f64>> = (0..n)
             .into_par_iter()
-            .map(|i| {
-                let row: Vec<f64> = (i + 1..n)
-                    .map(|j| area::coupling(ctx, &samples, i, j, rays))
-                    .collect();
+            .map_init(area::Scratch::default, |scratch, i| {
+                let row = integrator.couplings(i, i + 1..n, rays, scratch);
                 progress.advance(1);
                 row
             })
@@ -313,21 +288,18 @@ pub fn compute_rows(
 ) -> RowBlock {
     let n = ctx.mesh.len();
     let FormFactorMethod::AreaIntegral { steps } = method;
-    let samples = ElementSamples::new(ctx.mesh, steps);
+    let integrator = area::AreaIntegrator::new(ctx, steps);
     let data: Vec<f32> = rows
         .clone()
         .into_par_iter()
-        .flat_map_iter(|i| {
+        .map_init(area::Scratch::default, |scratch, i| {
             let a_i = ctx.mesh.elements[i].area;
-            let samples = &samples;
-            (0..n).map(move |j| {
-                if i == j {
-                    0.0
-                } else {
-                    (area::coupling(ctx, samples, i, j, rays) / a_i) as f32
-                }
-            })
+            let row = integrator.couplings(i, 0..n, rays, scratch);
+            row.into_iter()
+                .map(|g| (g / a_i) as f32)
+                .collect::<Vec<f32>>()
         })
+        .flatten_iter()
         .collect();
     RowBlock { rows, data }
 }
