@@ -202,16 +202,13 @@ pub struct FormFactorContext<'a> {
 
 /// Builds the occluder BVH of a scene: every input surface, tagged with its surface index.
 pub fn occluder_bvh(scene: &Scene) -> PolygonBvh {
-    let mut tris = Vec::new();
-    let mut ids = Vec::new();
-    for (s, surf) in scene.surfaces.iter().enumerate() {
-        let v = &surf.vertices;
-        for i in 1..v.len() - 1 {
-            tris.push([v[0], v[i], v[i + 1]]);
-            ids.push(s as u32);
-        }
-    }
-    PolygonBvh::new(&tris, &ids)
+    let polygons: Vec<&[DVec3]> = scene
+        .surfaces
+        .iter()
+        .map(|s| s.vertices.as_slice())
+        .collect();
+    let ids: Vec<u32> = (0..polygons.len() as u32).collect();
+    PolygonBvh::new(&polygons, &ids)
 }
 
 /// Counts the rays cast, for rays-per-second figures.
