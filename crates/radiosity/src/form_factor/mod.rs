@@ -255,19 +255,22 @@ pub fn compute_matrix(
     run_stage(progress, Stage::FormFactors, n as u64, || {
         let FormFactorMethod::AreaIntegral { steps } = method;
         let integrator = area::AreaIntegrator::new(ctx, steps);
-        // Upper triangle, row by row: row i holds G_ij for j > i in columns i+1..n.
-        let upper: Vec<Vec<f64>> = (0..n)
-            .into_par_iter()
-            .map_init(area::Scratch::default, |scratch, i| {
-                let row = integrator.couplings(i, i + 1..n, rays, scratch);
+        // Upper triangle, row by row, straight into the matrix: F_ij = G_ij / A_i for j > i.
+        matrix
+            .data
+            .par_chunks_mut(n.max(1))
+            .enumerate()
+            .for_each_init(area::Scratch::default, |scratch, (i, row)| {
+                let g = integrator.couplings(i, i + 1..n, rays, scratch);
+                for (f, g) in row[i + 1..].iter_mut().zip(g) {
+                    *f = (g / areas[i]) as f32;
+                }
                 progress.advance(1);
-                row
-            })
-            .collect();
-        for (i, row) in upper.iter().enumerate() {
-            for (off, &g) in row.iter().enumerate() {
-                let j = i + 1 + off;
-                matrix.data[i * n + j] = (g / areas[i]) as f32;
+            });
+        // Lower triangle by reciprocity: F_ji = A_i F_ij / A_j.
+        for i in 0..n {
+            for j in i + 1..n {
+                let g = matrix.data[i * n + j] as f64 * areas[i];
                 matrix.data[j * n + i] = (g / areas[j]) as f32;
             }
         }
