@@ -30,6 +30,7 @@ pub mod form_factor;
 pub mod geometry;
 pub mod mesh;
 pub mod progress;
+pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod visibility;
