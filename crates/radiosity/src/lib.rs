@@ -33,6 +33,7 @@ pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod shade;
+pub mod solution;
 pub mod visibility;
 
 pub use atomic_write::write_atomically;
