@@ -84,8 +84,8 @@ fn csv_field(s: &str) -> std::borrow::Cow<'_, str> {
 }
 
 /// Writes the solution to `path`: CSV with the header line [`HEADER`] and one row per
-/// element (numbers in Rust's shortest round-trip form, so they read back exactly; lines
-/// end in `\n`), or, when the file name ends in `.json` (any case), a JSON array of
+/// element (numbers in Rust's `Display` form, the shortest that reads back exactly, never
+/// with an exponent: 1.5e-7 is written `0.00000015`; lines end in `\n`), or, when the file name ends in `.json` (any case), a JSON array of
 /// objects with the same fields (non-finite numbers become `null`). The file is written
 /// atomically (see [`crate::write_atomically`]).
 ///
