@@ -30,7 +30,10 @@ pub mod form_factor;
 pub mod geometry;
 pub mod mesh;
 pub mod progress;
+pub mod render;
 pub mod scene;
+pub mod shade;
+pub mod solution;
 pub mod visibility;
 
 pub use atomic_write::write_atomically;

@@ -1,0 +1,301 @@
+//! From element radiosities to displayable colours: vertex radiosities for smooth shading
+//! (paper section 2.5), exposure (the normalisation of paper section 2.2) and gamma
+//! correction (paper section 2.7).
+//!
+//! * [`vertex_radiosity`] gives each mesh vertex the area-weighted mean radiosity of the
+//!   elements that have it as a corner. The paper averages the (up to four) coplanar
+//!   neighbours of a quadrilateral patch's corner; this is the same rule for any conforming
+//!   mesh of triangles and quadrilaterals. Vertices belong to one surface each (see
+//!   [`crate::mesh`]), so the averaging never crosses a surface boundary and smooth shading
+//!   has no seams inside a surface.
+//! * [`Exposure`] chooses the factor that maps radiosity to display values in [0, 1].
+//! * [`tone_map`] applies exposure, clamps, applies the paper's gamma correction
+//!   `color = color ^ (1 / gamma)` and quantises to 8 bits.
+
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+
+/// The radiosity at every vertex of `mesh`: the area-weighted mean of `element_b` over the
+/// elements that have the vertex as a corner (paper 2.5's neighbour averaging, generalised).
+///
+/// Element areas are the weights, so on a regular grid an interior vertex gets the plain
+/// mean of its four elements, and a field linear in position is reproduced exactly there.
+/// A vertex on a surface's boundary gets the mean of the elements that touch it (one at a
+/// corner of a quadrilateral surface, two along an edge). A vertex no element uses (there
+/// are none in a mesh from [`crate::mesh::mesh_scene`]) gets zero.
+///
+/// # Panics
+/// If `element_b` does not have one entry per element of `mesh`.
+pub fn vertex_radiosity(mesh: &Mesh, element_b: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    assert_eq!(
+        element_b.len(),
+        mesh.len(),
+        "one radiosity per element expected"
+    );
+    let mut sum = vec![[0.0f64; 3]; mesh.vertices.len()];
+    let mut weight = vec![0.0f64; mesh.vertices.len()];
+    for (el, b) in mesh.elements.iter().zip(element_b) {
+        for &v in el.corners() {
+            let v = v as usize;
+            weight[v] += el.area;
+            for k in 0..3 {
+                sum[v][k] += el.area * b[k];
+            }
+        }
+    }
+    sum.iter()
+        .zip(&weight)
+        .map(|(s, &w)| {
+            if w > 0.0 {
+                [s[0] / w, s[1] / w, s[2] / w]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
+}
+
+/// How radiosities are scaled before display.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Exposure {
+    /// The paper's normalisation (section 2.2: "radiosities are normalized so that all values
+    /// are fractions of the largest radiosity value"), with one change: the largest value is
+    /// taken over the elements of surfaces that do **not** emit. Emitters are usually far
+    /// brighter than anything they light, so normalising by them leaves the walls dim; this
+    /// way the brightest lit wall is at full scale, and the light itself is clipped to white,
+    /// as a photograph exposed for the room shows it. When every surface emits, the largest
+    /// value over all elements is used. When that is zero or not finite the scale is 1.
+    Brightest,
+    /// Multiply every radiosity by this factor.
+    Fixed(f64),
+}
+
+impl Exposure {
+    /// The factor that radiosities are multiplied by before clamping to [0, 1].
+    ///
+    /// `element_b` holds one radiosity per element of `mesh`, which was cut from `scene`.
+    pub fn scale(self, scene: &Scene, mesh: &Mesh, element_b: &[[f64; 3]]) -> f64 {
+        match self {
+            Exposure::Fixed(s) => s,
+            Exposure::Brightest => {
+                let band_max = |b: &[f64; 3]| b[0].max(b[1]).max(b[2]);
+                let emits = |s: u32| {
+                    scene
+                        .surfaces
+                        .get(s as usize)
+                        .is_some_and(|s| s.emission.max_band() > 0.0)
+                };
+                let mut lit: Option<f64> = None;
+                let mut all: Option<f64> = None;
+                for (el, b) in mesh.elements.iter().zip(element_b) {
+                    let m = band_max(b);
+                    all = Some(all.map_or(m, |a| a.max(m)));
+                    if !emits(el.surface) {
+                        lit = Some(lit.map_or(m, |a| a.max(m)));
+                    }
+                }
+                match lit.or(all) {
+                    Some(m) if m > 0.0 && m.is_finite() => 1.0 / m,
+                    _ => 1.0,
+                }
+            }
+        }
+    }
+}
+
+/// `value * scale` clamped to [0, 1] per band (NaN becomes 0): the display value before
+/// gamma correction.
+pub fn expose(value: [f64; 3], scale: f64) -> [f64; 3] {
+    value.map(|c| {
+        let x = c * scale;
+        if x > 0.0 {
+            x.min(1.0)
+        } else {
+            0.0
+        }
+    })
+}
+
+/// Gamma-corrects display values in [0, 1] (paper 2.7: `color ^ (1 / gamma)`) and
+/// quantises them to 0..=255 with rounding. A `gamma` that is not a positive finite number
+/// is treated as 1 (no correction).
+pub fn encode(display: [f64; 3], gamma: f64) -> [u8; 3] {
+    let inv = if gamma.is_finite() && gamma > 0.0 {
+        1.0 / gamma
+    } else {
+        1.0
+    };
+    display.map(|c| {
+        let c = if c > 0.0 { c.min(1.0) } else { 0.0 };
+        (c.powf(inv) * 255.0).round() as u8
+    })
+}
+
+/// The 8-bit colour of radiosity `value`: `clamp(value * scale, 0, 1) ^ (1 / gamma)` per
+/// band (paper 2.7), times 255, rounded. For example 0.25 with scale 1 and gamma 2 is
+/// 0.5, which is 127.5 and rounds to 128.
+pub fn tone_map(value: [f64; 3], scale: f64, gamma: f64) -> [u8; 3] {
+    encode(expose(value, scale), gamma)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::mesh_scene;
+    use crate::scene::{MeshSettings, Rgb, Surface};
+    use glam::{dvec3, DVec3};
+
+    fn surface(name: &str, emission: f64, vertices: Vec<DVec3>) -> Surface {
+        Surface {
+            name: name.into(),
+            emission: Rgb([emission; 3]),
+            reflectance: Rgb([0.5; 3]),
+            vertices,
+        }
+    }
+
+    fn scene(surfaces: Vec<Surface>) -> Scene {
+        Scene {
+            settings: MeshSettings {
+                max_patch_area: 1.0,
+                integral_steps: 1,
+            },
+            surfaces,
+            camera: None,
+        }
+    }
+
+    /// The square [0, 4] x [0, 4] in the plane z = 0.
+    fn square4() -> Vec<DVec3> {
+        vec![
+            dvec3(0., 0., 0.),
+            dvec3(4., 0., 0.),
+            dvec3(4., 4., 0.),
+            dvec3(0., 4., 0.),
+        ]
+    }
+
+    fn vertex_at(mesh: &Mesh, p: DVec3) -> usize {
+        mesh.vertices
+            .iter()
+            .position(|v| (*v - p).length() < 1e-9)
+            .unwrap()
+    }
+
+    #[test]
+    fn constant_field_is_constant_at_vertices() {
+        let tri = vec![dvec3(0., 0., 1.), dvec3(3., 0., 1.), dvec3(0., 3., 2.)];
+        let s = scene(vec![surface("a", 0.0, square4()), surface("b", 0.0, tri)]);
+        let mesh = mesh_scene(&s, 0.3).unwrap();
+        let b = vec![[0.2, 0.7, 3.0]; mesh.len()];
+        for v in vertex_radiosity(&mesh, &b) {
+            for k in 0..3 {
+                assert!((v[k] - b[0][k]).abs() < 1e-14, "{v:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn linear_field_is_exact_inside_and_averaged_on_the_boundary() {
+        let s = scene(vec![surface("a", 0.0, square4())]);
+        let mesh = mesh_scene(&s, 1.0).unwrap();
+        assert_eq!(mesh.len(), 16); // 1 x 1 cells
+        let f = |p: DVec3| p.x + 2.0 * p.y;
+        let b: Vec<[f64; 3]> = mesh
+            .elements
+            .iter()
+            .map(|e| [f(e.centroid), -f(e.centroid), 1.0])
+            .collect();
+        let vb = vertex_radiosity(&mesh, &b);
+        // Interior vertices: f at the vertex itself.
+        for i in 1..4 {
+            for j in 1..4 {
+                let p = dvec3(i as f64, j as f64, 0.0);
+                let v = vb[vertex_at(&mesh, p)];
+                assert!((v[0] - (i as f64 + 2.0 * j as f64)).abs() < 1e-12);
+                assert!((v[1] + (i as f64 + 2.0 * j as f64)).abs() < 1e-12);
+                assert!((v[2] - 1.0).abs() < 1e-12);
+            }
+        }
+        // Corner (0,0): the one element with centroid (0.5, 0.5): 0.5 + 1 = 1.5.
+        assert!((vb[vertex_at(&mesh, dvec3(0., 0., 0.))][0] - 1.5).abs() < 1e-12);
+        // Edge vertex (2,0): centroids (1.5,0.5) -> 2.5 and (2.5,0.5) -> 3.5; mean 3.0.
+        assert!((vb[vertex_at(&mesh, dvec3(2., 0., 0.))][0] - 3.0).abs() < 1e-12);
+        // Edge vertex (4,1): centroids (3.5,0.5) -> 4.5 and (3.5,1.5) -> 6.5; mean 5.5.
+        assert!((vb[vertex_at(&mesh, dvec3(4., 1., 0.))][0] - 5.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn values_do_not_leak_between_surfaces() {
+        // A floor and a wall that meet along the edge y = 0, z = 0.
+        let floor = vec![
+            dvec3(0., 0., 0.),
+            dvec3(0., 0., 2.),
+            dvec3(2., 0., 2.),
+            dvec3(2., 0., 0.),
+        ];
+        let wall = vec![
+            dvec3(0., 0., 0.),
+            dvec3(2., 0., 0.),
+            dvec3(2., 2., 0.),
+            dvec3(0., 2., 0.),
+        ];
+        let s = scene(vec![
+            surface("floor", 0.0, floor),
+            surface("wall", 0.0, wall),
+        ]);
+        let mesh = mesh_scene(&s, 1.0).unwrap();
+        let b: Vec<[f64; 3]> = mesh
+            .elements
+            .iter()
+            .map(|e| if e.surface == 0 { [1.0; 3] } else { [5.0; 3] })
+            .collect();
+        let vb = vertex_radiosity(&mesh, &b);
+        for (s, range) in mesh.surface_vertices.iter().enumerate() {
+            let want = if s == 0 { 1.0 } else { 5.0 };
+            for v in range.clone() {
+                assert_eq!(vb[v as usize], [want; 3], "surface {s} vertex {v}");
+            }
+        }
+    }
+
+    #[test]
+    fn brightest_exposure_skips_emitters() {
+        let light = vec![
+            dvec3(0., 0., 5.),
+            dvec3(1., 0., 5.),
+            dvec3(1., 1., 5.),
+            dvec3(0., 1., 5.),
+        ];
+        let s = scene(vec![
+            surface("wall", 0.0, square4()),
+            surface("light", 10.0, light),
+        ]);
+        let mesh = mesh_scene(&s, 4.0).unwrap();
+        assert_eq!(mesh.len(), 5);
+        let mut b = vec![[0.5, 2.0, 1.0]; 5];
+        b[4] = [40.0; 3]; // the light
+        assert_eq!(Exposure::Brightest.scale(&s, &mesh, &b), 0.5);
+        assert_eq!(Exposure::Fixed(3.0).scale(&s, &mesh, &b), 3.0);
+        // Every surface emitting: the light counts after all.
+        let mut all = s.clone();
+        all.surfaces[0].emission = Rgb([1.0; 3]);
+        assert_eq!(Exposure::Brightest.scale(&all, &mesh, &b), 1.0 / 40.0);
+        // All black: no division by zero.
+        assert_eq!(Exposure::Brightest.scale(&s, &mesh, &[[0.0; 3]; 5]), 1.0);
+    }
+
+    #[test]
+    fn tone_map_exact_values() {
+        // 0.25^(1/2) = 0.5 -> 127.5 -> 128.
+        assert_eq!(tone_map([0.25; 3], 1.0, 2.0), [128; 3]);
+        // Scale, clamping above and below, gamma 1.
+        assert_eq!(tone_map([0.5, 3.0, -1.0], 2.0, 1.0), [255, 255, 0]);
+        // 0.2 * 255 = 51 exactly; 0.1 * 255 = 25.5 -> 26 (rounding, not truncation).
+        assert_eq!(tone_map([0.2, 0.1, 0.0], 1.0, 1.0), [51, 26, 0]);
+        // 0.064^(1/3) = 0.4 -> 102.
+        assert_eq!(tone_map([0.128; 3], 0.5, 3.0), [102; 3]);
+        // NaN is black; a bad gamma means no correction.
+        assert_eq!(tone_map([f64::NAN, 0.2, 0.2], 1.0, 0.0), [0, 51, 51]);
+    }
+}
