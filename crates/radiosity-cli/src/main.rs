@@ -1,1 +1,418 @@
-fn main() {}
+//! `radiosity`: the command-line program. A thin layer over the `radiosity` library:
+//! parse the arguments, run the pipeline, report progress and timings.
+
+mod progress_bar;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::DVec3;
+use radiosity::form_factor::FormFactorMatrix;
+use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::progress::{run_stage, Stage};
+use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
+use radiosity::scene::{self, Scene};
+use radiosity::shade::{self, Exposure};
+use radiosity::solve::Solver;
+
+use progress_bar::{format_duration, Reporter};
+
+/// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
+///
+/// Every command takes an optional scene file in the paper's Appendix A format; without one
+/// it uses the built-in Cornell box.
+#[derive(Parser)]
+#[command(name = "radiosity", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a scene and render it to a PNG image.
+    Render(RenderArgs),
+    /// Compute the form-factor matrix and write it to a file (paper 2.8).
+    Formfactors(FormFactorArgs),
+    /// Solve a scene and write the radiosity of every element as CSV (or JSON for *.json).
+    Solve(SolveArgs),
+    /// Print statistics of a scene: surfaces, elements, area, form-factor row sums,
+    /// reciprocity, energy balance and stage times.
+    Check(CheckArgs),
+}
+
+/// Options every command shares.
+#[derive(Args)]
+struct SceneArgs {
+    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    scene: Option<PathBuf>,
+    /// Override the scene's MAX_PATCH_AREA (scene units squared).
+    #[arg(long, value_name = "AREA")]
+    max_area: Option<f64>,
+    /// Override the scene's INTEGRAL_STEPS (points along each axis of each element).
+    #[arg(long, value_name = "K")]
+    steps: Option<u32>,
+    /// No progress bars, timings or notes (errors are still printed).
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Options of commands that solve.
+#[derive(Args)]
+struct SolveOptions {
+    /// Linear solver for (I - rho F) B = E.
+    #[arg(long, value_enum, default_value_t = SolverArg::Lu)]
+    solver: SolverArg,
+    /// Relative residual at which Gauss-Seidel stops.
+    #[arg(long, default_value_t = 1e-9, value_name = "TOL")]
+    tolerance: f64,
+    /// Read form factors from this file (written by `radiosity formfactors`) instead of
+    /// computing them; refused if it was made for another mesh or method.
+    #[arg(long, value_name = "FILE")]
+    form_factors: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SolverArg {
+    /// LU factorisation with partial pivoting (the paper's Gaussian elimination).
+    Lu,
+    /// Gauss-Seidel iteration to --tolerance.
+    GaussSeidel,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ShadingArg {
+    /// Vertex radiosities interpolated across elements (paper plate 2).
+    Smooth,
+    /// One colour per element (paper plate 1).
+    Flat,
+    /// Element edges (paper plate 4).
+    Wireframe,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    solve: SolveOptions,
+    /// Output PNG (default: cornell.png for the built-in box, else the scene's name).
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// Shading.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
+    shading: ShadingArg,
+    /// Gamma: displayed = value^(1/gamma) (paper 2.7).
+    #[arg(long, default_value_t = 2.2)]
+    gamma: f64,
+    /// Exposure: "auto" scales the brightest non-emitting element to white (the paper's
+    /// normalisation), a number multiplies radiosities by it.
+    #[arg(long, default_value = "auto")]
+    exposure: String,
+    /// Eye position "x,y,z" (default: the scene's camera, or one that frames the scene).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    eye: Option<String>,
+    /// Point looked at "x,y,z".
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    look_at: Option<String>,
+    /// Up direction "x,y,z".
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    up: Option<String>,
+    /// Vertical field of view in degrees.
+    #[arg(long, value_name = "DEGREES")]
+    fov: Option<f64>,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512)]
+    height: u32,
+    /// Rays per pixel along each axis (antialiasing).
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    supersample: u32,
+}
+
+#[derive(Args)]
+struct FormFactorArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output file (default: the scene's name with .ff).
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct SolveArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    solve: SolveOptions,
+    /// Output file: CSV, or JSON when it ends in .json (default: the scene's name with .csv).
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct CheckArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    solve: SolveOptions,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Render(args) => render_command(args),
+        Command::Formfactors(args) => formfactors_command(args),
+        Command::Solve(args) => solve_command(args),
+        Command::Check(args) => check_command(args),
+    }
+}
+
+/// The scene (from its file or built in), meshed, with a short name for default outputs.
+fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
+    let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
+    let overrides = Overrides { max_patch_area: args.max_area, integral_steps: args.steps };
+    if let Some(k) = args.steps {
+        if k == 0 {
+            bail!("--steps must be at least 1");
+        }
+    }
+    let prepared = Prepared::new(scene, overrides, reporter)?;
+    reporter.note(&format!(
+        "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
+        stem,
+        prepared.scene.surfaces.len(),
+        prepared.mesh.len(),
+        prepared.scene.settings.max_patch_area,
+        prepared.scene.settings.integral_steps
+    ));
+    Ok((prepared, stem))
+}
+
+fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
+    match path {
+        None => Ok((run_stage(reporter, Stage::Parse, 0, scene::cornell_box), "cornell".to_string())),
+        Some(path) => {
+            let scene = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
+            let stem = path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            Ok((scene, stem))
+        }
+    }
+}
+
+/// Form factors from the file given, or computed (with their statistics reported).
+fn form_factors(prepared: &Prepared, file: Option<&Path>, reporter: &Reporter) -> Result<FormFactorMatrix> {
+    if let Some(path) = file {
+        let f = prepared.load_form_factors(path, reporter)?;
+        reporter.note(&format!("form factors read from {}", path.display()));
+        return Ok(f);
+    }
+    let (f, stats) = prepared.form_factors(reporter)?;
+    reporter.note(&format!(
+        "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
+         largest reciprocity error {:.1e}",
+        prepared.method(),
+        stats.rays,
+        stats.seconds,
+        stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
+        stats.row_sums.min,
+        stats.row_sums.mean,
+        stats.row_sums.max,
+        stats.reciprocity_error
+    ));
+    Ok(f)
+}
+
+fn solver(options: &SolveOptions) -> Result<Solver> {
+    Ok(match options.solver {
+        SolverArg::Lu => Solver::Lu,
+        SolverArg::GaussSeidel => {
+            if !(options.tolerance > 0.0 && options.tolerance.is_finite()) {
+                bail!("--tolerance must be a positive number, got {}", options.tolerance);
+            }
+            Solver::GaussSeidel { tolerance: options.tolerance, max_iterations: 10_000 }
+        }
+    })
+}
+
+fn render_command(args: RenderArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let settings = render_settings(&args)?;
+    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let camera = camera(&args, &prepared.scene)?;
+    let f = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
+    let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
+    drop(f);
+    let element_b = solution.element_rgb();
+    let vertex_b = run_stage(&reporter, Stage::Shade, 0, || shade::vertex_radiosity(&prepared.mesh, &element_b));
+    let exposure = parse_exposure(&args.exposure)?;
+    let scale = exposure.scale(&prepared.scene, &prepared.mesh, &element_b);
+    let settings = RenderSettings { exposure_scale: scale, ..settings };
+    let renderer = Renderer::new(&prepared.mesh);
+    let image = render::render(&renderer, &camera, &element_b, &vertex_b, &settings, &reporter);
+    let output = args.output.unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+    run_stage(&reporter, Stage::Write, 0, || render::write_png(&image, &output))
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!("wrote {} ({} x {})", output.display(), image.width(), image.height()));
+    reporter.print_timings();
+    Ok(())
+}
+
+fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
+    if args.width == 0 || args.height == 0 {
+        bail!("--width and --height must be at least 1");
+    }
+    if (args.width as u64) * (args.height as u64) > 100_000_000 {
+        bail!("an image of {} x {} pixels is too large (at most 100 megapixels)", args.width, args.height);
+    }
+    if !(args.gamma > 0.0 && args.gamma.is_finite()) {
+        bail!("--gamma must be a positive number, got {}", args.gamma);
+    }
+    if args.supersample == 0 || args.supersample > 16 {
+        bail!("--supersample must be between 1 and 16");
+    }
+    let shading = match args.shading {
+        ShadingArg::Smooth => Shading::Smooth,
+        ShadingArg::Flat => Shading::Flat,
+        ShadingArg::Wireframe => Shading::Wireframe,
+    };
+    Ok(RenderSettings { shading, gamma: args.gamma, supersample: args.supersample, ..RenderSettings::default() })
+}
+
+fn parse_exposure(text: &str) -> Result<Exposure> {
+    if text.eq_ignore_ascii_case("auto") {
+        return Ok(Exposure::Brightest);
+    }
+    match text.parse::<f64>() {
+        Ok(s) if s > 0.0 && s.is_finite() => Ok(Exposure::Fixed(s)),
+        _ => bail!("--exposure must be \"auto\" or a positive number, got \"{text}\""),
+    }
+}
+
+fn parse_vec3(name: &str, text: &str) -> Result<DVec3> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).filter(|v| v.is_finite()).collect();
+    if parts.len() != 3 || values.len() != 3 {
+        bail!("--{name} expects three numbers \"x,y,z\", got \"{text}\"");
+    }
+    Ok(DVec3::new(values[0], values[1], values[2]))
+}
+
+fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
+    let mut camera = Camera::for_scene(scene, args.width, args.height);
+    if let Some(eye) = &args.eye {
+        camera.eye = parse_vec3("eye", eye)?;
+    }
+    if let Some(at) = &args.look_at {
+        camera.look_at = parse_vec3("look-at", at)?;
+    }
+    if let Some(up) = &args.up {
+        camera.up = parse_vec3("up", up)?;
+    }
+    if let Some(fov) = args.fov {
+        if !(fov > 0.0 && fov < 180.0) {
+            bail!("--fov must be between 0 and 180 degrees, got {fov}");
+        }
+        camera.fov_y_degrees = fov;
+    }
+    let forward = camera.look_at - camera.eye;
+    if forward.length() == 0.0 {
+        bail!("--eye and --look-at must differ");
+    }
+    if forward.cross(camera.up).length() <= 1e-12 * forward.length() * camera.up.length() {
+        bail!("--up must not be parallel to the viewing direction (or zero)");
+    }
+    Ok(camera)
+}
+
+fn formfactors_command(args: FormFactorArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let f = form_factors(&prepared, None, &reporter)?;
+    let output = args.output.unwrap_or_else(|| PathBuf::from(format!("{stem}.ff")));
+    prepared.save_form_factors(&output, &f, &reporter)?;
+    reporter.note(&format!("wrote {} ({} x {} form factors, method {})", output.display(), f.n(), f.n(), prepared.method()));
+    reporter.print_timings();
+    Ok(())
+}
+
+fn solve_command(args: SolveArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let f = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
+    let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
+    let output = args.output.unwrap_or_else(|| PathBuf::from(format!("{stem}.csv")));
+    run_stage(&reporter, Stage::Write, 0, || {
+        radiosity::solution::write_solution(&output, &prepared.scene, &prepared.mesh, &solution.element_rgb())
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!("wrote {} ({} elements)", output.display(), prepared.mesh.len()));
+    reporter.print_timings();
+    Ok(())
+}
+
+fn check_command(args: CheckArgs) -> Result<()> {
+    // `check` always prints its report; --quiet only silences the progress bars.
+    let reporter = Reporter::new(true);
+    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let (f, stats) = match args.solve.form_factors.as_deref() {
+        Some(path) => {
+            let f = prepared.load_form_factors(path, &reporter)?;
+            let stats = radiosity::pipeline::FormFactorStats {
+                rays: 0,
+                seconds: 0.0,
+                row_sums: f.row_sums(),
+                reciprocity_error: f.max_reciprocity_error(&prepared.areas()),
+            };
+            (f, stats)
+        }
+        None => prepared.form_factors(&reporter)?,
+    };
+    let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
+    let scene = &prepared.scene;
+    println!("scene             {stem}");
+    println!("surfaces          {}", scene.surfaces.len());
+    println!("elements          {}", prepared.mesh.len());
+    println!("total area        {:.6}", prepared.mesh.total_area());
+    println!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
+    println!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
+    println!("method            {}", prepared.method());
+    println!("row sums          min {:.6}  mean {:.6}  max {:.6}", stats.row_sums.min, stats.row_sums.mean, stats.row_sums.max);
+    println!("reciprocity error {:.3e} (largest |A_i F_ij - A_j F_ji| / max)", stats.reciprocity_error);
+    if stats.rays > 0 {
+        println!(
+            "visibility rays   {} ({:.1} M rays/s)",
+            stats.rays,
+            stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+        );
+    }
+    let r = solution.report.residual;
+    println!("solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)", r[0], r[1], r[2]);
+    let b = &solution.balance;
+    println!(
+        "energy (R)        emitted {:.6e} = absorbed {:.6e} + escaped {:.6e} (relative error {:.1e})",
+        b.emitted[0],
+        b.absorbed[0],
+        b.escaped[0],
+        b.relative_error()
+    );
+    println!("stage times:");
+    for (stage, d) in reporter.timings() {
+        println!("  {:<14}{}", stage.name(), format_duration(d));
+    }
+    Ok(())
+}

@@ -29,6 +29,7 @@ mod atomic_write;
 pub mod form_factor;
 pub mod geometry;
 pub mod mesh;
+pub mod pipeline;
 pub mod progress;
 pub mod render;
 pub mod scene;

@@ -1,0 +1,160 @@
+//! The whole pipeline in a few calls, for the command line, benchmarks and tests:
+//! scene -> mesh -> form factors (computed or read from a file) -> solve -> shade.
+//!
+//! Each stage reports through [`Progress`], so its time and progress reach whoever
+//! listens (a progress bar, a window, a distributed runner).
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::form_factor::{
+    self, mesh_fingerprint, read_form_factors, write_form_factors, FormFactorContext, FormFactorFileError,
+    FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter, RowSums,
+};
+use crate::mesh::{mesh_scene, Mesh, MeshError};
+use crate::progress::{run_stage, Progress, Stage};
+use crate::scene::Scene;
+use crate::solve::{self, energy_balance, EnergyBalance, Radiosity, SolveError, SolveReport, Solver};
+use crate::visibility::PolygonBvh;
+
+/// Anything that stops the pipeline.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// Meshing failed.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// A dense matrix would not fit in memory.
+    #[error(transparent)]
+    OutOfMemory(#[from] OutOfMemory),
+    /// A form-factor file was refused.
+    #[error(transparent)]
+    FormFactorFile(#[from] FormFactorFileError),
+    /// The solve failed.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// Writing an output failed.
+    #[error("cannot write {path}: {source}")]
+    Write {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+}
+
+/// Settings from the command line that override the scene file's.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Overrides {
+    /// Replaces `MAX_PATCH_AREA`.
+    pub max_patch_area: Option<f64>,
+    /// Replaces `INTEGRAL_STEPS`.
+    pub integral_steps: Option<u32>,
+}
+
+/// A meshed scene with its occluder BVH: everything form factors need.
+pub struct Prepared {
+    /// The scene, with overrides applied to its settings.
+    pub scene: Scene,
+    /// Its elements.
+    pub mesh: Mesh,
+    /// The input surfaces in a BVH, for occlusion.
+    pub occluders: PolygonBvh,
+}
+
+/// What computing form factors found, besides the matrix.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FormFactorStats {
+    /// Visibility segments tested against candidate occluders.
+    pub rays: u64,
+    /// Wall-clock seconds of the computation.
+    pub seconds: f64,
+    /// Row sums.
+    pub row_sums: RowSums,
+    /// Largest relative reciprocity error (see `FormFactorMatrix::max_reciprocity_error`).
+    pub reciprocity_error: f64,
+}
+
+/// A solved scene.
+pub struct Solution {
+    /// Element radiosities.
+    pub radiosity: Radiosity,
+    /// How the solve went.
+    pub report: SolveReport,
+    /// Where the emitted power went.
+    pub balance: EnergyBalance,
+}
+
+impl Prepared {
+    /// Applies `overrides`, meshes the scene and builds the occluder BVH.
+    pub fn new(mut scene: Scene, overrides: Overrides, progress: &dyn Progress) -> Result<Prepared, PipelineError> {
+        if let Some(a) = overrides.max_patch_area {
+            scene.settings.max_patch_area = a;
+        }
+        if let Some(k) = overrides.integral_steps {
+            scene.settings.integral_steps = k;
+        }
+        let mesh = run_stage(progress, Stage::Mesh, 0, || mesh_scene(&scene, scene.settings.max_patch_area))?;
+        let occluders = run_stage(progress, Stage::Bvh, 0, || form_factor::occluder_bvh(&scene));
+        Ok(Prepared { scene, mesh, occluders })
+    }
+
+    /// The paper's method with the scene's `INTEGRAL_STEPS`.
+    pub fn method(&self) -> FormFactorMethod {
+        FormFactorMethod::AreaIntegral { steps: self.scene.settings.integral_steps }
+    }
+
+    /// The fingerprint of the meshed geometry, as stored in form-factor files.
+    pub fn fingerprint(&self) -> u64 {
+        mesh_fingerprint(&self.mesh)
+    }
+
+    /// Element areas.
+    pub fn areas(&self) -> Vec<f64> {
+        self.mesh.elements.iter().map(|e| e.area).collect()
+    }
+
+    /// Computes the form-factor matrix.
+    pub fn form_factors(&self, progress: &dyn Progress) -> Result<(FormFactorMatrix, FormFactorStats), PipelineError> {
+        let ctx = FormFactorContext { mesh: &self.mesh, occluders: &self.occluders };
+        let rays = RayCounter::default();
+        let start = Instant::now();
+        let matrix = form_factor::compute_matrix(&ctx, self.method(), &rays, progress)?;
+        let seconds = start.elapsed().as_secs_f64();
+        let stats = FormFactorStats {
+            rays: rays.get(),
+            seconds,
+            row_sums: matrix.row_sums(),
+            reciprocity_error: matrix.max_reciprocity_error(&self.areas()),
+        };
+        Ok((matrix, stats))
+    }
+
+    /// Reads form factors from `path`, refusing a file made for another mesh or method.
+    pub fn load_form_factors(&self, path: &Path, progress: &dyn Progress) -> Result<FormFactorMatrix, PipelineError> {
+        let method = self.method().to_string();
+        Ok(run_stage(progress, Stage::FormFactors, 0, || read_form_factors(path, self.fingerprint(), Some(&method)))?)
+    }
+
+    /// Writes form factors to `path` (atomically) with this mesh's fingerprint and method.
+    pub fn save_form_factors(&self, path: &Path, matrix: &FormFactorMatrix, progress: &dyn Progress) -> Result<(), PipelineError> {
+        run_stage(progress, Stage::Write, 0, || {
+            write_form_factors(path, matrix, self.fingerprint(), &self.method().to_string())
+        })
+        .map_err(|source| PipelineError::Write { path: path.display().to_string(), source })
+    }
+
+    /// Solves for element radiosities with `solver`.
+    pub fn solve(&self, f: &FormFactorMatrix, solver: Solver, progress: &dyn Progress) -> Result<Solution, PipelineError> {
+        let (reflectance, emission) = solve::element_properties(&self.mesh, &self.scene);
+        let (radiosity, report) = solve::solve(f, &reflectance, &emission, solver, progress)?;
+        let balance = energy_balance(f, &self.areas(), &reflectance, &emission, &radiosity);
+        Ok(Solution { radiosity, report, balance })
+    }
+}
+
+impl Solution {
+    /// B per element as RGB triples.
+    pub fn element_rgb(&self) -> Vec<[f64; 3]> {
+        (0..self.radiosity.len()).map(|i| self.radiosity.element(i)).collect()
+    }
+}
