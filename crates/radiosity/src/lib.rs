@@ -31,6 +31,7 @@ pub mod geometry;
 pub mod mesh;
 pub mod progress;
 pub mod scene;
+pub mod solve;
 pub mod visibility;
 
 pub use atomic_write::write_atomically;
