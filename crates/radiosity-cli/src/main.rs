@@ -185,7 +185,10 @@ fn run(cli: Cli) -> Result<()> {
 /// The scene (from its file or built in), meshed, with a short name for default outputs.
 fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
     let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
-    let overrides = Overrides { max_patch_area: args.max_area, integral_steps: args.steps };
+    let overrides = Overrides {
+        max_patch_area: args.max_area,
+        integral_steps: args.steps,
+    };
     if let Some(k) = args.steps {
         if k == 0 {
             bail!("--steps must be at least 1");
@@ -205,17 +208,26 @@ fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> 
 
 fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
     match path {
-        None => Ok((run_stage(reporter, Stage::Parse, 0, scene::cornell_box), "cornell".to_string())),
+        None => Ok((
+            run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
+            "cornell".to_string(),
+        )),
         Some(path) => {
             let scene = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
-            let stem = path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            let stem = path
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
             Ok((scene, stem))
         }
     }
 }
 
 /// Form factors from the file given, or computed (with their statistics reported).
-fn form_factors(prepared: &Prepared, file: Option<&Path>, reporter: &Reporter) -> Result<FormFactorMatrix> {
+fn form_factors(
+    prepared: &Prepared,
+    file: Option<&Path>,
+    reporter: &Reporter,
+) -> Result<FormFactorMatrix> {
     if let Some(path) = file {
         let f = prepared.load_form_factors(path, reporter)?;
         reporter.note(&format!("form factors read from {}", path.display()));
@@ -242,9 +254,15 @@ fn solver(options: &SolveOptions) -> Result<Solver> {
         SolverArg::Lu => Solver::Lu,
         SolverArg::GaussSeidel => {
             if !(options.tolerance > 0.0 && options.tolerance.is_finite()) {
-                bail!("--tolerance must be a positive number, got {}", options.tolerance);
+                bail!(
+                    "--tolerance must be a positive number, got {}",
+                    options.tolerance
+                );
             }
-            Solver::GaussSeidel { tolerance: options.tolerance, max_iterations: 10_000 }
+            Solver::GaussSeidel {
+                tolerance: options.tolerance,
+                max_iterations: 10_000,
+            }
         }
     })
 }
@@ -258,16 +276,32 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     drop(f);
     let element_b = solution.element_rgb();
-    let vertex_b = run_stage(&reporter, Stage::Shade, 0, || shade::vertex_radiosity(&prepared.mesh, &element_b));
+    let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
+        shade::vertex_radiosity(&prepared.mesh, &element_b)
+    });
     let exposure = parse_exposure(&args.exposure)?;
     let scale = exposure.scale(&prepared.scene, &prepared.mesh, &element_b);
-    let settings = RenderSettings { exposure_scale: scale, ..settings };
+    let settings = RenderSettings {
+        exposure_scale: scale,
+        ..settings
+    };
     let renderer = Renderer::new(&prepared.mesh);
-    let image = render::render(&renderer, &camera, &element_b, &vertex_b, &settings, &reporter);
-    let output = args.output.unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
-    run_stage(&reporter, Stage::Write, 0, || render::write_png(&image, &output))
-        .with_context(|| format!("cannot write {}", output.display()))?;
-    reporter.note(&format!("wrote {} ({} x {})", output.display(), image.width(), image.height()));
+    let image = render::render(
+        &renderer, &camera, &element_b, &vertex_b, &settings, &reporter,
+    );
+    let output = args
+        .output
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+    run_stage(&reporter, Stage::Write, 0, || {
+        render::write_png(&image, &output)
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!(
+        "wrote {} ({} x {})",
+        output.display(),
+        image.width(),
+        image.height()
+    ));
     reporter.print_timings();
     Ok(())
 }
@@ -277,7 +311,11 @@ fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
         bail!("--width and --height must be at least 1");
     }
     if (args.width as u64) * (args.height as u64) > 100_000_000 {
-        bail!("an image of {} x {} pixels is too large (at most 100 megapixels)", args.width, args.height);
+        bail!(
+            "an image of {} x {} pixels is too large (at most 100 megapixels)",
+            args.width,
+            args.height
+        );
     }
     if !(args.gamma > 0.0 && args.gamma.is_finite()) {
         bail!("--gamma must be a positive number, got {}", args.gamma);
@@ -290,7 +328,12 @@ fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
         ShadingArg::Flat => Shading::Flat,
         ShadingArg::Wireframe => Shading::Wireframe,
     };
-    Ok(RenderSettings { shading, gamma: args.gamma, supersample: args.supersample, ..RenderSettings::default() })
+    Ok(RenderSettings {
+        shading,
+        gamma: args.gamma,
+        supersample: args.supersample,
+        ..RenderSettings::default()
+    })
 }
 
 fn parse_exposure(text: &str) -> Result<Exposure> {
@@ -305,7 +348,11 @@ fn parse_exposure(text: &str) -> Result<Exposure> {
 
 fn parse_vec3(name: &str, text: &str) -> Result<DVec3> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).filter(|v| v.is_finite()).collect();
+    let values: Vec<f64> = parts
+        .iter()
+        .filter_map(|p| p.parse::<f64>().ok())
+        .filter(|v| v.is_finite())
+        .collect();
     if parts.len() != 3 || values.len() != 3 {
         bail!("--{name} expects three numbers \"x,y,z\", got \"{text}\"");
     }
@@ -343,9 +390,17 @@ fn formfactors_command(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
     let f = form_factors(&prepared, None, &reporter)?;
-    let output = args.output.unwrap_or_else(|| PathBuf::from(format!("{stem}.ff")));
+    let output = args
+        .output
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.ff")));
     prepared.save_form_factors(&output, &f, &reporter)?;
-    reporter.note(&format!("wrote {} ({} x {} form factors, method {})", output.display(), f.n(), f.n(), prepared.method()));
+    reporter.note(&format!(
+        "wrote {} ({} x {} form factors, method {})",
+        output.display(),
+        f.n(),
+        f.n(),
+        prepared.method()
+    ));
     reporter.print_timings();
     Ok(())
 }
@@ -355,12 +410,23 @@ fn solve_command(args: SolveArgs) -> Result<()> {
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
     let f = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
-    let output = args.output.unwrap_or_else(|| PathBuf::from(format!("{stem}.csv")));
+    let output = args
+        .output
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.csv")));
     run_stage(&reporter, Stage::Write, 0, || {
-        radiosity::solution::write_solution(&output, &prepared.scene, &prepared.mesh, &solution.element_rgb())
+        radiosity::solution::write_solution(
+            &output,
+            &prepared.scene,
+            &prepared.mesh,
+            &solution.element_rgb(),
+        )
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
-    reporter.note(&format!("wrote {} ({} elements)", output.display(), prepared.mesh.len()));
+    reporter.note(&format!(
+        "wrote {} ({} elements)",
+        output.display(),
+        prepared.mesh.len()
+    ));
     reporter.print_timings();
     Ok(())
 }
@@ -391,8 +457,14 @@ fn check_command(args: CheckArgs) -> Result<()> {
     println!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
     println!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
     println!("method            {}", prepared.method());
-    println!("row sums          min {:.6}  mean {:.6}  max {:.6}", stats.row_sums.min, stats.row_sums.mean, stats.row_sums.max);
-    println!("reciprocity error {:.3e} (largest |A_i F_ij - A_j F_ji| / max)", stats.reciprocity_error);
+    println!(
+        "row sums          min {:.6}  mean {:.6}  max {:.6}",
+        stats.row_sums.min, stats.row_sums.mean, stats.row_sums.max
+    );
+    println!(
+        "reciprocity error {:.3e} (largest |A_i F_ij - A_j F_ji| / max)",
+        stats.reciprocity_error
+    );
     if stats.rays > 0 {
         println!(
             "visibility rays   {} ({:.1} M rays/s)",
@@ -401,7 +473,10 @@ fn check_command(args: CheckArgs) -> Result<()> {
         );
     }
     let r = solution.report.residual;
-    println!("solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)", r[0], r[1], r[2]);
+    println!(
+        "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
+        r[0], r[1], r[2]
+    );
     let b = &solution.balance;
     println!(
         "energy (R)        emitted {:.6e} = absorbed {:.6e} + escaped {:.6e} (relative error {:.1e})",

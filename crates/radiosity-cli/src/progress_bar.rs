@@ -49,9 +49,15 @@ impl Reporter {
         }
         let timings = self.timings();
         let total: Duration = timings.iter().map(|t| t.1).sum();
-        let parts: Vec<String> =
-            timings.iter().map(|(s, d)| format!("{} {}", s.name(), format_duration(*d))).collect();
-        eprintln!("timings: {}; total {}", parts.join(", "), format_duration(total));
+        let parts: Vec<String> = timings
+            .iter()
+            .map(|(s, d)| format!("{} {}", s.name(), format_duration(*d)))
+            .collect();
+        eprintln!(
+            "timings: {}; total {}",
+            parts.join(", "),
+            format_duration(total)
+        );
     }
 }
 
@@ -72,9 +78,11 @@ impl Progress for Reporter {
         }
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
         bar.set_style(
-            ProgressStyle::with_template("{prefix:>13} [{bar:40}] {pos}/{len} {elapsed_precise} eta {eta}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
+            ProgressStyle::with_template(
+                "{prefix:>13} [{bar:40}] {pos}/{len} {elapsed_precise} eta {eta}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
         );
         bar.set_prefix(stage.name());
         *self.bar.lock().unwrap() = Some(bar);

@@ -35,6 +35,7 @@ pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod solution;
+pub mod solve;
 pub mod visibility;
 
 pub use atomic_write::write_atomically;

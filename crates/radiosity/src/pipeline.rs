@@ -8,13 +8,15 @@ use std::path::Path;
 use std::time::Instant;
 
 use crate::form_factor::{
-    self, mesh_fingerprint, read_form_factors, write_form_factors, FormFactorContext, FormFactorFileError,
-    FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter, RowSums,
+    self, mesh_fingerprint, read_form_factors, write_form_factors, FormFactorContext,
+    FormFactorFileError, FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter, RowSums,
 };
 use crate::mesh::{mesh_scene, Mesh, MeshError};
 use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::Scene;
-use crate::solve::{self, energy_balance, EnergyBalance, Radiosity, SolveError, SolveReport, Solver};
+use crate::solve::{
+    self, energy_balance, EnergyBalance, Radiosity, SolveError, SolveReport, Solver,
+};
 use crate::visibility::PolygonBvh;
 
 /// Anything that stops the pipeline.
@@ -86,21 +88,35 @@ pub struct Solution {
 
 impl Prepared {
     /// Applies `overrides`, meshes the scene and builds the occluder BVH.
-    pub fn new(mut scene: Scene, overrides: Overrides, progress: &dyn Progress) -> Result<Prepared, PipelineError> {
+    pub fn new(
+        mut scene: Scene,
+        overrides: Overrides,
+        progress: &dyn Progress,
+    ) -> Result<Prepared, PipelineError> {
         if let Some(a) = overrides.max_patch_area {
             scene.settings.max_patch_area = a;
         }
         if let Some(k) = overrides.integral_steps {
             scene.settings.integral_steps = k;
         }
-        let mesh = run_stage(progress, Stage::Mesh, 0, || mesh_scene(&scene, scene.settings.max_patch_area))?;
-        let occluders = run_stage(progress, Stage::Bvh, 0, || form_factor::occluder_bvh(&scene));
-        Ok(Prepared { scene, mesh, occluders })
+        let mesh = run_stage(progress, Stage::Mesh, 0, || {
+            mesh_scene(&scene, scene.settings.max_patch_area)
+        })?;
+        let occluders = run_stage(progress, Stage::Bvh, 0, || {
+            form_factor::occluder_bvh(&scene)
+        });
+        Ok(Prepared {
+            scene,
+            mesh,
+            occluders,
+        })
     }
 
     /// The paper's method with the scene's `INTEGRAL_STEPS`.
     pub fn method(&self) -> FormFactorMethod {
-        FormFactorMethod::AreaIntegral { steps: self.scene.settings.integral_steps }
+        FormFactorMethod::AreaIntegral {
+            steps: self.scene.settings.integral_steps,
+        }
     }
 
     /// The fingerprint of the meshed geometry, as stored in form-factor files.
@@ -114,8 +130,14 @@ impl Prepared {
     }
 
     /// Computes the form-factor matrix.
-    pub fn form_factors(&self, progress: &dyn Progress) -> Result<(FormFactorMatrix, FormFactorStats), PipelineError> {
-        let ctx = FormFactorContext { mesh: &self.mesh, occluders: &self.occluders };
+    pub fn form_factors(
+        &self,
+        progress: &dyn Progress,
+    ) -> Result<(FormFactorMatrix, FormFactorStats), PipelineError> {
+        let ctx = FormFactorContext {
+            mesh: &self.mesh,
+            occluders: &self.occluders,
+        };
         let rays = RayCounter::default();
         let start = Instant::now();
         let matrix = form_factor::compute_matrix(&ctx, self.method(), &rays, progress)?;
@@ -130,31 +152,56 @@ impl Prepared {
     }
 
     /// Reads form factors from `path`, refusing a file made for another mesh or method.
-    pub fn load_form_factors(&self, path: &Path, progress: &dyn Progress) -> Result<FormFactorMatrix, PipelineError> {
+    pub fn load_form_factors(
+        &self,
+        path: &Path,
+        progress: &dyn Progress,
+    ) -> Result<FormFactorMatrix, PipelineError> {
         let method = self.method().to_string();
-        Ok(run_stage(progress, Stage::FormFactors, 0, || read_form_factors(path, self.fingerprint(), Some(&method)))?)
+        Ok(run_stage(progress, Stage::FormFactors, 0, || {
+            read_form_factors(path, self.fingerprint(), Some(&method))
+        })?)
     }
 
     /// Writes form factors to `path` (atomically) with this mesh's fingerprint and method.
-    pub fn save_form_factors(&self, path: &Path, matrix: &FormFactorMatrix, progress: &dyn Progress) -> Result<(), PipelineError> {
+    pub fn save_form_factors(
+        &self,
+        path: &Path,
+        matrix: &FormFactorMatrix,
+        progress: &dyn Progress,
+    ) -> Result<(), PipelineError> {
         run_stage(progress, Stage::Write, 0, || {
             write_form_factors(path, matrix, self.fingerprint(), &self.method().to_string())
         })
-        .map_err(|source| PipelineError::Write { path: path.display().to_string(), source })
+        .map_err(|source| PipelineError::Write {
+            path: path.display().to_string(),
+            source,
+        })
     }
 
     /// Solves for element radiosities with `solver`.
-    pub fn solve(&self, f: &FormFactorMatrix, solver: Solver, progress: &dyn Progress) -> Result<Solution, PipelineError> {
+    pub fn solve(
+        &self,
+        f: &FormFactorMatrix,
+        solver: Solver,
+        progress: &dyn Progress,
+    ) -> Result<Solution, PipelineError> {
         let (reflectance, emission) = solve::element_properties(&self.mesh, &self.scene);
         let (radiosity, report) = solve::solve(f, &reflectance, &emission, solver, progress)?;
         let balance = energy_balance(f, &self.areas(), &reflectance, &emission, &radiosity);
-        Ok(Solution { radiosity, report, balance })
+        Ok(Solution {
+            radiosity,
+            report,
+            balance,
+        })
     }
 }
 
 impl Solution {
     /// B per element as RGB triples.
     pub fn element_rgb(&self) -> Vec<[f64; 3]> {
-        (0..self.radiosity.len()).map(|i| self.radiosity.element(i)).collect()
+        (0..self.radiosity.len())
+            .map(|i| self.radiosity.element(i))
+            .collect()
     }
 }

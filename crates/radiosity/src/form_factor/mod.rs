@@ -5,9 +5,14 @@
 //! sums to at most 1 (to 1 in a closed scene); reciprocity A_i F_ij = A_j F_ji.
 
 mod area;
+mod file;
 pub mod reference;
 
 pub use area::area_integral_pair;
+pub use file::{
+    mesh_fingerprint, read_form_factors, write_form_factors, FormFactorFileError,
+    FORM_FACTOR_FILE_VERSION, FORM_FACTOR_MAGIC, MAX_METHOD_LEN,
+};
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -1,0 +1,72 @@
+//! The iterative solver: Gauss-Seidel sweeps over (I - rho F) B = E.
+//!
+//! Each sweep visits the elements in order and sets B_i <- E_i + rho_i sum_j F_ij B_j using
+//! the values already updated in this sweep, for all three bands at once, so that every row
+//! of F (f32, widened to f64) is read once per sweep. Since rho_i < 1 and each row of F sums
+//! to at most 1, the iteration matrix has norm below 1 and the sweeps converge.
+//!
+//! Stopping: the change d_i made to B_i during a sweep is the residual of the vector as it
+//! stood just before that update. The residual of the vector after the sweep is
+//! r_i = rho_i sum_{j >= i} F_ij d_j, so |r_i| <= max |d|; once max |d| / max |E| is below
+//! the tolerance the true residual is computed (one more pass over F) and the solve ends
+//! when that too is below the tolerance.
+
+use super::{max_abs_emission, relative, relative_residual, row_dot3, Radiosity, SolveError};
+use crate::form_factor::FormFactorMatrix;
+use crate::progress::Progress;
+
+/// Iterates from B = E until the relative residual is below `tolerance` in every band;
+/// returns B and the number of sweeps.
+pub(super) fn solve(
+    f: &FormFactorMatrix,
+    reflectance: &[[f64; 3]],
+    emission: &[[f64; 3]],
+    tolerance: f64,
+    max_iterations: usize,
+    progress: &dyn Progress,
+) -> Result<(Radiosity, usize), SolveError> {
+    let n = f.n();
+    let scale = max_abs_emission(emission);
+    let mut b: Vec<[f64; 3]> = emission.to_vec();
+    let to_radiosity = |b: &[[f64; 3]]| Radiosity {
+        bands: std::array::from_fn(|k| b.iter().map(|x| x[k]).collect()),
+    };
+    let mut residual = f64::INFINITY;
+    for sweep in 1..=max_iterations {
+        let mut change = [0.0f64; 3];
+        for i in 0..n {
+            let h = row_dot3(f.row(i), &b);
+            for k in 0..3 {
+                let new = emission[i][k] + reflectance[i][k] * h[k];
+                change[k] = change[k].max((new - b[i][k]).abs());
+                b[i][k] = new;
+            }
+        }
+        progress.advance(1);
+        let estimate = relative(change, scale).into_iter().fold(0.0, f64::max);
+        if estimate.is_nan() {
+            // Cannot happen for valid inputs; do not loop on NaN.
+            return Err(SolveError::NotConverged {
+                iterations: sweep,
+                residual: f64::NAN,
+                tolerance,
+            });
+        }
+        residual = estimate;
+        if estimate < tolerance {
+            let radiosity = to_radiosity(&b);
+            let true_residual = relative_residual(f, reflectance, emission, &radiosity)
+                .into_iter()
+                .fold(0.0, f64::max);
+            residual = true_residual;
+            if true_residual < tolerance {
+                return Ok((radiosity, sweep));
+            }
+        }
+    }
+    Err(SolveError::NotConverged {
+        iterations: max_iterations,
+        residual,
+        tolerance,
+    })
+}
