@@ -7,6 +7,17 @@
 
 use glam::DVec3;
 
+mod builtin;
+mod lex;
+mod parse;
+mod shape;
+mod write;
+
+pub use builtin::cornell_box;
+pub use parse::{parse_scene, read_scene, ParseError, SceneError};
+pub use shape::PLANARITY_TOLERANCE;
+pub use write::{write_scene, write_scene_file};
+
 /// A colour triple in linear red, green, blue bands.
 ///
 /// Used both for emission (exitance per band, scene units) and reflectance (fraction in [0, 1)).
