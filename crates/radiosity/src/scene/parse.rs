@@ -1,0 +1,707 @@
+//! Reading scene files: the Appendix A grammar, value checks, polygon checks, error recovery.
+
+use std::path::Path;
+
+use glam::{dvec3, DVec3};
+use thiserror::Error;
+
+use super::lex::{lex, Keyword, Line, Token};
+use super::shape::{self, Facing};
+use super::{MeshSettings, Rgb, Scene, Surface};
+
+/// After this many errors the reader stops looking for more.
+const MAX_ERRORS: usize = 100;
+
+/// One problem in a scene file, at a line and column.
+///
+/// Displays as `FILE:LINE:COLUMN: error: MESSAGE`. Lines and columns count from 1; a problem
+/// with the file as a whole (it cannot be read) has line 0 and displays as
+/// `FILE: error: MESSAGE`.
+#[derive(Clone, Debug, PartialEq, Eq, Error)]
+#[error("{}: error: {message}", location(file, *line, *column))]
+pub struct ParseError {
+    /// The file name (or other source name) given to the reader.
+    pub file: String,
+    /// The line, counting from 1; 0 for the file as a whole.
+    pub line: usize,
+    /// The column in characters, counting from 1; 0 for the whole line or file.
+    pub column: usize,
+    /// What was found and what was expected.
+    pub message: String,
+}
+
+/// `FILE:LINE:COLUMN`, `FILE:LINE` or `FILE`, leaving out what is 0.
+fn location(file: &str, line: usize, column: usize) -> String {
+    match (line, column) {
+        (0, _) => file.to_string(),
+        (l, 0) => format!("{file}:{l}"),
+        (l, c) => format!("{file}:{l}:{c}"),
+    }
+}
+
+/// Every problem found in a scene file, in file order (at least one).
+///
+/// Displays as one [`ParseError`] per line followed by a line with the count.
+#[derive(Clone, Debug, PartialEq, Eq, Error)]
+#[error("{}", render(errors))]
+pub struct SceneError {
+    /// The problems, in the order they occur in the file.
+    pub errors: Vec<ParseError>,
+}
+
+/// The errors one per line, then `N error(s)`.
+fn render(errors: &[ParseError]) -> String {
+    let mut text = String::new();
+    for e in errors {
+        text.push_str(&e.to_string());
+        text.push('\n');
+    }
+    let plural = if errors.len() == 1 { "" } else { "s" };
+    text.push_str(&format!("{} error{plural}", errors.len()));
+    text
+}
+
+impl SceneError {
+    /// A scene error made of one problem with the file as a whole.
+    fn whole_file(file: &str, message: String) -> SceneError {
+        SceneError {
+            errors: vec![ParseError {
+                file: file.to_string(),
+                line: 0,
+                column: 0,
+                message,
+            }],
+        }
+    }
+}
+
+/// Reads and checks the scene file at `path`.
+///
+/// A file that cannot be read, or is not UTF-8, gives a [`SceneError`] naming the file.
+pub fn read_scene(path: &Path) -> Result<Scene, SceneError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path)
+        .map_err(|e| SceneError::whole_file(&name, format!("cannot read the scene file: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = 1 + valid.iter().filter(|&&b| b == b'\n').count();
+        SceneError {
+            errors: vec![ParseError {
+                file: name.clone(),
+                line,
+                column: 0,
+                message: "the file is not valid UTF-8 text".to_string(),
+            }],
+        }
+    })?;
+    parse_scene(&text, &name)
+}
+
+/// Parses and checks scene text in the Appendix A format (with the box primitive).
+///
+/// `source_name` is the file name used in error messages. Every error in the text is reported,
+/// in order; after an error inside a `PATCHBEGIN` or `BOXBEGIN` block the reader skips to the
+/// end of that block and goes on. The result's `camera` is `None`.
+pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
+    let (lines, eof) = lex(text);
+    let mut parser = Parser {
+        file: source_name,
+        lines,
+        pos: 0,
+        eof,
+        errors: Vec::new(),
+    };
+    let settings = parser.header();
+    let surfaces = parser.body();
+    match settings {
+        Some(settings) if parser.errors.is_empty() => Ok(Scene {
+            settings,
+            surfaces,
+            camera: None,
+        }),
+        _ => Err(SceneError {
+            errors: parser.errors,
+        }),
+    }
+}
+
+/// Marks a failed step whose error has already been recorded.
+struct Reported;
+
+/// The result of a step that records its own errors.
+type Step<T> = Result<T, Reported>;
+
+/// A recursive-descent reader over the significant lines.
+struct Parser<'a> {
+    file: &'a str,
+    lines: Vec<Line<'a>>,
+    pos: usize,
+    eof: (usize, usize),
+    errors: Vec<ParseError>,
+}
+
+/// A patch or box block's name and colours.
+struct Head {
+    name: String,
+    emission: Rgb,
+    reflectance: Rgb,
+}
+
+/// The corners of a polygon and where they were written.
+struct Corners {
+    vertices: Vec<DVec3>,
+    /// The `VERTEX0` line, where polygon errors are reported.
+    line: usize,
+    column: usize,
+}
+
+/// A box block's geometry as written.
+enum BoxShape {
+    /// `ORIGIN` and `SIZE`.
+    Aligned { origin: DVec3, size: DVec3 },
+    /// `VERTICES 4`, `VERTEX0`..`VERTEX3` and `HEIGHT`.
+    Prism { base: Corners, height: f64 },
+}
+
+impl<'a> Parser<'a> {
+    // ----- low-level helpers -----
+
+    fn current(&self) -> Option<Line<'a>> {
+        self.lines.get(self.pos).cloned()
+    }
+
+    fn current_keyword(&self) -> Option<Keyword> {
+        self.lines.get(self.pos).map(Line::keyword)
+    }
+
+    fn error(&mut self, line: usize, column: usize, message: impl Into<String>) -> Reported {
+        self.errors.push(ParseError {
+            file: self.file.to_string(),
+            line,
+            column,
+            message: message.into(),
+        });
+        Reported
+    }
+
+    fn error_at(&mut self, token: Token, line: &Line, message: impl Into<String>) -> Reported {
+        self.error(line.number, token.column, message)
+    }
+
+    /// Takes the current line if it starts with `keyword`; otherwise reports what was found.
+    fn expect(&mut self, keyword: Keyword) -> Step<Line<'a>> {
+        self.expect_either(keyword, &keyword.spelling())
+    }
+
+    /// Like [`Self::expect`], with `wanted` describing the expectation in the message.
+    fn expect_either(&mut self, keyword: Keyword, wanted: &str) -> Step<Line<'a>> {
+        match self.current() {
+            Some(line) if line.keyword() == keyword => {
+                self.pos += 1;
+                Ok(line)
+            }
+            _ => Err(self.unexpected(wanted)),
+        }
+    }
+
+    /// Reports the current line (or the end of the file) where `wanted` should be.
+    fn unexpected(&mut self, wanted: &str) -> Reported {
+        let Some(line) = self.current() else {
+            let (l, c) = self.eof;
+            return self.error(l, c, format!("expected {wanted}, found end of file"));
+        };
+        let head = line.head();
+        let msg = if line.keyword() == Keyword::Unknown {
+            format!("unknown keyword \"{}\"; expected {wanted}", head.text)
+        } else {
+            format!("expected {wanted}, found \"{}\"", head.text)
+        };
+        self.error_at(head, &line, msg)
+    }
+
+    /// Reports words after the first `used` ones on `line` (the line is still understood).
+    fn line_end(&mut self, line: &Line, used: usize) {
+        let Some(extra) = line.tokens.get(used) else {
+            return;
+        };
+        let what = match used {
+            1 => format!("\"{}\"", line.head().text),
+            2 => format!("the value of \"{}\"", line.head().text),
+            n => format!("the {} values of \"{}\"", n - 1, line.head().text),
+        };
+        self.error_at(
+            *extra,
+            line,
+            format!(
+                "expected end of line after {what}, found \"{}\"",
+                extra.text
+            ),
+        );
+    }
+
+    /// The finite number in word `index` of `line`; `what` names it in messages.
+    fn number(&mut self, line: &Line<'a>, index: usize, what: &str) -> Step<(f64, Token<'a>)> {
+        let key = line.head().text;
+        let Some(token) = line.tokens.get(index).copied() else {
+            return Err(self.error(
+                line.number,
+                line.end_column,
+                format!("expected {what} after \"{key}\", found end of line"),
+            ));
+        };
+        let message = match token.text.parse::<f64>() {
+            Ok(v) if v.is_finite() => return Ok((v, token)),
+            Ok(_) => format!(
+                "expected a finite number after \"{key}\", found \"{}\"",
+                token.text
+            ),
+            Err(_) => format!("expected {what} after \"{key}\", found \"{}\"", token.text),
+        };
+        Err(self.error_at(token, line, message))
+    }
+
+    /// A `KEYWORD value` line.
+    fn value(&mut self, keyword: Keyword) -> Step<(f64, Token<'a>, Line<'a>)> {
+        let line = self.expect(keyword)?;
+        let (v, token) = self.number(&line, 1, "a number")?;
+        self.line_end(&line, 2);
+        Ok((v, token, line))
+    }
+
+    /// A `KEYWORD x y z` line; `what` names the three numbers ("coordinate", "size").
+    fn triple(&mut self, keyword: Keyword, what: &str) -> Step<(DVec3, Line<'a>)> {
+        let line = self.expect(keyword)?;
+        let mut xyz = [0.0; 3];
+        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            xyz[i] = self
+                .number(&line, i + 1, &format!("a number (the {axis} {what})"))?
+                .0;
+        }
+        self.line_end(&line, 4);
+        Ok((dvec3(xyz[0], xyz[1], xyz[2]), line))
+    }
+
+    /// A whole number written as an integer or with a zero fraction ("2", "2.0").
+    fn whole(v: f64) -> Option<u64> {
+        (v.fract() == 0.0 && (0.0..=9.007_199_254_740_992e15).contains(&v)).then_some(v as u64)
+    }
+
+    // ----- file structure -----
+
+    /// `MAX_PATCH_AREA`, `INTEGRAL_STEPS` and `SCENEBEGIN`.
+    fn header(&mut self) -> Option<MeshSettings> {
+        let area = self
+            .header_value(Keyword::MaxPatchArea)
+            .and_then(|(v, t, l)| {
+                if v > 0.0 {
+                    return Some(v);
+                }
+                let msg = format!(
+                    "MAX_PATCH_AREA must be greater than 0, found \"{}\"",
+                    t.text
+                );
+                self.error_at(t, &l, msg);
+                None
+            });
+        let steps = self
+            .header_value(Keyword::IntegralSteps)
+            .and_then(
+                |(v, t, l)| match Self::whole(v).and_then(|k| u32::try_from(k).ok()) {
+                    Some(k) if k >= 1 => Some(k),
+                    _ => {
+                        let msg = format!(
+                        "INTEGRAL_STEPS must be a whole number of at least 1 (and at most {}), \
+                         found \"{}\"",
+                        u32::MAX,
+                        t.text
+                    );
+                        self.error_at(t, &l, msg);
+                        None
+                    }
+                },
+            );
+        let _ =
+            self.skip_unless_known(|p| p.expect(Keyword::SceneBegin).map(|l| p.line_end(&l, 1)));
+        Some(MeshSettings {
+            max_patch_area: area?,
+            integral_steps: steps?,
+        })
+    }
+
+    /// A header line; a line with an unknown keyword in its place is taken as a misspelling.
+    fn header_value(&mut self, keyword: Keyword) -> Option<(f64, Token<'a>, Line<'a>)> {
+        self.skip_unless_known(|p| p.value(keyword)).ok()
+    }
+
+    /// Runs `step`; when it fails without taking a line and the line has an unknown keyword,
+    /// takes that line (so one misspelt line gives one error, not one per expectation).
+    fn skip_unless_known<T>(&mut self, step: impl FnOnce(&mut Self) -> Step<T>) -> Step<T> {
+        let before = self.pos;
+        let result = step(self);
+        if result.is_err() && self.pos == before && self.current_keyword() == Some(Keyword::Unknown)
+        {
+            self.pos += 1;
+        }
+        result
+    }
+
+    /// The blocks up to and including `SCENEEND`, then a check that nothing follows.
+    fn body(&mut self) -> Vec<Surface> {
+        let mut surfaces = Vec::new();
+        let mut blocks = 0usize;
+        loop {
+            if self.errors.len() >= MAX_ERRORS {
+                let (l, _) = self.current().map_or(self.eof, |l| (l.number, 0));
+                self.error(l, 0, "too many errors; stopped reading here");
+                return surfaces;
+            }
+            match self.current_keyword() {
+                None => {
+                    let (l, c) = self.eof;
+                    let msg = if blocks == 0 {
+                        "no patches: expected PATCHBEGIN or BOXBEGIN after SCENEBEGIN, found \
+                         end of file"
+                    } else {
+                        "expected SCENEEND, found end of file"
+                    };
+                    self.error(l, c, msg);
+                    return surfaces;
+                }
+                Some(Keyword::PatchBegin) => {
+                    blocks += 1;
+                    surfaces.extend(self.patch());
+                }
+                Some(Keyword::BoxBegin) => {
+                    blocks += 1;
+                    surfaces.extend(self.box_block().into_iter().flatten());
+                }
+                Some(Keyword::SceneEnd) => {
+                    self.scene_end(blocks);
+                    return surfaces;
+                }
+                Some(_) => {
+                    // Counted so that an unreadable block is not also reported as "no patches".
+                    blocks += 1;
+                    self.stray_line();
+                }
+            }
+        }
+    }
+
+    /// Takes `SCENEEND` and reports an empty scene or anything after it.
+    fn scene_end(&mut self, blocks: usize) {
+        let Ok(line) = self.expect(Keyword::SceneEnd) else {
+            return;
+        };
+        self.line_end(&line, 1);
+        if blocks == 0 {
+            let head = line.head();
+            self.error_at(
+                head,
+                &line,
+                "no patches: expected PATCHBEGIN or BOXBEGIN after SCENEBEGIN, found \"SCENEEND\"",
+            );
+        }
+        if let Some(after) = self.current() {
+            let head = after.head();
+            self.error_at(
+                head,
+                &after,
+                format!(
+                    "expected end of file after SCENEEND, found \"{}\"",
+                    head.text
+                ),
+            );
+        }
+    }
+
+    /// Reports a line where a block should start and skips to the next block.
+    fn stray_line(&mut self) {
+        self.unexpected("PATCHBEGIN, BOXBEGIN or SCENEEND");
+        self.pos += 1;
+        while let Some(k) = self.current_keyword() {
+            if matches!(
+                k,
+                Keyword::PatchBegin | Keyword::BoxBegin | Keyword::SceneEnd
+            ) {
+                break;
+            }
+            self.pos += 1;
+        }
+    }
+
+    /// After an error inside a block: skips past its `end` line, or up to the start of the
+    /// next block or of `SCENEEND` when `end` is missing.
+    fn skip_block(&mut self, end: Keyword) {
+        while let Some(k) = self.current_keyword() {
+            if k == end {
+                self.pos += 1;
+                return;
+            }
+            if matches!(
+                k,
+                Keyword::PatchBegin | Keyword::BoxBegin | Keyword::SceneEnd
+            ) {
+                return;
+            }
+            self.pos += 1;
+        }
+    }
+
+    /// Runs `fields` inside a `begin` ... `end` block; on a failure skips the rest of it.
+    /// `None` when anything in the block was wrong.
+    fn block<T>(
+        &mut self,
+        begin: Keyword,
+        end: Keyword,
+        fields: impl FnOnce(&mut Self) -> Step<T>,
+    ) -> Option<T> {
+        let errors_before = self.errors.len();
+        let result = self.expect(begin).and_then(|line| {
+            self.line_end(&line, 1);
+            let value = fields(self)?;
+            let end_line = self.expect_end(end)?;
+            self.line_end(&end_line, 1);
+            Ok(value)
+        });
+        match result {
+            Ok(value) if self.errors.len() == errors_before => Some(value),
+            Ok(_) => None,
+            Err(Reported) => {
+                self.skip_block(end);
+                None
+            }
+        }
+    }
+
+    /// The block's `end` line; a further `VERTEXk` gets its own message.
+    fn expect_end(&mut self, end: Keyword) -> Step<Line<'a>> {
+        if let Some(line) = self.current() {
+            if let Keyword::Vertex(_) = line.keyword() {
+                let head = line.head();
+                let msg = format!(
+                    "expected {}, found \"{}\": there are more VERTEX lines than VERTICES says",
+                    end.spelling(),
+                    head.text
+                );
+                return Err(self.error_at(head, &line, msg));
+            }
+        }
+        self.expect(end)
+    }
+
+    // ----- patches -----
+
+    /// A `PATCHBEGIN` block as a checked surface.
+    fn patch(&mut self) -> Option<Surface> {
+        let (head, mut corners) = self.block(Keyword::PatchBegin, Keyword::PatchEnd, |p| {
+            let name = p.name_line()?;
+            let count = p.vertex_count(3, "a patch")?;
+            let head = p.colours(name)?;
+            Ok((head, p.vertex_lines(count)?))
+        })?;
+        self.check_polygon(&mut corners)?;
+        Some(Surface {
+            name: head.name,
+            emission: head.emission,
+            reflectance: head.reflectance,
+            vertices: corners.vertices,
+        })
+    }
+
+    /// Checks and flattens a polygon, reporting a problem at its `VERTEX0` line.
+    fn check_polygon(&mut self, corners: &mut Corners) -> Option<()> {
+        match shape::check_polygon(&mut corners.vertices) {
+            Ok(()) => Some(()),
+            Err(msg) => {
+                self.error(corners.line, corners.column, msg);
+                None
+            }
+        }
+    }
+
+    /// The `#NAME` line: the rest of the line after `#`, trimmed.
+    fn name_line(&mut self) -> Step<String> {
+        let line = self.expect(Keyword::Name)?;
+        let after_hash = line.code.split_once('#').map_or("", |(_, rest)| rest);
+        Ok(after_hash.trim().to_string())
+    }
+
+    /// `Er`, `Eg`, `Eb`, `Rr`, `Rg`, `Rb` in that order, range-checked.
+    fn colours(&mut self, name: String) -> Step<Head> {
+        let mut emission = [0.0; 3];
+        for (i, k) in [Keyword::Er, Keyword::Eg, Keyword::Eb]
+            .into_iter()
+            .enumerate()
+        {
+            let (v, token, line) = self.value(k)?;
+            if v < 0.0 {
+                let msg = format!("emission must not be negative, found \"{}\"", token.text);
+                self.error_at(token, &line, msg);
+            }
+            emission[i] = v;
+        }
+        let mut reflectance = [0.0; 3];
+        for (i, k) in [Keyword::Rr, Keyword::Rg, Keyword::Rb]
+            .into_iter()
+            .enumerate()
+        {
+            let (v, token, line) = self.value(k)?;
+            if !(0.0..1.0).contains(&v) {
+                let msg = format!(
+                    "reflectance must be at least 0 and below 1, found \"{}\"",
+                    token.text
+                );
+                self.error_at(token, &line, msg);
+            }
+            reflectance[i] = v;
+        }
+        Ok(Head {
+            name,
+            emission: Rgb(emission),
+            reflectance: Rgb(reflectance),
+        })
+    }
+
+    /// `VERTICES n` with a whole `n` of at least `min`.
+    fn vertex_count(&mut self, min: u64, what: &str) -> Step<usize> {
+        let (v, token, line) = self.value(Keyword::Vertices)?;
+        match Self::whole(v) {
+            Some(n) if n >= min => Ok(usize::try_from(n).unwrap_or(usize::MAX)),
+            _ => Err(self.error_at(
+                token,
+                &line,
+                format!(
+                    "{what} needs a whole number of at least {min} after \"VERTICES\", \
+                     found \"{}\"",
+                    token.text
+                ),
+            )),
+        }
+    }
+
+    /// `VERTEX0` .. `VERTEX(count-1)`, in order.
+    fn vertex_lines(&mut self, count: usize) -> Step<Corners> {
+        let mut vertices = Vec::new();
+        let (mut first_line, mut first_column) = (0, 0);
+        for k in 0..count {
+            let keyword = Keyword::Vertex(k);
+            let found = self.current_keyword();
+            if k > 0 && !matches!(found, Some(Keyword::Vertex(_))) {
+                let wanted = format!(
+                    "{} (VERTICES says {count} vertices, but only {k} are given)",
+                    keyword.spelling()
+                );
+                return Err(self.unexpected(&wanted));
+            }
+            let (v, line) = self.triple(keyword, "coordinate")?;
+            if k == 0 {
+                (first_line, first_column) = (line.number, line.head().column);
+            }
+            vertices.push(v);
+        }
+        Ok(Corners {
+            vertices,
+            line: first_line,
+            column: first_column,
+        })
+    }
+
+    // ----- boxes -----
+
+    /// A `BOXBEGIN` block as its six checked faces.
+    fn box_block(&mut self) -> Option<Vec<Surface>> {
+        let (head, facing, shape) = self.block(Keyword::BoxBegin, Keyword::BoxEnd, |p| {
+            let name = p.name_line()?;
+            let facing = p.facing()?;
+            let head = p.colours(name)?;
+            let shape = p.box_shape()?;
+            Ok((head, facing, shape))
+        })?;
+        let (base, height) = match shape {
+            BoxShape::Aligned { origin, size } => (shape::axis_aligned_base(origin, size), size.y),
+            BoxShape::Prism { mut base, height } => {
+                self.check_polygon(&mut base)?;
+                let quad = [0, 1, 2, 3].map(|i| base.vertices.get(i).copied().unwrap_or_default());
+                (quad, height)
+            }
+        };
+        let faces = shape::box_faces(&base, height, facing);
+        let surfaces = shape::FACE_NAMES
+            .iter()
+            .zip(faces)
+            .map(|(suffix, vertices)| Surface {
+                name: format!("{}.{suffix}", head.name),
+                emission: head.emission,
+                reflectance: head.reflectance,
+                vertices,
+            })
+            .collect();
+        Some(surfaces)
+    }
+
+    /// `FACING OUT` or `FACING IN`.
+    fn facing(&mut self) -> Step<Facing> {
+        let line = self.expect(Keyword::Facing)?;
+        let word = line.tokens.get(1).copied();
+        let facing = match word.map(|t| t.text.to_ascii_uppercase()) {
+            Some(w) if w == "OUT" => Facing::Out,
+            Some(w) if w == "IN" => Facing::In,
+            _ => {
+                let (column, found) = word.map_or((line.end_column, "end of line".into()), |t| {
+                    (t.column, format!("\"{}\"", t.text))
+                });
+                let msg = format!("expected OUT or IN after \"FACING\", found {found}");
+                return Err(self.error(line.number, column, msg));
+            }
+        };
+        self.line_end(&line, 2);
+        Ok(facing)
+    }
+
+    /// `ORIGIN` + `SIZE`, or `VERTICES 4` + `VERTEX0..3` + `HEIGHT`.
+    fn box_shape(&mut self) -> Step<BoxShape> {
+        if self.current_keyword() == Some(Keyword::Vertices) {
+            return self.prism_shape();
+        }
+        if self.current_keyword() != Some(Keyword::Origin) {
+            return Err(self.unexpected("ORIGIN or VERTICES"));
+        }
+        let (origin, _) = self.triple(Keyword::Origin, "coordinate")?;
+        let (size, line) = self.triple(Keyword::Size, "size")?;
+        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            if size[i] <= 0.0 {
+                let token = line.tokens[i + 1];
+                let msg = format!(
+                    "box sizes must be greater than 0, found \"{}\" for {axis}",
+                    token.text
+                );
+                self.error_at(token, &line, msg);
+            }
+        }
+        Ok(BoxShape::Aligned { origin, size })
+    }
+
+    /// The base quad and `HEIGHT` of a box given as one face plus a height.
+    fn prism_shape(&mut self) -> Step<BoxShape> {
+        let (v, token, line) = self.value(Keyword::Vertices)?;
+        if v != 4.0 {
+            let msg = format!(
+                "a box's base needs exactly 4 vertices after \"VERTICES\", found \"{}\"",
+                token.text
+            );
+            return Err(self.error_at(token, &line, msg));
+        }
+        let base = self.vertex_lines(4)?;
+        let (height, token, line) = self.value(Keyword::Height)?;
+        if height <= 0.0 {
+            let msg = format!("HEIGHT must be greater than 0, found \"{}\"", token.text);
+            self.error_at(token, &line, msg);
+        }
+        Ok(BoxShape::Prism { base, height })
+    }
+}
+
+#[cfg(test)]
+#[path = "parse_tests.rs"]
+mod tests;

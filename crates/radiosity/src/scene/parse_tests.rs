@@ -1,0 +1,749 @@
+//! Tests of the scene reader: every error with its line and column, recovery, the box
+//! primitive, and robustness against garbled input.
+
+use super::*;
+use crate::geometry;
+
+/// A valid one-patch scene; the line numbers below refer to it.
+const VALID: &str = "MAX_PATCH_AREA 100
+INTEGRAL_STEPS 2
+SCENEBEGIN
+PATCHBEGIN
+#Floor
+VERTICES 4
+Er 0.0
+Eg 0.0
+Eb 0.0
+Rr 0.5
+Rg 0.5
+Rb 0.5
+VERTEX0 0 0 0
+VERTEX1 1 0 0
+VERTEX2 1 1 0
+VERTEX3 0 1 0
+PATCHEND
+SCENEEND
+";
+
+/// `VALID` with line `n` (from 1) replaced by `text` (which may hold several lines, or none).
+fn with_line(n: usize, text: &str) -> String {
+    let mut lines: Vec<&str> = VALID.lines().collect();
+    if text.is_empty() {
+        lines.remove(n - 1);
+    } else {
+        lines[n - 1] = text;
+    }
+    lines.join("\n") + "\n"
+}
+
+/// `VALID` with each line `n` replaced by its `text`.
+fn with_lines(edits: &[(usize, &str)]) -> String {
+    let mut lines: Vec<&str> = VALID.lines().collect();
+    for &(n, text) in edits {
+        lines[n - 1] = text;
+    }
+    lines.join("\n") + "\n"
+}
+
+/// The (line, column, message) of each error in `text`.
+fn errors(text: &str) -> Vec<(usize, usize, String)> {
+    match parse_scene(text, "t.scene") {
+        Ok(_) => Vec::new(),
+        Err(e) => e
+            .errors
+            .into_iter()
+            .map(|e| (e.line, e.column, e.message))
+            .collect(),
+    }
+}
+
+/// Asserts that `text` has exactly one error, at `line`:`column`, whose message contains
+/// `needle`.
+#[track_caller]
+fn one_error(text: &str, line: usize, column: usize, needle: &str) {
+    let errs = errors(text);
+    assert_eq!(errs.len(), 1, "{errs:#?}");
+    let (l, c, m) = &errs[0];
+    assert_eq!((*l, *c), (line, column), "{m}");
+    assert!(m.contains(needle), "message {m:?} lacks {needle:?}");
+}
+
+#[test]
+fn valid_scene() {
+    let scene = parse_scene(VALID, "t.scene").unwrap();
+    assert_eq!(scene.settings.max_patch_area, 100.0);
+    assert_eq!(scene.settings.integral_steps, 2);
+    assert_eq!(scene.camera, None);
+    assert_eq!(scene.surfaces.len(), 1);
+    let s = &scene.surfaces[0];
+    assert_eq!(s.name, "Floor");
+    assert_eq!(s.emission, Rgb([0.0; 3]));
+    assert_eq!(s.reflectance, Rgb([0.5; 3]));
+    assert_eq!(
+        s.vertices,
+        vec![
+            dvec3(0., 0., 0.),
+            dvec3(1., 0., 0.),
+            dvec3(1., 1., 0.),
+            dvec3(0., 1., 0.)
+        ]
+    );
+}
+
+#[test]
+fn case_comments_blank_lines_and_number_forms() {
+    let text = "// a header comment
+
+max_patch_area 0.25   // decimals are fine
+Integral_Steps 3.0    // a whole number written with a fraction
+   SceneBegin
+patchbegin
+  #  My floor // the name ends at the comment
+
+vertices 3
+er 1e-1
+EG +2
+eb 3.
+rr .5
+RG 0.25e0
+rb 0
+vertex0 0 0 0
+Vertex1 1E0 0 0  // comment after numbers
+VERTEX2 0 1 0
+patchEnd
+sceneend
+// trailing comment
+
+";
+    let scene = parse_scene(text, "t.scene").unwrap();
+    assert_eq!(scene.settings.max_patch_area, 0.25);
+    assert_eq!(scene.settings.integral_steps, 3);
+    let s = &scene.surfaces[0];
+    assert_eq!(s.name, "My floor");
+    assert_eq!(s.emission, Rgb([0.1, 2.0, 3.0]));
+    assert_eq!(s.reflectance, Rgb([0.5, 0.25, 0.0]));
+    assert_eq!(s.vertices[1], dvec3(1.0, 0.0, 0.0));
+}
+
+#[test]
+fn windows_line_ends_and_byte_order_mark() {
+    let text = format!("\u{feff}{}", VALID.replace('\n', "\r\n"));
+    assert_eq!(
+        parse_scene(&text, "t").unwrap(),
+        parse_scene(VALID, "t").unwrap()
+    );
+}
+
+#[test]
+fn missing_or_misordered_keyword() {
+    one_error(&with_line(8, ""), 8, 1, "expected Eg, found \"Eb\"");
+    one_error(
+        &with_line(8, "Eb 0\nEg 0"),
+        8,
+        1,
+        "expected Eg, found \"Eb\"",
+    );
+    one_error(
+        &with_line(5, ""),
+        5,
+        1,
+        "expected a \"#NAME\" line, found \"VERTICES\"",
+    );
+    one_error(
+        &with_line(17, ""),
+        17,
+        1,
+        "expected PATCHEND, found \"SCENEEND\"",
+    );
+    one_error(
+        &with_line(4, ""),
+        4,
+        1,
+        "expected PATCHBEGIN, BOXBEGIN or SCENEEND",
+    );
+}
+
+#[test]
+fn unknown_keyword() {
+    one_error(
+        &with_line(8, "Eq 0.0"),
+        8,
+        1,
+        "unknown keyword \"Eq\"; expected Eg",
+    );
+    one_error(
+        &with_line(13, "VERTEXO 0 0 0"),
+        13,
+        1,
+        "unknown keyword \"VERTEXO\"",
+    );
+}
+
+#[test]
+fn missing_header_lines_give_one_error_each() {
+    one_error(
+        &with_line(1, ""),
+        1,
+        1,
+        "expected MAX_PATCH_AREA, found \"INTEGRAL_STEPS\"",
+    );
+    one_error(
+        &with_line(1, "MAX_PATCH_AREAS 100"),
+        1,
+        1,
+        "unknown keyword",
+    );
+    one_error(
+        &with_line(2, ""),
+        2,
+        1,
+        "expected INTEGRAL_STEPS, found \"SCENEBEGIN\"",
+    );
+    one_error(
+        &with_line(3, ""),
+        3,
+        1,
+        "expected SCENEBEGIN, found \"PATCHBEGIN\"",
+    );
+}
+
+#[test]
+fn not_a_number() {
+    one_error(
+        &with_line(11, "Rg abc"),
+        11,
+        4,
+        "expected a number after \"Rg\", found \"abc\"",
+    );
+    one_error(&with_line(11, "Rg"), 11, 3, "found end of line");
+    one_error(
+        &with_line(14, "VERTEX1 1 zero 0"),
+        14,
+        11,
+        "the y coordinate",
+    );
+    one_error(&with_line(14, "VERTEX1 1 0"), 14, 12, "the z coordinate");
+}
+
+#[test]
+fn not_finite() {
+    for bad in ["NaN", "nan", "inf", "-inf", "infinity", "1e400"] {
+        one_error(
+            &with_line(7, &format!("Er {bad}")),
+            7,
+            4,
+            "expected a finite number after \"Er\"",
+        );
+    }
+    one_error(&with_line(15, "VERTEX2 1 1 NaN"), 15, 13, "finite number");
+}
+
+#[test]
+fn extra_tokens() {
+    one_error(
+        &with_line(10, "Rr 0.5 0.6"),
+        10,
+        8,
+        "expected end of line after the value of \"Rr\", found \"0.6\"",
+    );
+    one_error(
+        &with_line(13, "VERTEX0 0 0 0 0"),
+        13,
+        15,
+        "the 3 values of \"VERTEX0\"",
+    );
+    one_error(
+        &with_line(4, "PATCHBEGIN now"),
+        4,
+        12,
+        "after \"PATCHBEGIN\"",
+    );
+}
+
+#[test]
+fn reflectance_range() {
+    for bad in ["1", "1.0", "-0.1", "2"] {
+        one_error(
+            &with_line(11, &format!("Rg {bad}")),
+            11,
+            4,
+            "reflectance must be at least 0 and below 1",
+        );
+    }
+    assert!(parse_scene(&with_line(11, "Rg 0.999"), "t").is_ok());
+    assert!(parse_scene(&with_line(11, "Rg 0"), "t").is_ok());
+}
+
+#[test]
+fn negative_emission() {
+    one_error(
+        &with_line(9, "Eb -1"),
+        9,
+        4,
+        "emission must not be negative",
+    );
+}
+
+#[test]
+fn vertex_count() {
+    one_error(&with_line(6, "VERTICES 2"), 6, 10, "at least 3");
+    one_error(&with_line(6, "VERTICES 3.5"), 6, 10, "whole number");
+    one_error(&with_line(6, "VERTICES -4"), 6, 10, "whole number");
+    // Fewer VERTEXk lines than VERTICES says.
+    one_error(
+        &with_line(6, "VERTICES 5"),
+        17,
+        1,
+        "expected VERTEX4 (VERTICES says 5 vertices, but only 4 are given), found \"PATCHEND\"",
+    );
+    // More.
+    one_error(
+        &with_line(6, "VERTICES 3"),
+        16,
+        1,
+        "more VERTEX lines than VERTICES says",
+    );
+    // Out of order.
+    one_error(
+        &with_line(14, "VERTEX2 1 1 0\nVERTEX1 1 0 0"),
+        14,
+        1,
+        "expected VERTEX1, found \"VERTEX2\"",
+    );
+    // "4.0" is a whole number.
+    assert!(parse_scene(&with_line(6, "VERTICES 4.0"), "t").is_ok());
+}
+
+#[test]
+fn polygon_errors_point_at_vertex0() {
+    one_error(&with_line(15, "VERTEX2 1 1 0.1"), 13, 1, "not planar");
+    one_error(&with_line(15, "VERTEX2 0.2 0.2 0"), 13, 1, "not convex");
+    one_error(
+        &with_line(15, "VERTEX2 1 0 0"),
+        13,
+        1,
+        "VERTEX1 and VERTEX2 are the same",
+    );
+    one_error(
+        &with_lines(&[(15, "VERTEX2 2 0 0"), (16, "VERTEX3 3 0 0")]),
+        13,
+        1,
+        "area is zero",
+    );
+    // A clockwise square is fine: it just faces the other way.
+    let flipped = parse_scene(
+        &with_lines(&[(14, "VERTEX1 0 1 0"), (16, "VERTEX3 1 0 0")]),
+        "t",
+    )
+    .unwrap();
+    let n = geometry::polygon_normal(&flipped.surfaces[0].vertices).unwrap();
+    assert_eq!(n, -DVec3::Z);
+}
+
+#[test]
+fn planarity_message_states_deviation_limit_and_units() {
+    let errs = errors(&with_line(15, "VERTEX2 1 1 0.1"));
+    let m = &errs[0].2;
+    assert!(m.contains("scene units"), "{m}");
+    assert!(m.contains("0.2%"), "{m}");
+}
+
+#[test]
+fn slightly_non_planar_polygon_is_flattened() {
+    // 0.004 / 4 = 0.001 off the plane, under the limit 0.002 * sqrt(2).
+    let scene = parse_scene(&with_line(15, "VERTEX2 1 1 0.004"), "t").unwrap();
+    let v = &scene.surfaces[0].vertices;
+    assert!(geometry::max_plane_deviation(v) < 1e-12);
+    assert!((v[2].z - 0.003).abs() < 1e-4, "{:?}", v[2]);
+}
+
+#[test]
+fn scene_structure_errors() {
+    // Nothing between SCENEBEGIN and SCENEEND.
+    let empty = "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\nSCENEEND\n";
+    one_error(empty, 4, 1, "no patches");
+    // Nothing at all after SCENEBEGIN.
+    one_error(
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\n",
+        3,
+        11,
+        "no patches",
+    );
+    // Missing SCENEEND: reported at the end of the last line.
+    one_error(
+        &with_line(18, ""),
+        17,
+        9,
+        "expected SCENEEND, found end of file",
+    );
+    // Text after SCENEEND.
+    one_error(
+        &with_line(18, "SCENEEND\n\nPATCHBEGIN"),
+        20,
+        1,
+        "expected end of file after SCENEEND, found \"PATCHBEGIN\"",
+    );
+    // An empty file.
+    let errs = errors("");
+    assert_eq!(errs[0].0, 1);
+    assert!(errs[0]
+        .2
+        .contains("expected MAX_PATCH_AREA, found end of file"));
+}
+
+#[test]
+fn header_values() {
+    one_error(&with_line(1, "MAX_PATCH_AREA 0"), 1, 16, "greater than 0");
+    one_error(&with_line(1, "MAX_PATCH_AREA -5"), 1, 16, "greater than 0");
+    one_error(
+        &with_line(2, "INTEGRAL_STEPS 2.5"),
+        2,
+        16,
+        "whole number of at least 1",
+    );
+    one_error(
+        &with_line(2, "INTEGRAL_STEPS 0"),
+        2,
+        16,
+        "whole number of at least 1",
+    );
+    one_error(&with_line(2, "INTEGRAL_STEPS 1e10"), 2, 16, "at most");
+    let s = parse_scene(&with_line(1, "MAX_PATCH_AREA 12.5"), "t").unwrap();
+    assert_eq!(s.settings.max_patch_area, 12.5);
+    let s = parse_scene(&with_line(2, "INTEGRAL_STEPS 2.0"), "t").unwrap();
+    assert_eq!(s.settings.integral_steps, 2);
+}
+
+/// A patch block with the given colour line and third vertex.
+fn patch(name: &str, colour: &str, vertex2: &str) -> String {
+    format!(
+        "PATCHBEGIN\n#{name}\nVERTICES 4\nEr 0\nEg 0\nEb 0\nRr 0.5\n{colour}\nRb 0.5\n\
+         VERTEX0 0 0 0\nVERTEX1 1 0 0\n{vertex2}\nVERTEX3 0 1 0\nPATCHEND\n"
+    )
+}
+
+#[test]
+fn several_bad_patches_are_all_reported() {
+    // Each patch is 14 lines; the scene starts with 3 header lines.
+    let text = [
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\n".to_string(),
+        patch("a", "Rg x", "VERTEX2 1 1 0"), // lines 4..17, error on 11
+        patch("b", "Rg 0.5", "VERTEX2 1 1 0"), // lines 18..31, fine
+        patch("c", "Rg 0.5", "VERTEX2 1 1 5"), // lines 32..45, not planar: VERTEX0 is 41
+        patch("d", "Rg 0.5", "VERTEX9 1 1 0"), // lines 46..59, wrong vertex on 57
+        "SCENEEND\n".to_string(),
+    ]
+    .concat();
+    let errs = errors(&text);
+    let places: Vec<(usize, usize)> = errs.iter().map(|e| (e.0, e.1)).collect();
+    assert_eq!(places, vec![(11, 4), (41, 1), (57, 1)], "{errs:#?}");
+    assert!(errs[2].2.contains("expected VERTEX2, found \"VERTEX9\""));
+}
+
+#[test]
+fn recovery_when_patchend_is_missing() {
+    let text = [
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\n".to_string(),
+        patch("a", "Rg 0.5", "VERTEX2 1 1 0").replace("PATCHEND\n", ""),
+        patch("b", "Rg 7", "VERTEX2 1 1 0"),
+        "SCENEEND\n".to_string(),
+    ]
+    .concat();
+    let errs = errors(&text);
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    assert_eq!((errs[0].0, errs[0].1), (17, 1));
+    assert!(errs[0]
+        .2
+        .contains("expected PATCHEND, found \"PATCHBEGIN\""));
+    assert_eq!((errs[1].0, errs[1].1), (24, 4));
+}
+
+#[test]
+fn error_display() {
+    let err = parse_scene(&with_line(11, "Rg abc"), "room.scene").unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "room.scene:11:4: error: expected a number after \"Rg\", found \"abc\"\n\
+         1 error"
+    );
+    let err = parse_scene(&with_lines(&[(10, "Rr 3"), (11, "Rg 3")]), "room.scene").unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.starts_with("room.scene:10:4: error: reflectance"),
+        "{text}"
+    );
+    assert!(
+        text.contains("\nroom.scene:11:4: error: reflectance"),
+        "{text}"
+    );
+    assert!(text.ends_with("\n2 errors"), "{text}");
+}
+
+#[test]
+fn read_scene_reports_file_problems() {
+    let missing = Path::new("/nonexistent/dir/x.scene");
+    let err = read_scene(missing).unwrap_err();
+    assert_eq!(err.errors.len(), 1);
+    assert!(err
+        .to_string()
+        .starts_with("/nonexistent/dir/x.scene: error: cannot read the scene file"));
+
+    let dir = std::env::temp_dir().join(format!("radiosity-parse-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.scene");
+    std::fs::write(&path, b"MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\n\xff\n").unwrap();
+    let err = read_scene(&path).unwrap_err();
+    assert_eq!(err.errors[0].line, 3);
+    assert!(err.errors[0].message.contains("UTF-8"));
+    std::fs::write(&path, VALID).unwrap();
+    assert_eq!(read_scene(&path).unwrap(), parse_scene(VALID, "x").unwrap());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+// ----- boxes -----
+
+/// A box block with the given facing and shape lines.
+fn box_scene(facing: &str, shape: &str) -> String {
+    format!(
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\nBOXBEGIN\n#Table\nFACING {facing}\n\
+         Er 0\nEg 0\nEb 0\nRr 0.1\nRg 0.2\nRb 0.3\n{shape}\nBOXEND\nSCENEEND\n"
+    )
+}
+
+/// Volume enclosed by faces (divergence theorem), positive when they face out.
+fn enclosed_volume(faces: &[Surface]) -> f64 {
+    faces
+        .iter()
+        .map(|f| {
+            let v = &f.vertices;
+            geometry::polygon_centroid(v).dot(geometry::area_vector(v)) / 3.0
+        })
+        .sum()
+}
+
+/// Checks each face looks away from (`out`) or towards the mean of all corners.
+#[track_caller]
+fn check_facing(faces: &[Surface], out: bool) {
+    let all: Vec<DVec3> = faces.iter().flat_map(|f| f.vertices.clone()).collect();
+    let centre = geometry::vertex_mean(&all);
+    for f in faces {
+        let n = geometry::polygon_normal(&f.vertices).unwrap();
+        let away = (geometry::polygon_centroid(&f.vertices) - centre).dot(n);
+        assert!(
+            if out { away > 0.0 } else { away < 0.0 },
+            "{} {away}",
+            f.name
+        );
+        assert!(geometry::is_convex(&f.vertices));
+        assert_eq!(f.vertices.len(), 4);
+    }
+}
+
+#[test]
+fn axis_aligned_box() {
+    let scene = parse_scene(&box_scene("OUT", "ORIGIN 1 0 2\nSIZE 2 0.8 1"), "t").unwrap();
+    let faces = &scene.surfaces;
+    let names: Vec<&str> = faces.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "Table.base",
+            "Table.top",
+            "Table.side0",
+            "Table.side1",
+            "Table.side2",
+            "Table.side3"
+        ]
+    );
+    for f in faces {
+        assert_eq!(f.emission, Rgb([0.0; 3]));
+        assert_eq!(f.reflectance, Rgb([0.1, 0.2, 0.3]));
+    }
+    check_facing(faces, true);
+    assert!((enclosed_volume(faces) - 2.0 * 0.8 * 1.0).abs() < 1e-12);
+    assert_eq!(scene.bounds(), (dvec3(1., 0., 2.), dvec3(3., 0.8, 3.)));
+    // The base is the y-min face, the top the y-max face.
+    assert!(faces[0].vertices.iter().all(|v| v.y == 0.0));
+    assert!(faces[1].vertices.iter().all(|v| v.y == 0.8));
+    assert_eq!(
+        geometry::polygon_normal(&faces[0].vertices),
+        Some(-DVec3::Y)
+    );
+
+    let room = parse_scene(&box_scene("in", "ORIGIN 1 0 2\nSIZE 2 0.8 1"), "t").unwrap();
+    check_facing(&room.surfaces, false);
+    assert!((enclosed_volume(&room.surfaces) + 1.6).abs() < 1e-12);
+    assert_eq!(
+        geometry::polygon_normal(&room.surfaces[0].vertices),
+        Some(DVec3::Y)
+    );
+}
+
+#[test]
+fn box_from_a_face_and_a_height() {
+    // A skewed parallelogram base in a tilted plane; its right-hand-rule normal sets the
+    // sweep direction.
+    let base = [
+        dvec3(0.0, 0.0, 0.0),
+        dvec3(2.0, 0.5, 0.0),
+        dvec3(2.5, 0.5, 1.0),
+        dvec3(0.5, 0.0, 1.0),
+    ];
+    let lines: String = base
+        .iter()
+        .enumerate()
+        .map(|(k, v)| format!("VERTEX{k} {} {} {}\n", v.x, v.y, v.z))
+        .collect();
+    let shape = format!("VERTICES 4\n{lines}HEIGHT 0.75");
+    let expected = geometry::polygon_area(&base) * 0.75;
+    let n = geometry::polygon_normal(&base).unwrap();
+    for (facing, out) in [("OUT", true), ("IN", false)] {
+        let scene = parse_scene(&box_scene(facing, &shape), "t").unwrap();
+        let faces = &scene.surfaces;
+        assert_eq!(faces.len(), 6);
+        check_facing(faces, out);
+        let volume = enclosed_volume(faces);
+        let sign = if out { 1.0 } else { -1.0 };
+        assert!(
+            (volume - sign * expected).abs() < 1e-12,
+            "{volume} {expected}"
+        );
+        // The top is the base moved along the base normal.
+        let top_mean = geometry::vertex_mean(&faces[1].vertices);
+        let base_mean = geometry::vertex_mean(&base);
+        assert!((top_mean - (base_mean + 0.75 * n)).length() < 1e-12);
+    }
+}
+
+#[test]
+fn box_errors() {
+    let ok = "ORIGIN 1 0 2\nSIZE 2 0.8 1";
+    one_error(
+        &box_scene("SIDEWAYS", ok),
+        6,
+        8,
+        "expected OUT or IN after \"FACING\"",
+    );
+    one_error(&box_scene("", ok), 6, 7, "found end of line");
+    one_error(
+        &box_scene("OUT", "ORIGIN 1 0 2\nSIZE 2 0 1"),
+        14,
+        8,
+        "greater than 0",
+    );
+    one_error(
+        &box_scene("OUT", "SIZE 2 1 1"),
+        13,
+        1,
+        "expected ORIGIN or VERTICES",
+    );
+    one_error(
+        &box_scene("OUT", "ORIGIN 1 0\nSIZE 2 1 1"),
+        13,
+        11,
+        "z coordinate",
+    );
+    let tri = "VERTICES 3\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 0 1 0\nHEIGHT 1";
+    one_error(&box_scene("OUT", tri), 13, 10, "exactly 4 vertices");
+    let flat = "VERTICES 4\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 1 1 0\nVERTEX3 0 1 0\nHEIGHT 0";
+    one_error(
+        &box_scene("OUT", flat),
+        18,
+        8,
+        "HEIGHT must be greater than 0",
+    );
+    let dart = "VERTICES 4\nVERTEX0 0 0 0\nVERTEX1 2 1 0\nVERTEX2 0 2 0\nVERTEX3 1 1 0\nHEIGHT 1";
+    one_error(&box_scene("OUT", dart), 14, 1, "not convex");
+    let no_end = box_scene("OUT", ok).replace("BOXEND\n", "");
+    one_error(&no_end, 15, 1, "expected BOXEND, found \"SCENEEND\"");
+}
+
+// ----- robustness -----
+
+/// A small deterministic generator for the garbling test.
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self, n: usize) -> usize {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 33) as usize) % n.max(1)
+    }
+}
+
+#[test]
+fn garbled_input_never_panics() {
+    let source = format!(
+        "{}{}",
+        VALID.replace("SCENEEND\n", ""),
+        box_scene(
+            "OUT",
+            "VERTICES 4\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 1 0 1\nVERTEX3 0 0 1\nHEIGHT 2"
+        )
+        .split_once("SCENEBEGIN\n")
+        .map_or(String::new(), |(_, rest)| rest.to_string())
+    );
+    assert!(parse_scene(&source, "t").is_ok());
+    // Every truncation.
+    for (i, _) in source.char_indices() {
+        let _ = parse_scene(&source[..i], "t");
+    }
+    // Every line removed, duplicated, or moved one down.
+    let lines: Vec<&str> = source.lines().collect();
+    for i in 0..lines.len() {
+        let mut removed = lines.clone();
+        removed.remove(i);
+        let _ = parse_scene(&removed.join("\n"), "t");
+        let mut doubled = lines.clone();
+        doubled.insert(i, lines[i]);
+        let _ = parse_scene(&doubled.join("\n"), "t");
+        if i + 1 < lines.len() {
+            let mut swapped = lines.clone();
+            swapped.swap(i, i + 1);
+            let _ = parse_scene(&swapped.join("\n"), "t");
+        }
+    }
+    // Random character edits.
+    let alphabet: Vec<char> = "# /\n\t0123456789.-+eEnaNinfXVERTEX\u{e9}\u{feff}\r"
+        .chars()
+        .collect();
+    let chars: Vec<char> = source.chars().collect();
+    let mut rng = Lcg(7);
+    for _ in 0..3000 {
+        let mut edited = chars.clone();
+        for _ in 0..1 + rng.next(4) {
+            let at = rng.next(edited.len());
+            match rng.next(3) {
+                0 => {
+                    edited.remove(at);
+                }
+                1 => edited.insert(at, alphabet[rng.next(alphabet.len())]),
+                _ => edited[at] = alphabet[rng.next(alphabet.len())],
+            }
+        }
+        let text: String = edited.into_iter().collect();
+        if let Err(e) = parse_scene(&text, "t") {
+            assert!(!e.errors.is_empty());
+            let _ = e.to_string();
+        }
+    }
+    // Pathological counts and values.
+    let _ = parse_scene(&with_line(6, "VERTICES 1e300"), "t");
+    let _ = parse_scene(&with_line(6, "VERTICES 18446744073709551616"), "t");
+    let _ = parse_scene(&with_line(13, "VERTEX0 1e308 -1e308 1e308"), "t");
+    let _ = parse_scene(&with_line(14, "VERTEX99999999999999999999999 0 0 0"), "t");
+}
+
+#[test]
+fn error_count_is_bounded() {
+    let mut text = String::from("MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\n");
+    for _ in 0..500 {
+        text.push_str(&patch("x", "Rg 2", "VERTEX2 1 1 0"));
+    }
+    text.push_str("SCENEEND\n");
+    let errs = errors(&text);
+    assert_eq!(errs.len(), MAX_ERRORS + 1);
+    assert!(errs[MAX_ERRORS].2.contains("too many errors"));
+}

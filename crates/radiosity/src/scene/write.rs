@@ -1,0 +1,254 @@
+//! Writing scenes in the Appendix A format.
+//!
+//! Numbers are printed with Rust's `{}` formatting of `f64`, the shortest text that reads
+//! back as the same value, so reading a written scene gives back exactly the scene written
+//! (for any scene that [`super::parse_scene`] could have produced). Boxes are written as their
+//! six patches; the camera hint is not part of the format and is not written.
+
+use std::io::{self, Write};
+use std::path::Path;
+
+use super::{Scene, Surface};
+
+/// Writes `scene` as scene-file text to `out`.
+///
+/// Fails with [`io::ErrorKind::InvalidInput`] for a surface name that would not read back as
+/// itself (one with a line break, a `//`, or leading or trailing whitespace).
+pub fn write_scene(scene: &Scene, out: &mut impl Write) -> io::Result<()> {
+    for (i, s) in scene.surfaces.iter().enumerate() {
+        check_name(i, &s.name)?;
+    }
+    writeln!(
+        out,
+        "// Radiosity scene (De Angelis 1998, Appendix A format), written by radiosity {}.",
+        env!("CARGO_PKG_VERSION")
+    )?;
+    writeln!(out, "// {} surfaces.", scene.surfaces.len())?;
+    writeln!(out, "MAX_PATCH_AREA {}", scene.settings.max_patch_area)?;
+    writeln!(out, "INTEGRAL_STEPS {}", scene.settings.integral_steps)?;
+    writeln!(out, "SCENEBEGIN")?;
+    for surface in &scene.surfaces {
+        writeln!(out)?;
+        write_patch(surface, out)?;
+    }
+    writeln!(out)?;
+    writeln!(out, "SCENEEND")
+}
+
+/// Writes `scene` to the file at `path`, replacing it atomically (temporary file and rename).
+pub fn write_scene_file(scene: &Scene, path: &Path) -> io::Result<()> {
+    crate::write_atomically(path, |w| write_scene(scene, w))
+}
+
+/// One `PATCHBEGIN` ... `PATCHEND` block.
+fn write_patch(s: &Surface, out: &mut impl Write) -> io::Result<()> {
+    writeln!(out, "PATCHBEGIN")?;
+    writeln!(out, "#{}", s.name)?;
+    writeln!(out, "VERTICES {}", s.vertices.len())?;
+    for (key, value) in ["Er", "Eg", "Eb"].iter().zip(s.emission.0) {
+        writeln!(out, "{key} {value}")?;
+    }
+    for (key, value) in ["Rr", "Rg", "Rb"].iter().zip(s.reflectance.0) {
+        writeln!(out, "{key} {value}")?;
+    }
+    for (k, v) in s.vertices.iter().enumerate() {
+        writeln!(out, "VERTEX{k} {} {} {}", v.x, v.y, v.z)?;
+    }
+    writeln!(out, "PATCHEND")
+}
+
+/// An error for a name that the reader would not give back unchanged.
+fn check_name(index: usize, name: &str) -> io::Result<()> {
+    let bad = name.contains(['\n', '\r']) || name.contains("//") || name.trim() != name;
+    if bad {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "surface {index} has the name {name:?}, which cannot be written to a scene \
+                 file (no line breaks, \"//\", or leading or trailing spaces)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{cornell_box, parse_scene, read_scene};
+    use super::*;
+    use crate::geometry;
+
+    /// The example scene files at the repository root, by name.
+    const EXAMPLES: [(&str, &str); 4] = [
+        (
+            "cornell_box.scene",
+            include_str!("../../../../examples/cornell_box.scene"),
+        ),
+        (
+            "room.scene",
+            include_str!("../../../../examples/room.scene"),
+        ),
+        (
+            "occluder.scene",
+            include_str!("../../../../examples/occluder.scene"),
+        ),
+        (
+            "triangles.scene",
+            include_str!("../../../../examples/triangles.scene"),
+        ),
+    ];
+
+    fn written(scene: &Scene) -> String {
+        let mut out = Vec::new();
+        write_scene(scene, &mut out).unwrap();
+        String::from_utf8(out).unwrap()
+    }
+
+    /// Asserts that reading the written scene gives it back bit for bit.
+    #[track_caller]
+    fn round_trips(scene: &Scene) {
+        let text = written(scene);
+        let mut back = parse_scene(&text, "written").unwrap_or_else(|e| panic!("{e}\n{text}"));
+        back.camera = scene.camera;
+        assert_eq!(&back, scene);
+        let bits = |s: &Scene| -> Vec<u64> {
+            s.surfaces
+                .iter()
+                .flat_map(|f| f.vertices.iter().flat_map(|v| v.to_array()))
+                .chain([s.settings.max_patch_area])
+                .map(f64::to_bits)
+                .collect()
+        };
+        assert_eq!(bits(&back), bits(scene));
+        // Writing again gives the same text.
+        assert_eq!(written(&back), text);
+    }
+
+    #[test]
+    fn every_example_parses_and_round_trips() {
+        for (name, text) in EXAMPLES {
+            let scene = parse_scene(text, name).unwrap_or_else(|e| panic!("{e}"));
+            assert!(text.starts_with("// "), "{name} needs a header comment");
+            round_trips(&scene);
+        }
+    }
+
+    #[test]
+    fn builtin_box_round_trips() {
+        round_trips(&cornell_box());
+    }
+
+    #[test]
+    fn written_layout() {
+        let text = written(&cornell_box());
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(lines[0].starts_with("// "));
+        let code: Vec<&str> = lines
+            .iter()
+            .copied()
+            .filter(|l| !l.starts_with("//"))
+            .collect();
+        assert_eq!(
+            &code[..4],
+            ["MAX_PATCH_AREA 1000", "INTEGRAL_STEPS 2", "SCENEBEGIN", ""]
+        );
+        assert_eq!(
+            &code[4..15],
+            [
+                "PATCHBEGIN",
+                "#Light",
+                "VERTICES 4",
+                "Er 53.40707511102649",
+                "Eg 37.69911184307752",
+                "Eb 12.566370614359172",
+                "Rr 0.78",
+                "Rg 0.78",
+                "Rb 0.78",
+                "VERTEX0 343 548.8 227",
+                "VERTEX1 343 548.8 332",
+            ]
+        );
+        assert_eq!(lines.last(), Some(&"SCENEEND"));
+    }
+
+    #[test]
+    fn room_example_contents() {
+        let scene = parse_scene(EXAMPLES[1].1, "room.scene").unwrap();
+        let (lo, hi) = scene.bounds();
+        assert_eq!((lo, hi), (glam::DVec3::ZERO, glam::dvec3(5.0, 2.7, 4.0)));
+        let lights = scene
+            .surfaces
+            .iter()
+            .filter(|s| s.emission.max_band() > 0.0);
+        assert_eq!(lights.count(), 2);
+        // The ottoman (a box from a face and a height) rises from the floor.
+        let top = &scene
+            .surfaces
+            .iter()
+            .find(|s| s.name == "Ottoman.top")
+            .unwrap();
+        assert!(top.vertices.iter().all(|v| (v.y - 0.42).abs() < 1e-12));
+        let mesh = crate::mesh::mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        println!(
+            "room.scene: {} surfaces, {} elements",
+            scene.surfaces.len(),
+            mesh.len()
+        );
+    }
+
+    #[test]
+    fn occluder_example_contents() {
+        let scene = parse_scene(EXAMPLES[2].1, "occluder.scene").unwrap();
+        let occluder = scene
+            .surfaces
+            .iter()
+            .find(|s| s.name == "Occluder")
+            .unwrap();
+        assert_eq!(occluder.reflectance.0, [0.0; 3]);
+        // The occluder lies between the light and the floor, under the light.
+        let light = scene.surfaces.iter().find(|s| s.name == "Light").unwrap();
+        let l = geometry::polygon_centroid(&light.vertices);
+        let o = geometry::polygon_centroid(&occluder.vertices);
+        assert!(o.y > 0.0 && o.y < l.y);
+        assert!((o.x - l.x).abs() < 0.5 && (o.z - l.z).abs() < 0.5);
+        // The room's faces look inwards: the floor is the box's base, facing up.
+        let floor = scene
+            .surfaces
+            .iter()
+            .find(|s| s.name == "Room.base")
+            .unwrap();
+        assert_eq!(
+            geometry::polygon_normal(&floor.vertices),
+            Some(glam::DVec3::Y)
+        );
+    }
+
+    #[test]
+    fn unwritable_names_are_refused() {
+        let mut scene = cornell_box();
+        for bad in ["a\nb", "a // b", " padded", "x\r"] {
+            scene.surfaces[0].name = bad.to_string();
+            let mut out = Vec::new();
+            let err = write_scene(&scene, &mut out).unwrap_err();
+            assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
+        }
+    }
+
+    #[test]
+    fn file_round_trip() {
+        let dir = std::env::temp_dir().join(format!("radiosity-write-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("box.scene");
+        let scene = cornell_box();
+        write_scene_file(&scene, &path).unwrap();
+        let mut back = read_scene(&path).unwrap();
+        back.camera = scene.camera;
+        assert_eq!(back, scene);
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            1,
+            "temporary file left"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
