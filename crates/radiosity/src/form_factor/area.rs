@@ -6,6 +6,17 @@
 //! with k x k points per element (paper 2.8, `INTEGRAL_STEPS`) and V(p, q) in {0, 1} the
 //! visibility of q from p by a ray cast (paper 2.3, through a BVH instead of the paper's
 //! test against every patch).
+//!
+//! One change to the paper's integrand: a point pair's term w_q cos cos / (pi r^2) is the
+//! form factor from point p to the small area w_q, and when r^2 is not large against w_q
+//! (elements that touch, or furniture a centimetre from a wall) it exceeds 1, which no form
+//! factor can: in the furnished room example, rows then summed to 7. Each term is therefore
+//! the form factor from p to a coaxial disc of that area, w cos cos / (pi r^2 + w)
+//! (Wallace, Elmquist and Haines 1989, eq. 7), with w = max(w_p, w_q) so that the kernel stays
+//! symmetric and reciprocity exact. It equals the paper's term to first order in w / r^2, so
+//! it converges to the same limit (see tests/form_factors.rs), and is never above 1. On the
+//! unit-square closed forms at k = 2 it cuts the error from 0.017 to 0.0032 (opposed) and
+//! from 0.064 to 0.0088 (sharing an edge).
 
 use std::f64::consts::PI;
 
@@ -186,8 +197,9 @@ impl<'a> AreaIntegrator<'a> {
                         continue;
                     }
                 }
-                // cos_p and cos_q carry a factor |d| each: divide by r^4 in all.
-                sum += cos_p * cos_q / (PI * r2 * r2) * wp * wq;
+                // cos_p and cos_q carry a factor |d| each, so this is
+                // cos cos w_p w_q / (pi r^2 + w) with unit cosines (see the module doc).
+                sum += cos_p * cos_q / (r2 * (PI * r2 + wp.max(wq))) * wp * wq;
             }
         }
         rays.add(cast);

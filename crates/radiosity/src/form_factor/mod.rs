@@ -29,7 +29,8 @@ use crate::visibility::PolygonBvh;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FormFactorMethod {
     /// The paper's double area integral (figure 4) by the midpoint rule with `steps` x `steps`
-    /// points on each element, and a ray cast for the visibility of every point pair.
+    /// points on each element, a disc-regularised kernel (see `area.rs`) and the visibility
+    /// of every point pair by a ray cast against candidate occluders.
     AreaIntegral {
         /// k, points along each axis of each element (`INTEGRAL_STEPS`).
         steps: u32,
