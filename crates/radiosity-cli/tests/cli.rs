@@ -1,0 +1,256 @@
+//! The `radiosity` program end to end: each command as a user runs it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn radiosity(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the radiosity binary runs")
+}
+
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("radiosity-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn example(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn render_writes_png_of_requested_size() {
+    let dir = scratch_dir("render");
+    // The built-in Cornell box, coarsely meshed so the test is quick.
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--width",
+            "48",
+            "--height",
+            "64",
+            "-o",
+            "box.png",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(dir.join("box.png")).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (48, 64));
+    // Not a blank picture: the red wall is on the left, the green wall on the right.
+    let (left, right) = (img.get_pixel(2, 32), img.get_pixel(45, 32));
+    assert!(left[0] > left[1], "left edge should be red, got {left:?}");
+    assert!(
+        right[1] > right[0],
+        "right edge should be green, got {right:?}"
+    );
+    assert!(
+        stderr(&out).contains("timings:"),
+        "render prints stage timings"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn render_default_output_name_and_shadings() {
+    let dir = scratch_dir("shadings");
+    for shading in ["smooth", "flat", "wireframe"] {
+        let out = radiosity(
+            &[
+                "render",
+                "--max-area",
+                "20000",
+                "--width",
+                "32",
+                "--height",
+                "32",
+                "--shading",
+                shading,
+                "-q",
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{shading}: {}", stderr(&out));
+        assert!(
+            out.stderr.is_empty(),
+            "--quiet prints nothing: {}",
+            stderr(&out)
+        );
+        let img = image::open(dir.join("cornell.png")).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (32, 32));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn solve_writes_csv_with_exact_header_and_one_row_per_element() {
+    let dir = scratch_dir("solve");
+    let out = radiosity(
+        &["solve", &example("triangles.scene"), "-o", "tri.csv", "-q"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = std::fs::read_to_string(dir.join("tri.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "surface,element,area,centroid_x,centroid_y,centroid_z,radiosity_r,radiosity_g,radiosity_b"
+    );
+    let check = radiosity(&["check", &example("triangles.scene")], &dir);
+    let text = String::from_utf8_lossy(&check.stdout);
+    let elements: usize = text
+        .lines()
+        .find(|l| l.starts_with("elements"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|n| n.parse().ok())
+        .expect("check prints the element count");
+    assert_eq!(lines.count(), elements);
+
+    // The same solution as JSON.
+    let out = radiosity(
+        &["solve", &example("triangles.scene"), "-o", "tri.json", "-q"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("tri.json")).unwrap()).unwrap();
+    assert_eq!(json.as_array().unwrap().len(), elements);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn form_factor_file_round_trip_and_refusals() {
+    let dir = scratch_dir("ff");
+    let scene = example("triangles.scene");
+    let out = radiosity(&["formfactors", &scene, "-o", "t.ff", "-q"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+
+    // Solving from the file gives the same numbers as computing afresh.
+    let a = radiosity(&["solve", &scene, "-o", "a.csv", "-q"], &dir);
+    let b = radiosity(
+        &[
+            "solve",
+            &scene,
+            "--form-factors",
+            "t.ff",
+            "-o",
+            "b.csv",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(
+        a.status.success() && b.status.success(),
+        "{}{}",
+        stderr(&a),
+        stderr(&b)
+    );
+    assert_eq!(
+        std::fs::read(dir.join("a.csv")).unwrap(),
+        std::fs::read(dir.join("b.csv")).unwrap()
+    );
+
+    // A file for another mesh is stale.
+    let out = radiosity(
+        &[
+            "solve",
+            &scene,
+            "--max-area",
+            "0.1",
+            "--form-factors",
+            "t.ff",
+            "-o",
+            "c.csv",
+        ],
+        &dir,
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("t.ff"), "{}", stderr(&out));
+    assert!(!dir.join("c.csv").exists(), "no output from a refused run");
+
+    // A corrupted byte is caught by the checksum.
+    let mut bytes = std::fs::read(dir.join("t.ff")).unwrap();
+    let middle = bytes.len() / 2;
+    bytes[middle] ^= 0x40;
+    std::fs::write(dir.join("bad.ff"), &bytes).unwrap();
+    let out = radiosity(
+        &["solve", &scene, "--form-factors", "bad.ff", "-o", "d.csv"],
+        &dir,
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("bad.ff"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_scene_reports_file_line_and_column() {
+    let dir = scratch_dir("bad");
+    std::fs::write(
+        dir.join("bad.scene"),
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 2\nSCENEBEGIN\nPATCHBEGIN\n#a\nVERTICES 3\nEr 0\nEg zero\n",
+    )
+    .unwrap();
+    let out = radiosity(&["render", "bad.scene"], &dir);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("bad.scene:8:4"), "{err}");
+    assert!(!dir.join("bad.png").exists());
+    let out = radiosity(&["check", "missing.scene"], &dir);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("missing.scene"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn check_prints_statistics() {
+    let dir = scratch_dir("check");
+    let out = radiosity(
+        &["check", &example("occluder.scene"), "--max-area", "2"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    for field in [
+        "surfaces",
+        "elements",
+        "total area",
+        "row sums",
+        "reciprocity error",
+        "stage times",
+    ] {
+        assert!(text.contains(field), "check output lacks {field}:\n{text}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_arguments_are_refused_with_a_message() {
+    let dir = scratch_dir("args");
+    for (args, needle) in [
+        (vec!["render", "--eye", "1,2"], "--eye"),
+        (vec!["render", "--gamma", "0"], "--gamma"),
+        (vec!["render", "--exposure", "bright"], "--exposure"),
+        (vec!["render", "--width", "0"], "--width"),
+        (vec!["render", "--max-area=-1"], "MAX_PATCH_AREA"),
+        (vec!["check", "--steps", "0"], "--steps"),
+    ] {
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
