@@ -61,10 +61,10 @@ impl Reporter {
     }
 }
 
-/// Milliseconds below 10 s, seconds above.
+/// Milliseconds below 1 s, seconds above.
 pub fn format_duration(d: Duration) -> String {
     let s = d.as_secs_f64();
-    if s < 10.0 {
+    if s < 1.0 {
         format!("{:.1} ms", s * 1e3)
     } else {
         format!("{s:.2} s")
@@ -79,7 +79,7 @@ impl Progress for Reporter {
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
         bar.set_style(
             ProgressStyle::with_template(
-                "{prefix:>13} [{bar:40}] {pos}/{len} {elapsed_precise} eta {eta}",
+                "{prefix:>13} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> "),

@@ -16,7 +16,7 @@ pub enum Stage {
     Mesh,
     /// Building the ray-query acceleration structure.
     Bvh,
-    /// Computing form factors (work unit: one matrix row).
+    /// Computing form factors (work unit: one element pair of the upper triangle).
     FormFactors,
     /// Solving the radiosity system (work unit: one band or one iteration).
     Solve,

@@ -242,8 +242,8 @@ pub struct RowBlock {
     pub data: Vec<f32>,
 }
 
-/// Computes the full matrix with `method`, in parallel over rows, reporting one unit of
-/// progress per row.
+/// Computes the full matrix with `method`, in parallel over rows, reporting progress in
+/// element pairs (n (n - 1) / 2 in all) as each row of the upper triangle finishes.
 ///
 /// The area integral is symmetric in i and j up to the 1/A_i factor, so only the upper
 /// triangle G_ij = A_i F_ij (j > i) is integrated and both F_ij = G_ij / A_i and
@@ -258,7 +258,8 @@ pub fn compute_matrix(
     let n = ctx.mesh.len();
     let mut matrix = FormFactorMatrix::zeros(n)?;
     let areas: Vec<f64> = ctx.mesh.elements.iter().map(|e| e.area).collect();
-    run_stage(progress, Stage::FormFactors, n as u64, || {
+    let pairs = (n as u64) * (n as u64).saturating_sub(1) / 2;
+    run_stage(progress, Stage::FormFactors, pairs, || {
         let FormFactorMethod::AreaIntegral { steps } = method;
         let integrator = area::AreaIntegrator::new(ctx, steps);
         // Upper triangle, row by row, straight into the matrix: F_ij = G_ij / A_i for j > i.
@@ -271,7 +272,7 @@ pub fn compute_matrix(
                 for (f, g) in row[i + 1..].iter_mut().zip(g) {
                     *f = (g / areas[i]) as f32;
                 }
-                progress.advance(1);
+                progress.advance((n - i - 1) as u64);
             });
         // Lower triangle by reciprocity: F_ji = A_i F_ij / A_j.
         for i in 0..n {
