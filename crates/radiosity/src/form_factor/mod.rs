@@ -6,6 +6,8 @@
 
 mod area;
 mod file;
+mod hemicube;
+mod montecarlo;
 pub mod reference;
 
 pub use area::area_integral_pair;
@@ -35,12 +37,49 @@ pub enum FormFactorMethod {
         /// k, points along each axis of each element (`INTEGRAL_STEPS`).
         steps: u32,
     },
+    /// The hemicube (Cohen and Greenberg 1985): each element's view rasterised on the CPU
+    /// onto a half cube of `resolution` x `resolution` cells on top.
+    Hemicube {
+        /// Cells across the top face (even).
+        resolution: u32,
+    },
+    /// Stratified Monte Carlo ray casting: `samples` cosine-distributed rays per element,
+    /// from a seeded generator (deterministic).
+    MonteCarlo {
+        /// Rays per element (rounded up to a square).
+        samples: u32,
+        /// Generator seed.
+        seed: u64,
+    },
+}
+
+impl FormFactorMethod {
+    /// True when the method's estimate is symmetric (A_i F_ij = A_j F_ji exactly), so only
+    /// the upper triangle need be computed.
+    pub fn is_reciprocal(&self) -> bool {
+        matches!(self, FormFactorMethod::AreaIntegral { .. })
+    }
+
+    /// How the method handles occlusion, for the command line's help and notes.
+    pub fn occlusion(&self) -> &'static str {
+        match self {
+            FormFactorMethod::AreaIntegral { .. } => "ray cast per point pair",
+            FormFactorMethod::Hemicube { .. } => "depth buffer",
+            FormFactorMethod::MonteCarlo { .. } => "closest hit of each ray",
+        }
+    }
 }
 
 impl std::fmt::Display for FormFactorMethod {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             FormFactorMethod::AreaIntegral { steps } => write!(f, "area k={steps}"),
+            FormFactorMethod::Hemicube { resolution } => {
+                write!(f, "hemicube resolution={resolution}")
+            }
+            FormFactorMethod::MonteCarlo { samples, seed } => {
+                write!(f, "montecarlo samples={samples} seed={seed}")
+            }
         }
     }
 }
@@ -242,6 +281,77 @@ pub struct RowBlock {
     pub data: Vec<f32>,
 }
 
+/// The per-method machinery, built once per matrix and shared by all rows.
+enum Engine<'a> {
+    /// Symmetric pair integrals.
+    Pairs(area::AreaIntegrator<'a>),
+    Hemicube(hemicube::Hemicube),
+    MonteCarlo {
+        elements: PolygonBvh,
+        samples: u32,
+        seed: u64,
+    },
+}
+
+/// Per-thread scratch space of every engine.
+#[derive(Default)]
+struct Scratch {
+    area: area::Scratch,
+    hemicube: hemicube::HemicubeScratch,
+}
+
+impl<'a> Engine<'a> {
+    fn new(ctx: &'a FormFactorContext<'a>, method: FormFactorMethod) -> Engine<'a> {
+        match method {
+            FormFactorMethod::AreaIntegral { steps } => {
+                Engine::Pairs(area::AreaIntegrator::new(ctx, steps))
+            }
+            FormFactorMethod::Hemicube { resolution } => {
+                Engine::Hemicube(hemicube::Hemicube::new(resolution))
+            }
+            FormFactorMethod::MonteCarlo { samples, seed } => {
+                let mesh = ctx.mesh;
+                let polygons: Vec<Vec<DVec3>> = (0..mesh.len())
+                    .map(|e| mesh.corner_positions(e).collect())
+                    .collect();
+                let ids: Vec<u32> = (0..mesh.len() as u32).collect();
+                Engine::MonteCarlo {
+                    elements: PolygonBvh::new(&polygons, &ids),
+                    samples,
+                    seed,
+                }
+            }
+        }
+    }
+
+    /// Row i in full: F_ij for every j.
+    fn row(
+        &self,
+        ctx: &FormFactorContext,
+        i: usize,
+        rays: &RayCounter,
+        scratch: &mut Scratch,
+    ) -> Vec<f64> {
+        let mesh = ctx.mesh;
+        match self {
+            Engine::Pairs(integrator) => {
+                let a_i = mesh.elements[i].area;
+                integrator
+                    .couplings(i, 0..mesh.len(), rays, &mut scratch.area)
+                    .into_iter()
+                    .map(|g| g / a_i)
+                    .collect()
+            }
+            Engine::Hemicube(h) => h.row(mesh, i, &mut scratch.hemicube),
+            Engine::MonteCarlo {
+                elements,
+                samples,
+                seed,
+            } => montecarlo::row(mesh, elements, i, *samples, *seed, rays),
+        }
+    }
+}
+
 /// Computes the full matrix with `method`, in parallel over rows, reporting progress in
 /// element pairs (n (n - 1) / 2 in all) as each row of the upper triangle finishes.
 ///
@@ -258,30 +368,45 @@ pub fn compute_matrix(
     let n = ctx.mesh.len();
     let mut matrix = FormFactorMatrix::zeros(n)?;
     let areas: Vec<f64> = ctx.mesh.elements.iter().map(|e| e.area).collect();
-    let pairs = (n as u64) * (n as u64).saturating_sub(1) / 2;
-    run_stage(progress, Stage::FormFactors, pairs, || {
-        let FormFactorMethod::AreaIntegral { steps } = method;
-        let integrator = area::AreaIntegrator::new(ctx, steps);
-        // Upper triangle, row by row, straight into the matrix: F_ij = G_ij / A_i for j > i.
-        matrix
-            .data
-            .par_chunks_mut(n.max(1))
-            .enumerate()
-            .for_each_init(area::Scratch::default, |scratch, (i, row)| {
-                let g = integrator.couplings(i, i + 1..n, rays, scratch);
-                for (f, g) in row[i + 1..].iter_mut().zip(g) {
-                    *f = (g / areas[i]) as f32;
+    let engine = Engine::new(ctx, method);
+    if let (true, Engine::Pairs(integrator)) = (method.is_reciprocal(), &engine) {
+        let pairs = (n as u64) * (n as u64).saturating_sub(1) / 2;
+        run_stage(progress, Stage::FormFactors, pairs, || {
+            // Upper triangle, row by row, straight into the matrix: F_ij = G_ij / A_i, j > i.
+            matrix
+                .data
+                .par_chunks_mut(n.max(1))
+                .enumerate()
+                .for_each_init(Scratch::default, |scratch, (i, row)| {
+                    let g = integrator.couplings(i, i + 1..n, rays, &mut scratch.area);
+                    for (f, g) in row[i + 1..].iter_mut().zip(g) {
+                        *f = (g / areas[i]) as f32;
+                    }
+                    progress.advance((n - i - 1) as u64);
+                });
+            // Lower triangle by reciprocity: F_ji = A_i F_ij / A_j.
+            for i in 0..n {
+                for j in i + 1..n {
+                    let g = matrix.data[i * n + j] as f64 * areas[i];
+                    matrix.data[j * n + i] = (g / areas[j]) as f32;
                 }
-                progress.advance((n - i - 1) as u64);
-            });
-        // Lower triangle by reciprocity: F_ji = A_i F_ij / A_j.
-        for i in 0..n {
-            for j in i + 1..n {
-                let g = matrix.data[i * n + j] as f64 * areas[i];
-                matrix.data[j * n + i] = (g / areas[j]) as f32;
             }
-        }
-    });
+        });
+    } else {
+        let pairs = (n as u64) * (n as u64).saturating_sub(1);
+        run_stage(progress, Stage::FormFactors, pairs, || {
+            matrix
+                .data
+                .par_chunks_mut(n.max(1))
+                .enumerate()
+                .for_each_init(Scratch::default, |scratch, (i, row)| {
+                    for (f, v) in row.iter_mut().zip(engine.row(ctx, i, rays, scratch)) {
+                        *f = v as f32;
+                    }
+                    progress.advance(n.saturating_sub(1) as u64);
+                });
+        });
+    }
     Ok(matrix)
 }
 
@@ -293,17 +418,15 @@ pub fn compute_rows(
     rows: Range<usize>,
     rays: &RayCounter,
 ) -> RowBlock {
-    let n = ctx.mesh.len();
-    let FormFactorMethod::AreaIntegral { steps } = method;
-    let integrator = area::AreaIntegrator::new(ctx, steps);
+    let engine = Engine::new(ctx, method);
     let data: Vec<f32> = rows
         .clone()
         .into_par_iter()
-        .map_init(area::Scratch::default, |scratch, i| {
-            let a_i = ctx.mesh.elements[i].area;
-            let row = integrator.couplings(i, 0..n, rays, scratch);
-            row.into_iter()
-                .map(|g| (g / a_i) as f32)
+        .map_init(Scratch::default, |scratch, i| {
+            engine
+                .row(ctx, i, rays, scratch)
+                .into_iter()
+                .map(|f| f as f32)
                 .collect::<Vec<f32>>()
         })
         .flatten_iter()
