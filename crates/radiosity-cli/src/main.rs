@@ -9,8 +9,9 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
+use image::RgbImage;
 use radiosity::form_factor::FormFactorMatrix;
-use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
 use radiosity::scene::{self, Scene};
@@ -222,16 +223,17 @@ fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String
     }
 }
 
-/// Form factors from the file given, or computed (with their statistics reported).
+/// Form factors from the file given, or computed (with their statistics reported and
+/// returned).
 fn form_factors(
     prepared: &Prepared,
     file: Option<&Path>,
     reporter: &Reporter,
-) -> Result<FormFactorMatrix> {
+) -> Result<(FormFactorMatrix, Option<FormFactorStats>)> {
     if let Some(path) = file {
         let f = prepared.load_form_factors(path, reporter)?;
         reporter.note(&format!("form factors read from {}", path.display()));
-        return Ok(f);
+        return Ok((f, None));
     }
     let (f, stats) = prepared.form_factors(reporter)?;
     reporter.note(&format!(
@@ -246,7 +248,7 @@ fn form_factors(
         stats.row_sums.max,
         stats.reciprocity_error
     ));
-    Ok(f)
+    Ok((f, Some(stats)))
 }
 
 fn solver(options: &SolveOptions) -> Result<Solver> {
@@ -272,23 +274,11 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let settings = render_settings(&args)?;
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
     let camera = camera(&args, &prepared.scene)?;
-    let f = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
+    let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     drop(f);
-    let element_b = solution.element_rgb();
-    let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(&prepared.mesh, &element_b)
-    });
     let exposure = parse_exposure(&args.exposure)?;
-    let scale = exposure.scale(&prepared.scene, &prepared.mesh, &element_b);
-    let settings = RenderSettings {
-        exposure_scale: scale,
-        ..settings
-    };
-    let renderer = Renderer::new(&prepared.mesh);
-    let image = render::render(
-        &renderer, &camera, &element_b, &vertex_b, &settings, &reporter,
-    );
+    let image = shade_and_render(&prepared, &solution, &camera, settings, exposure, &reporter);
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
@@ -304,6 +294,30 @@ fn render_command(args: RenderArgs) -> Result<()> {
     ));
     reporter.print_timings();
     Ok(())
+}
+
+/// Vertex radiosities (the shade stage), exposure, then the image (the render stage).
+fn shade_and_render(
+    prepared: &Prepared,
+    solution: &Solution,
+    camera: &Camera,
+    settings: RenderSettings,
+    exposure: Exposure,
+    reporter: &Reporter,
+) -> RgbImage {
+    let element_b = solution.element_rgb();
+    let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
+        shade::vertex_radiosity(&prepared.mesh, &element_b)
+    });
+    let scale = exposure.scale(&prepared.scene, &prepared.mesh, &element_b);
+    let settings = RenderSettings {
+        exposure_scale: scale,
+        ..settings
+    };
+    let renderer = Renderer::new(&prepared.mesh);
+    render::render(
+        &renderer, camera, &element_b, &vertex_b, &settings, reporter,
+    )
 }
 
 fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
@@ -389,7 +403,7 @@ fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
 fn formfactors_command(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
-    let f = form_factors(&prepared, None, &reporter)?;
+    let (f, _) = form_factors(&prepared, None, &reporter)?;
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{stem}.ff")));
@@ -408,7 +422,7 @@ fn formfactors_command(args: FormFactorArgs) -> Result<()> {
 fn solve_command(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
-    let f = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
+    let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     let output = args
         .output
