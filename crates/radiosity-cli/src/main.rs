@@ -9,8 +9,9 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
+use image::RgbImage;
 use radiosity::form_factor::FormFactorMatrix;
-use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
 use radiosity::scene::{self, Scene};
@@ -41,6 +42,9 @@ enum Command {
     /// Print statistics of a scene: surfaces, elements, area, form-factor row sums,
     /// reciprocity, energy balance and stage times.
     Check(CheckArgs),
+    /// Time the whole pipeline (parse, mesh, BVH, form factors, solve, shade, render) and
+    /// print one Markdown table row per MAX_PATCH_AREA with the median time of each stage.
+    Bench(BenchArgs),
 }
 
 /// Options every command shares.
@@ -162,6 +166,34 @@ struct CheckArgs {
     solve: SolveOptions,
 }
 
+#[derive(Args)]
+struct BenchArgs {
+    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    scene: Option<PathBuf>,
+    /// MAX_PATCH_AREA values to time, one table row each (repeat the option or give several
+    /// values); the scene's own when omitted.
+    #[arg(long, value_name = "AREA", num_args = 1..)]
+    max_area: Vec<f64>,
+    /// Override the scene's INTEGRAL_STEPS.
+    #[arg(long, value_name = "K")]
+    steps: Option<u32>,
+    /// Runs per configuration; the table shows the median of each column.
+    #[arg(long, default_value_t = 5, value_name = "N")]
+    repeat: usize,
+    /// Linear solver for (I - rho F) B = E.
+    #[arg(long, value_enum, default_value_t = SolverArg::Lu)]
+    solver: SolverArg,
+    /// Relative residual at which Gauss-Seidel stops.
+    #[arg(long, default_value_t = 1e-9, value_name = "TOL")]
+    tolerance: f64,
+    /// Image width and height in pixels.
+    #[arg(long, default_value_t = 512, value_name = "PIXELS")]
+    size: u32,
+    /// Rays per pixel along each axis (as `render --supersample`).
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    supersample: u32,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
@@ -179,6 +211,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Formfactors(args) => formfactors_command(args),
         Command::Solve(args) => solve_command(args),
         Command::Check(args) => check_command(args),
+        Command::Bench(args) => bench_command(args),
     }
 }
 
@@ -222,16 +255,17 @@ fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String
     }
 }
 
-/// Form factors from the file given, or computed (with their statistics reported).
+/// Form factors from the file given, or computed (with their statistics reported and
+/// returned).
 fn form_factors(
     prepared: &Prepared,
     file: Option<&Path>,
     reporter: &Reporter,
-) -> Result<FormFactorMatrix> {
+) -> Result<(FormFactorMatrix, Option<FormFactorStats>)> {
     if let Some(path) = file {
         let f = prepared.load_form_factors(path, reporter)?;
         reporter.note(&format!("form factors read from {}", path.display()));
-        return Ok(f);
+        return Ok((f, None));
     }
     let (f, stats) = prepared.form_factors(reporter)?;
     reporter.note(&format!(
@@ -246,7 +280,7 @@ fn form_factors(
         stats.row_sums.max,
         stats.reciprocity_error
     ));
-    Ok(f)
+    Ok((f, Some(stats)))
 }
 
 fn solver(options: &SolveOptions) -> Result<Solver> {
@@ -272,23 +306,11 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let settings = render_settings(&args)?;
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
     let camera = camera(&args, &prepared.scene)?;
-    let f = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
+    let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     drop(f);
-    let element_b = solution.element_rgb();
-    let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(&prepared.mesh, &element_b)
-    });
     let exposure = parse_exposure(&args.exposure)?;
-    let scale = exposure.scale(&prepared.scene, &prepared.mesh, &element_b);
-    let settings = RenderSettings {
-        exposure_scale: scale,
-        ..settings
-    };
-    let renderer = Renderer::new(&prepared.mesh);
-    let image = render::render(
-        &renderer, &camera, &element_b, &vertex_b, &settings, &reporter,
-    );
+    let image = shade_and_render(&prepared, &solution, &camera, settings, exposure, &reporter);
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
@@ -304,6 +326,30 @@ fn render_command(args: RenderArgs) -> Result<()> {
     ));
     reporter.print_timings();
     Ok(())
+}
+
+/// Vertex radiosities (the shade stage), exposure, then the image (the render stage).
+fn shade_and_render(
+    prepared: &Prepared,
+    solution: &Solution,
+    camera: &Camera,
+    settings: RenderSettings,
+    exposure: Exposure,
+    reporter: &Reporter,
+) -> RgbImage {
+    let element_b = solution.element_rgb();
+    let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
+        shade::vertex_radiosity(&prepared.mesh, &element_b)
+    });
+    let scale = exposure.scale(&prepared.scene, &prepared.mesh, &element_b);
+    let settings = RenderSettings {
+        exposure_scale: scale,
+        ..settings
+    };
+    let renderer = Renderer::new(&prepared.mesh);
+    render::render(
+        &renderer, camera, &element_b, &vertex_b, &settings, reporter,
+    )
 }
 
 fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
@@ -389,7 +435,7 @@ fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
 fn formfactors_command(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
-    let f = form_factors(&prepared, None, &reporter)?;
+    let (f, _) = form_factors(&prepared, None, &reporter)?;
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{stem}.ff")));
@@ -408,7 +454,7 @@ fn formfactors_command(args: FormFactorArgs) -> Result<()> {
 fn solve_command(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem) = prepare(&args.scene, &reporter)?;
-    let f = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
+    let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     let output = args
         .output
@@ -488,6 +534,174 @@ fn check_command(args: CheckArgs) -> Result<()> {
     println!("stage times:");
     for (stage, d) in reporter.timings() {
         println!("  {:<14}{}", stage.name(), format_duration(d));
+    }
+    Ok(())
+}
+
+/// One timed run of the whole pipeline.
+struct BenchRun {
+    elements: usize,
+    steps: u32,
+    /// Seconds per stage, in the order of [`BENCH_STAGES`].
+    stages: [f64; BENCH_STAGES.len()],
+    /// Wall-clock seconds from before parsing to the rendered image.
+    total: f64,
+    rays: u64,
+}
+
+/// The stages a bench run reports, in pipeline order.
+const BENCH_STAGES: [Stage; 7] = [
+    Stage::Parse,
+    Stage::Mesh,
+    Stage::Bvh,
+    Stage::FormFactors,
+    Stage::Solve,
+    Stage::Shade,
+    Stage::Render,
+];
+
+fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
+    let scene_args = SceneArgs {
+        scene: args.scene.clone(),
+        max_area,
+        steps: args.steps,
+        quiet: true,
+    };
+    let options = SolveOptions {
+        solver: args.solver,
+        tolerance: args.tolerance,
+        form_factors: None,
+    };
+    let settings = RenderSettings {
+        supersample: args.supersample,
+        ..RenderSettings::default()
+    };
+    let solver = solver(&options)?;
+    let reporter = Reporter::new(true);
+    let start = std::time::Instant::now();
+    let (prepared, _) = prepare(&scene_args, &reporter)?;
+    let (f, stats) = form_factors(&prepared, None, &reporter)?;
+    let solution = prepared.solve(&f, solver, &reporter)?;
+    drop(f);
+    let camera = Camera::for_scene(&prepared.scene, args.size, args.size);
+    let image = shade_and_render(
+        &prepared,
+        &solution,
+        &camera,
+        settings,
+        Exposure::Brightest,
+        &reporter,
+    );
+    let total = start.elapsed().as_secs_f64();
+    std::hint::black_box(image);
+    let mut stages = [0.0; BENCH_STAGES.len()];
+    for (stage, d) in reporter.timings() {
+        if let Some(k) = BENCH_STAGES.iter().position(|s| *s == stage) {
+            stages[k] += d.as_secs_f64();
+        }
+    }
+    Ok(BenchRun {
+        elements: prepared.mesh.len(),
+        steps: prepared.scene.settings.integral_steps,
+        stages,
+        total,
+        rays: stats.map_or(0, |s| s.rays),
+    })
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// Milliseconds with three significant digits or so.
+fn ms(seconds: f64) -> String {
+    let ms = seconds * 1e3;
+    if ms >= 100.0 {
+        format!("{ms:.0}")
+    } else if ms >= 10.0 {
+        format!("{ms:.1}")
+    } else {
+        format!("{ms:.2}")
+    }
+}
+
+fn bench_command(args: BenchArgs) -> Result<()> {
+    if args.repeat == 0 {
+        bail!("--repeat must be at least 1");
+    }
+    if args.size == 0 || args.size > 10_000 {
+        bail!("--size must be between 1 and 10000");
+    }
+    if args.supersample == 0 || args.supersample > 16 {
+        bail!("--supersample must be between 1 and 16");
+    }
+    if let Some(&a) = args.max_area.iter().find(|a| !(**a > 0.0 && a.is_finite())) {
+        bail!("--max-area must be a positive number, got {a}");
+    }
+    let name = args
+        .scene
+        .as_deref()
+        .and_then(Path::file_name)
+        .map_or("cornell (built in)".to_string(), |s| {
+            s.to_string_lossy().into_owned()
+        });
+    let areas: Vec<Option<f64>> = if args.max_area.is_empty() {
+        vec![None]
+    } else {
+        args.max_area.iter().copied().map(Some).collect()
+    };
+    let solver_name = match args.solver {
+        SolverArg::Lu => "LU",
+        SolverArg::GaussSeidel => "Gauss-Seidel",
+    };
+    eprintln!(
+        "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
+        args.repeat, args.size, args.supersample
+    );
+    println!(
+        "| scene | max area | elements | k | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for max_area in areas {
+        let runs = (0..args.repeat)
+            .map(|_| bench_run(&args, max_area))
+            .collect::<Result<Vec<_>>>()?;
+        let first = &runs[0];
+        if runs.iter().any(|r| r.rays != first.rays) {
+            eprintln!("note: the ray count differed between runs");
+        }
+        let stage = |k: usize| median(runs.iter().map(|r| r.stages[k]).collect());
+        let total = median(runs.iter().map(|r| r.total).collect());
+        let other = median(
+            runs.iter()
+                .map(|r| r.total - r.stages.iter().sum::<f64>())
+                .collect(),
+        );
+        let no_render = median(
+            runs.iter()
+                .map(|r| r.total - r.stages[BENCH_STAGES.len() - 1])
+                .collect(),
+        );
+        let ff = stage(3);
+        let area = max_area.map_or("scene's".to_string(), |a| a.to_string());
+        let stages: Vec<String> = (0..BENCH_STAGES.len()).map(|k| ms(stage(k))).collect();
+        println!(
+            "| {name} | {area} | {} | {} | {} | {} | {} | {} | {} | {:.2} M |",
+            first.elements,
+            first.steps,
+            stages.join(" | "),
+            ms(other),
+            ms(total),
+            ms(no_render),
+            first.rays,
+            first.rays as f64 / ff.max(1e-9) / 1e6,
+        );
     }
     Ok(())
 }

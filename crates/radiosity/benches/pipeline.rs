@@ -1,1 +1,96 @@
-fn main() {}
+//! Criterion benchmarks of the pipeline's costly stages on the built-in Cornell box:
+//! form factors at about 500 elements, the LU and Gauss-Seidel solves of the same matrix
+//! (one group, so the two are compared as a ratio measured in one run), and rendering a
+//! 256 x 256 image. Sample counts are small so that `cargo bench` ends in a few minutes on
+//! two cores. Figures: BENCHMARKS.md.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
+use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::progress::NoProgress;
+use radiosity::render::{self, Camera, RenderSettings, Renderer};
+use radiosity::scene::cornell_box;
+use radiosity::shade::{self, Exposure};
+use radiosity::solve::{self, Solver};
+
+/// MAX_PATCH_AREA (mm^2) that cuts the Cornell box into 518 elements.
+const MAX_AREA: f64 = 4000.0;
+
+fn prepared() -> Prepared {
+    let overrides = Overrides {
+        max_patch_area: Some(MAX_AREA),
+        integral_steps: Some(2),
+    };
+    Prepared::new(cornell_box(), overrides, &NoProgress).expect("the Cornell box meshes")
+}
+
+fn configure<'c>(c: &'c mut Criterion, name: &str) -> BenchmarkGroup<'c, WallTime> {
+    let mut group = c.benchmark_group(name);
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(5));
+    group
+}
+
+fn form_factors(c: &mut Criterion) {
+    let p = prepared();
+    let mut group = configure(c, "form_factors");
+    let id = format!("cornell_{}_elements_k2", p.mesh.len());
+    group.bench_function(id, |b| {
+        b.iter(|| black_box(p.form_factors(&NoProgress).expect("fits in memory")))
+    });
+    group.finish();
+}
+
+fn solvers(c: &mut Criterion) {
+    let p = prepared();
+    let (f, _) = p.form_factors(&NoProgress).expect("fits in memory");
+    let (rho, e) = solve::element_properties(&p.mesh, &p.scene);
+    let mut group = configure(c, "solve");
+    let n = p.mesh.len();
+    let gauss_seidel = Solver::GaussSeidel {
+        tolerance: 1e-9,
+        max_iterations: 10_000,
+    };
+    for (name, solver) in [("lu", Solver::Lu), ("gauss_seidel", gauss_seidel)] {
+        group.bench_function(format!("{name}_{n}_elements"), |b| {
+            b.iter(|| black_box(solve::solve(&f, &rho, &e, solver, &NoProgress).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+fn rendering(c: &mut Criterion) {
+    let p = prepared();
+    let (f, _) = p.form_factors(&NoProgress).expect("fits in memory");
+    let solution = p.solve(&f, Solver::Lu, &NoProgress).unwrap();
+    let element_b = solution.element_rgb();
+    let vertex_b = shade::vertex_radiosity(&p.mesh, &element_b);
+    let settings = RenderSettings {
+        exposure_scale: Exposure::Brightest.scale(&p.scene, &p.mesh, &element_b),
+        ..RenderSettings::default()
+    };
+    let camera = Camera::for_scene(&p.scene, 256, 256);
+    let renderer = Renderer::new(&p.mesh);
+    let mut group = configure(c, "render");
+    group.bench_function("cornell_256x256_smooth", |b| {
+        b.iter(|| {
+            black_box(render::render(
+                &renderer,
+                &camera,
+                &element_b,
+                &vertex_b,
+                &settings,
+                &NoProgress,
+            ))
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, form_factors, solvers, rendering);
+criterion_main!(benches);

@@ -79,7 +79,7 @@ mod tests {
     use crate::geometry;
 
     /// The example scene files at the repository root, by name.
-    const EXAMPLES: [(&str, &str); 4] = [
+    const EXAMPLES: [(&str, &str); 5] = [
         (
             "cornell_box.scene",
             include_str!("../../../../examples/cornell_box.scene"),
@@ -95,6 +95,10 @@ mod tests {
         (
             "triangles.scene",
             include_str!("../../../../examples/triangles.scene"),
+        ),
+        (
+            "paper196.scene",
+            include_str!("../../../../examples/paper196.scene"),
         ),
     ];
 
@@ -194,6 +198,14 @@ mod tests {
             scene.surfaces.len(),
             mesh.len()
         );
+    }
+
+    #[test]
+    fn paper196_example_meshes_to_196_elements() {
+        let scene = parse_scene(EXAMPLES[4].1, "paper196.scene").unwrap();
+        assert_eq!(scene.settings.integral_steps, 2);
+        let mesh = crate::mesh::mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        assert_eq!(mesh.len(), 196);
     }
 
     #[test]
