@@ -133,8 +133,8 @@ struct RenderArgs {
     /// Image height in pixels.
     #[arg(long, default_value_t = 512)]
     height: u32,
-    /// Rays per pixel along each axis (antialiasing).
-    #[arg(long, default_value_t = 2, value_name = "N")]
+    /// Rays per pixel along each axis: 2 or more antialiases edges (N^2 times the rays).
+    #[arg(long, default_value_t = 1, value_name = "N")]
     supersample: u32,
 }
 
@@ -190,7 +190,7 @@ struct BenchArgs {
     #[arg(long, default_value_t = 512, value_name = "PIXELS")]
     size: u32,
     /// Rays per pixel along each axis (as `render --supersample`).
-    #[arg(long, default_value_t = 2, value_name = "N")]
+    #[arg(long, default_value_t = 1, value_name = "N")]
     supersample: u32,
 }
 

@@ -347,20 +347,25 @@ impl<'m> Renderer<'m> {
         match settings.shading {
             Shading::Flat => expose(element_b[e], settings.exposure_scale),
             Shading::Smooth => {
+                // Interpolation weights of the element's corners at x (no allocation: this
+                // runs once per ray).
                 let c = el.corners();
-                let p: Vec<DVec3> = self.mesh.corner_positions(e).collect();
-                let b = |i: usize, w: f64| vertex_b[c[i] as usize].map(|v| v * w);
-                let weights: Vec<f64> = if el.is_quad() {
+                let mut p = [DVec3::ZERO; 4];
+                for (slot, v) in p.iter_mut().zip(self.mesh.corner_positions(e)) {
+                    *slot = v;
+                }
+                let weights: [f64; 4] = if el.is_quad() {
                     let (u, v) = inverse_bilinear(&p, x);
-                    vec![(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v]
+                    [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v]
                 } else {
-                    barycentric(&p, x).to_vec()
+                    let w = barycentric(&p[..3], x);
+                    [w[0], w[1], w[2], 0.0]
                 };
                 let mut sum = [0.0; 3];
-                for (i, &w) in weights.iter().enumerate() {
-                    let bi = b(i, w);
+                for (i, &w) in weights.iter().enumerate().take(c.len()) {
+                    let b = vertex_b[c[i] as usize];
                     for k in 0..3 {
-                        sum[k] += bi[k];
+                        sum[k] += w * b[k];
                     }
                 }
                 expose(sum, settings.exposure_scale)

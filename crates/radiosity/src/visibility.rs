@@ -53,6 +53,10 @@ pub struct PolygonBvh {
     /// Polygons in BVH primitive order, so a leaf's primitive index is a direct lookup.
     polygons: Vec<Polygon>,
     corners: Vec<DVec3>,
+    /// Per corner of each polygon, the inward unit normal m of the edge that starts there
+    /// (in the polygon's plane) and m . (edge start): x is inside when m . x >= offset for
+    /// every edge. Precomputed so the inside test is one dot product per edge.
+    edge_planes: Vec<(DVec3, f64)>,
     /// Length of the bounding-box diagonal of all polygons, for relative tolerances.
     scale: f64,
 }
@@ -99,6 +103,7 @@ impl PolygonBvh {
             })
             .collect();
         let mut corners = Vec::new();
+        let mut edge_planes = Vec::new();
         let mut records = Vec::with_capacity(polygons.len());
         for (p, &id) in polygons.iter().zip(ids) {
             let v = p.as_ref();
@@ -118,12 +123,18 @@ impl PolygonBvh {
                 hi,
             });
             corners.extend_from_slice(v);
+            // The corners run counter-clockwise about the normal, so n x edge points inward.
+            for (i, &a) in v.iter().enumerate() {
+                let m = normal.cross(v[(i + 1) % v.len()] - a).normalize_or_zero();
+                edge_planes.push((m, m.dot(a)));
+            }
         }
         if bounds.is_empty() {
             return PolygonBvh {
                 bvh: CwBvh::default(),
                 polygons: records,
                 corners,
+                edge_planes,
                 scale,
             };
         }
@@ -141,6 +152,7 @@ impl PolygonBvh {
             bvh,
             polygons,
             corners,
+            edge_planes,
             scale,
         }
     }
@@ -180,19 +192,15 @@ impl PolygonBvh {
             return None;
         }
         let x = origin + t * dir;
-        let c = &self.corners[poly.first as usize..(poly.first + poly.count) as usize];
         // Inside (edges included, to 1e-9 of the scene size) when on the inner side of
-        // every edge; the corners run counter-clockwise about the normal.
+        // every edge.
         let tol = 1e-9 * self.scale;
-        let mut a = c[c.len() - 1];
-        for &b in c {
-            let edge = b - a;
-            if edge.cross(x - a).dot(poly.normal) < -tol * edge.length() {
-                return None;
-            }
-            a = b;
+        let planes = &self.edge_planes[poly.first as usize..(poly.first + poly.count) as usize];
+        if planes.iter().all(|&(m, offset)| m.dot(x) >= offset - tol) {
+            Some(t)
+        } else {
+            None
         }
-        Some(t)
     }
 
     /// Appends to `out` every polygon (as an index for [`PolygonBvh::segment_blocked_by`])
