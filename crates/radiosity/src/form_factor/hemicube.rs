@@ -264,13 +264,14 @@ mod tests {
     use super::*;
 
     // The analytic total of the delta form factors is 1; the midpoint sums converge to it
-    // as O(1/res^2) (the integrands are smooth on each face).
+    // as O(1/res^2) (the integrands are smooth on each face). The constant is 0.55
+    // (raw sum 1.0086 at res 8), so the bound 1/res^2 leaves 80 % headroom.
     #[test]
     fn delta_form_factors_sum_to_one() {
         for res in [8u32, 32, 128, 512] {
             let (_, top, side) = raw_deltas(res);
             let raw = top.iter().sum::<f64>() + 4.0 * side.iter().sum::<f64>();
-            let bound = 0.5 / (res as f64).powi(2);
+            let bound = 1.0 / (res as f64).powi(2);
             assert!(
                 (raw - 1.0).abs() < bound,
                 "res {res}: raw sum {raw}, |error| above {bound}"
