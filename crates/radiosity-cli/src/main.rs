@@ -10,7 +10,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 use image::RgbImage;
-use radiosity::form_factor::FormFactorMatrix;
+use radiosity::form_factor::{FormFactorMatrix, FormFactorMethod};
 use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
@@ -55,12 +55,32 @@ struct SceneArgs {
     /// Override the scene's MAX_PATCH_AREA (scene units squared).
     #[arg(long, value_name = "AREA")]
     max_area: Option<f64>,
-    /// Override the scene's INTEGRAL_STEPS (points along each axis of each element).
+    /// Override the scene's INTEGRAL_STEPS (points along each axis of each element, for
+    /// the area method).
     #[arg(long, value_name = "K")]
     steps: Option<u32>,
+    #[command(flatten)]
+    method: MethodArgs,
     /// No progress bars, timings or notes (errors are still printed).
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// How form factors are computed.
+#[derive(Args, Clone)]
+struct MethodArgs {
+    /// Form-factor method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Area)]
+    method: MethodArg,
+    /// Hemicube resolution: cells across the top face.
+    #[arg(long, default_value_t = 128, value_name = "CELLS")]
+    resolution: u32,
+    /// Monte Carlo rays per element.
+    #[arg(long, default_value_t = 1024, value_name = "N")]
+    samples: u32,
+    /// Monte Carlo generator seed (the same seed gives the same numbers).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
 }
 
 /// Options of commands that solve.
@@ -76,6 +96,19 @@ struct SolveOptions {
     /// computing them; refused if it was made for another mesh or method.
     #[arg(long, value_name = "FILE")]
     form_factors: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MethodArg {
+    /// The paper's double area integral, INTEGRAL_STEPS^2 points per element, a ray per
+    /// point pair for occlusion.
+    Area,
+    /// Hemicube (Cohen and Greenberg 1985) rasterised on the CPU, --resolution; occlusion
+    /// by depth buffer.
+    Hemicube,
+    /// Stratified Monte Carlo ray casting, --samples rays per element, --seed; occlusion by
+    /// each ray's first hit.
+    Montecarlo,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -170,6 +203,8 @@ struct CheckArgs {
 struct BenchArgs {
     /// Scene file (Appendix A format); the built-in Cornell box when omitted.
     scene: Option<PathBuf>,
+    #[command(flatten)]
+    method: MethodArgs,
     /// MAX_PATCH_AREA values to time, one table row each (repeat the option or give several
     /// values); the scene's own when omitted.
     #[arg(long, value_name = "AREA", num_args = 1..)]
@@ -227,7 +262,31 @@ fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> 
             bail!("--steps must be at least 1");
         }
     }
-    let prepared = Prepared::new(scene, overrides, reporter)?;
+    let mut prepared = Prepared::new(scene, overrides, reporter)?;
+    let m = &args.method;
+    prepared.method = match m.method {
+        MethodArg::Area => prepared.method,
+        MethodArg::Hemicube => {
+            if m.resolution < 2 || m.resolution > 16_384 {
+                bail!(
+                    "--resolution must be between 2 and 16384, got {}",
+                    m.resolution
+                );
+            }
+            FormFactorMethod::Hemicube {
+                resolution: m.resolution,
+            }
+        }
+        MethodArg::Montecarlo => {
+            if m.samples == 0 {
+                bail!("--samples must be at least 1");
+            }
+            FormFactorMethod::MonteCarlo {
+                samples: m.samples,
+                seed: m.seed,
+            }
+        }
+    };
     reporter.note(&format!(
         "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
         stem,
@@ -270,7 +329,7 @@ fn form_factors(
     let (f, stats) = prepared.form_factors(reporter)?;
     reporter.note(&format!(
         "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
-         largest reciprocity error {:.1e}",
+         reciprocity error {:.1e} largest, {:.1e} of exchanged power",
         prepared.method(),
         stats.rays,
         stats.seconds,
@@ -278,7 +337,8 @@ fn form_factors(
         stats.row_sums.min,
         stats.row_sums.mean,
         stats.row_sums.max,
-        stats.reciprocity_error
+        stats.reciprocity.max_relative,
+        stats.reciprocity.total_relative
     ));
     Ok((f, Some(stats)))
 }
@@ -488,7 +548,7 @@ fn check_command(args: CheckArgs) -> Result<()> {
                 rays: 0,
                 seconds: 0.0,
                 row_sums: f.row_sums(),
-                reciprocity_error: f.max_reciprocity_error(&prepared.areas()),
+                reciprocity: f.reciprocity(&prepared.areas()),
             };
             (f, stats)
         }
@@ -508,8 +568,8 @@ fn check_command(args: CheckArgs) -> Result<()> {
         stats.row_sums.min, stats.row_sums.mean, stats.row_sums.max
     );
     println!(
-        "reciprocity error {:.3e} (largest |A_i F_ij - A_j F_ji| / max)",
-        stats.reciprocity_error
+        "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max; {:.3e} of all exchanged power",
+        stats.reciprocity.max_relative, stats.reciprocity.total_relative
     );
     if stats.rays > 0 {
         println!(
@@ -565,6 +625,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         scene: args.scene.clone(),
         max_area,
         steps: args.steps,
+        method: args.method.clone(),
         quiet: true,
     };
     let options = SolveOptions {

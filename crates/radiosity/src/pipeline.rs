@@ -9,7 +9,8 @@ use std::time::Instant;
 
 use crate::form_factor::{
     self, mesh_fingerprint, read_form_factors, write_form_factors, FormFactorContext,
-    FormFactorFileError, FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter, RowSums,
+    FormFactorFileError, FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter, Reciprocity,
+    RowSums,
 };
 use crate::mesh::{mesh_scene, Mesh, MeshError};
 use crate::progress::{run_stage, Progress, Stage};
@@ -61,6 +62,9 @@ pub struct Prepared {
     pub mesh: Mesh,
     /// The input surfaces in a BVH, for occlusion.
     pub occluders: PolygonBvh,
+    /// How form factors are computed (by default the area integral with the scene's
+    /// `INTEGRAL_STEPS`).
+    pub method: FormFactorMethod,
 }
 
 /// What computing form factors found, besides the matrix.
@@ -72,8 +76,8 @@ pub struct FormFactorStats {
     pub seconds: f64,
     /// Row sums.
     pub row_sums: RowSums,
-    /// Largest relative reciprocity error (see `FormFactorMatrix::max_reciprocity_error`).
-    pub reciprocity_error: f64,
+    /// Reciprocity errors (see `FormFactorMatrix::reciprocity`).
+    pub reciprocity: Reciprocity,
 }
 
 /// A solved scene.
@@ -105,18 +109,20 @@ impl Prepared {
         let occluders = run_stage(progress, Stage::Bvh, 0, || {
             form_factor::occluder_bvh(&scene)
         });
+        let method = FormFactorMethod::AreaIntegral {
+            steps: scene.settings.integral_steps,
+        };
         Ok(Prepared {
             scene,
             mesh,
             occluders,
+            method,
         })
     }
 
-    /// The paper's method with the scene's `INTEGRAL_STEPS`.
+    /// How form factors are computed.
     pub fn method(&self) -> FormFactorMethod {
-        FormFactorMethod::AreaIntegral {
-            steps: self.scene.settings.integral_steps,
-        }
+        self.method
     }
 
     /// The fingerprint of the meshed geometry, as stored in form-factor files.
@@ -146,7 +152,7 @@ impl Prepared {
             rays: rays.get(),
             seconds,
             row_sums: matrix.row_sums(),
-            reciprocity_error: matrix.max_reciprocity_error(&self.areas()),
+            reciprocity: matrix.reciprocity(&self.areas()),
         };
         Ok((matrix, stats))
     }
