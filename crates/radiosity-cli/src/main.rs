@@ -87,7 +87,7 @@ struct MethodArgs {
 #[derive(Args)]
 struct SolveOptions {
     /// Linear solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg::Lu)]
+    #[arg(long, value_enum, default_value_t = SolverArg::GaussSeidel)]
     solver: SolverArg,
     /// Relative residual at which Gauss-Seidel stops.
     #[arg(long, default_value_t = 1e-9, value_name = "TOL")]
@@ -216,7 +216,7 @@ struct BenchArgs {
     #[arg(long, default_value_t = 5, value_name = "N")]
     repeat: usize,
     /// Linear solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg::Lu)]
+    #[arg(long, value_enum, default_value_t = SolverArg::GaussSeidel)]
     solver: SolverArg,
     /// Relative residual at which Gauss-Seidel stops.
     #[arg(long, default_value_t = 1e-9, value_name = "TOL")]
