@@ -32,7 +32,7 @@ use rayon::prelude::*;
 use crate::mesh::Mesh;
 use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::{CameraHint, Scene};
-use crate::shade::{encode, expose};
+use crate::shade::{expose, GammaEncoder};
 use crate::visibility::PolygonBvh;
 
 /// A pinhole camera (right-handed): `forward = normalize(look_at - eye)`,
@@ -526,6 +526,7 @@ pub fn render(
     let footprint = camera.pixel_angle();
     let n = settings.supersample.max(1);
     let mut buf = vec![0u8; w * h * 3];
+    let encoder = GammaEncoder::new(settings.gamma);
     run_stage(progress, Stage::Render, h as u64, || {
         buf.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
             for x in 0..w {
@@ -543,7 +544,7 @@ pub fn render(
                     }
                 }
                 let samples = (n * n) as f64;
-                let rgb = encode(sum.map(|s| s / samples), settings.gamma);
+                let rgb = encoder.encode(sum.map(|s| s / samples));
                 row[3 * x..3 * x + 3].copy_from_slice(&rgb);
             }
             progress.advance(1);
