@@ -925,6 +925,49 @@ mod tests {
         assert!(rel_err(polygon_to_polygon(&upper, &wide), want) < EXACT);
     }
 
+    // Nearly touching: the wall lifted by a small gap, or moved off the floor's edge, and
+    // a tilted triangle whose corner touches the floor's edge mid-way (a T contact,
+    // checked against Lambert's formula integrated over the floor as above). These
+    // put near-singularities inside the outer intervals. F must approach the touching
+    // value continuously (the gap changes it by O(gap ln gap)) and stay reciprocal.
+    #[test]
+    fn exact_nearly_touching() {
+        let want = reference::perpendicular_rectangles(1.0, 1.0, 1.0);
+        for gap in [1e-3, 1e-6, 1e-9] {
+            for offset in [v(0., 0., gap), v(-gap, 0., 0.), v(-gap, 0.3, gap)] {
+                let w: Vec<DVec3> = wall(0.0, 1.0, 1.0).iter().map(|&p| p + offset).collect();
+                let f = polygon_to_polygon(&floor(), &w);
+                let back = polygon_to_polygon(&w, &floor());
+                assert!((f - back).abs() < 1e-13 * f, "{gap} {offset}: {f} {back}");
+                let bound = if offset.y == 0.0 {
+                    20.0 * gap * (1.0 - gap.ln())
+                } else {
+                    0.1
+                };
+                assert!(f < want && want - f < bound, "{gap} {offset}: {f}");
+            }
+        }
+        // In the plane 0.8 y + 0.5 z = 0, which holds the floor's edge y = 0: the whole floor
+        // is in front of it and it is above the floor.
+        let tri = vec![v(0.5, 0., 0.), v(0.1, -0.5, 0.8), v(0.9, -0.5, 0.8)];
+        let n = polygon_normal(&tri).unwrap();
+        assert!((n - v(0., 0.8, 0.5).normalize()).length() < 1e-15);
+        let (a_tri, a_floor) = (area_vector(&tri).length(), 1.0);
+        let f = polygon_to_polygon(&floor(), &tri);
+        let back = polygon_to_polygon(&tri, &floor());
+        assert!(
+            f > 0.0 && (a_floor * f - a_tri * back).abs() < 1e-13 * f,
+            "{f} {back}"
+        );
+        let lambert = |p: DVec3| point_to_polygon(p, DVec3::Z, &tri);
+        // Graded towards the contact at (0.5, 0): two halves of the floor, each graded
+        // towards its corner there.
+        let right = graded_corner_integral(0.5, 1.0, 24, &|p| lambert(v(0.5 + p.x, p.y, 0.)));
+        let left = graded_corner_integral(0.5, 1.0, 24, &|p| lambert(v(0.5 - p.x, p.y, 0.)));
+        eprintln!("T contact {f:.16} Lambert {:.16}", left + right);
+        assert!(rel_err(f, left + right) < EXACT);
+    }
+
     #[test]
     fn exact_coplanar_is_zero() {
         let beside: Vec<DVec3> = floor().into_iter().map(|p| p + v(1., 0., 0.)).collect();
