@@ -5,6 +5,7 @@
 //! sums to at most 1 (to 1 in a closed scene); reciprocity A_i F_ij = A_j F_ji.
 
 mod area;
+pub mod exact;
 mod file;
 mod hemicube;
 mod montecarlo;
