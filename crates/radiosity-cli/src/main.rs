@@ -103,6 +103,12 @@ enum MethodArg {
     /// The paper's double area integral, INTEGRAL_STEPS^2 points per element, a ray per
     /// point pair for occlusion.
     Area,
+    /// Exact element-to-element form factors (the double contour integral); pairs that an
+    /// occluder may block are scaled by the visible fraction of INTEGRAL_STEPS^2 point pairs.
+    Contour,
+    /// Lambert's exact point-to-polygon form factor at INTEGRAL_STEPS^2 receiver points,
+    /// with rays to the source's points for occlusion.
+    Analytic,
     /// Hemicube (Cohen and Greenberg 1985) rasterised on the CPU, --resolution; occlusion
     /// by depth buffer.
     Hemicube,
@@ -264,8 +270,11 @@ fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> 
     }
     let mut prepared = Prepared::new(scene, overrides, reporter)?;
     let m = &args.method;
+    let steps = prepared.scene.settings.integral_steps;
     prepared.method = match m.method {
-        MethodArg::Area => prepared.method,
+        MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
+        MethodArg::Contour => FormFactorMethod::Contour { steps },
+        MethodArg::Analytic => FormFactorMethod::Analytic { steps },
         MethodArg::Hemicube => {
             if m.resolution < 2 || m.resolution > 16_384 {
                 bail!(

@@ -384,13 +384,13 @@ fn montecarlo_is_deterministic_and_converges() {
 
 // Methods agree on an occluded scene: opposed unit squares with a 0.5 x 0.5 blocker halfway.
 // No closed form is at hand, and visibility is discontinuous at the shadow edges, where
-// every method converges only as O(h). Their errors have independent sources: the area
-// integral samples visibility at k x k points (biased low: refining 4x -> 8x -> 16x
-// elements at k = 16 gave 0.09708, 0.09830, 0.09890, halving each time towards ~0.0995);
-// the hemicube sees from element centres through finite cells; Monte Carlo is noisy. As
-// run here they gave 0.0971 (area, 2.4 % low: its shadow-edge bias at 8 x 8 elements),
-// 0.0998 and 0.0992 against the ~0.0995 limit. Any two must agree within 4 %: the area
-// integral's bias plus 1.5 % for the other two's errors.
+// every method converges only as O(h). Their errors have independent sources: the area,
+// contour and analytic methods sample visibility at k x k point pairs (biased low: refining
+// 4x -> 8x -> 16x elements for the area integral at k = 16 gave 0.09708, 0.09830, 0.09890,
+// halving each time towards ~0.0995); the hemicube sees from element centres through
+// finite cells; Monte Carlo is noisy. As run here they gave 0.0971 (area, contour and
+// analytic alike, 2.4 % low), 0.0998 (hemicube) and 0.0992 (Monte Carlo). Any two must
+// agree within 4 %: the point-pair visibility bias plus 1.5 % for the others' errors.
 #[test]
 fn methods_agree_on_an_occluded_scene() {
     let blocker = surface(
@@ -418,6 +418,8 @@ fn methods_agree_on_an_occluded_scene() {
                 seed: 3,
             },
         ),
+        (1.0 / 64.0, FormFactorMethod::Contour { steps: 8 }),
+        (1.0 / 64.0, FormFactorMethod::Analytic { steps: 8 }),
     ]
     .into_iter()
     .map(|(max_area, method)| {
@@ -436,5 +438,91 @@ fn methods_agree_on_an_occluded_scene() {
                 "{m} gives {f}, {m2} gives {f2}"
             );
         }
+    }
+}
+
+fn perpendicular_squares_scene(max_area: f64) -> Scene {
+    Scene {
+        settings: MeshSettings {
+            max_patch_area: max_area,
+            integral_steps: 2,
+        },
+        surfaces: vec![
+            surface("a", unit_square_z0()),
+            surface("b", perpendicular_square()),
+        ],
+        camera: None,
+    }
+}
+
+// The contour method is exact for unoccluded pairs: one element per square reproduces the
+// closed forms to the f32 rounding of the stored matrix (6e-8 relative), here bounded by
+// 2e-7; so does any subdivision, summed (f32 rounding of each entry, 64 entries).
+#[test]
+fn contour_reproduces_closed_forms() {
+    for (scene, exact) in [
+        (
+            opposed_squares_scene(1.0),
+            reference::parallel_rectangles(1.0, 1.0, 1.0),
+        ),
+        (
+            perpendicular_squares_scene(1.0),
+            reference::perpendicular_rectangles(1.0, 1.0, 1.0),
+        ),
+        (
+            perpendicular_squares_scene(1.0 / 16.0),
+            reference::perpendicular_rectangles(1.0, 1.0, 1.0),
+        ),
+    ] {
+        let (f, mesh) = matrix_for(&scene, FormFactorMethod::Contour { steps: 2 });
+        let est = surface_to_surface(&f, &mesh, 0, 1);
+        assert!(
+            (est - exact).abs() < 2e-7 * exact,
+            "{} elements: F = {est}, exact {exact}",
+            mesh.len()
+        );
+    }
+    // A closed cube: exact form factors of a closed convex enclosure sum to 1 in every
+    // row; f32 storage of 54 entries bounds the error by ~54 x 6e-8.
+    let (f, _) = matrix_for(&unit_cube(), FormFactorMethod::Contour { steps: 2 });
+    for i in 0..f.n() {
+        assert!(
+            (f.row_sum(i) - 1.0).abs() < 4e-6,
+            "row {i} sums to {}",
+            f.row_sum(i)
+        );
+    }
+}
+
+// The analytic method integrates Lambert's exact point-to-polygon form factor over the
+// receiver by the midpoint rule, so only the receiver is discretised and F(dA_p -> A_j)
+// stays finite up to the shared edge: the error is second order even for perpendicular
+// squares sharing an edge, where the area integral is only first order (0.046/k). Measured
+// (one element per square): perpendicular 2.0e-3 at k = 2 down to 7.4e-6 at k = 32, i.e.
+// 0.0080/k^2 to 0.0075/k^2; opposed 8.0e-3 down to 2.9e-5, 0.032/k^2 to 0.030/k^2. The
+// bounds 0.009/k^2 and 0.035/k^2 have about 10 % headroom.
+#[test]
+fn analytic_converges_as_k_squared_even_at_shared_edges() {
+    let perpendicular = reference::perpendicular_rectangles(1.0, 1.0, 1.0);
+    let opposed = reference::parallel_rectangles(1.0, 1.0, 1.0);
+    for k in [2u32, 4, 8, 16, 32] {
+        let (f, mesh) = matrix_for(
+            &perpendicular_squares_scene(1.0),
+            FormFactorMethod::Analytic { steps: k },
+        );
+        let err = (surface_to_surface(&f, &mesh, 0, 1) - perpendicular).abs();
+        assert!(
+            err < 0.009 / (k * k) as f64,
+            "perpendicular, k = {k}: error {err}"
+        );
+        let (f, mesh) = matrix_for(
+            &opposed_squares_scene(1.0),
+            FormFactorMethod::Analytic { steps: k },
+        );
+        let err = (surface_to_surface(&f, &mesh, 0, 1) - opposed).abs();
+        assert!(
+            err < 0.035 / (k * k) as f64,
+            "opposed, k = {k}: error {err}"
+        );
     }
 }

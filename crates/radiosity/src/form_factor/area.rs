@@ -22,12 +22,29 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::{FormFactorContext, RayCounter};
+use super::{exact, FormFactorContext, RayCounter};
+
+/// What an element pair's coupling is computed from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PairKernel {
+    /// The double area integral (this module's kernel) with a ray per point pair.
+    Area,
+    /// The exact polygon-to-polygon form factor (`exact::polygon_to_polygon`, the
+    /// double contour integral), times the kernel-weighted visible fraction of the point
+    /// pairs when occluders may intervene.
+    Contour,
+    /// Lambert's exact point-to-polygon form factor (`exact::point_to_polygon`) at each
+    /// sample point of the receiver i, times the kernel-weighted visible fraction of the
+    /// source's sample points seen from it (Wallace, Elmquist and Haines 1989). Not
+    /// symmetric in i and j.
+    Analytic,
+}
 
 /// Everything the area integral precomputes once per matrix: integration points and
 /// bounding boxes of the elements, bounding boxes of the surfaces.
 pub(super) struct AreaIntegrator<'a> {
     ctx: &'a FormFactorContext<'a>,
+    kernel: PairKernel,
     /// k^2 points per element with their area weights.
     per_element: usize,
     points: Vec<(DVec3, f64)>,
@@ -58,7 +75,7 @@ fn boxes_overlap(a: (DVec3, DVec3), b: (DVec3, DVec3), pad: f64) -> bool {
 }
 
 impl<'a> AreaIntegrator<'a> {
-    pub fn new(ctx: &'a FormFactorContext<'a>, k: u32) -> AreaIntegrator<'a> {
+    pub fn new(ctx: &'a FormFactorContext<'a>, k: u32, kernel: PairKernel) -> AreaIntegrator<'a> {
         let mesh = ctx.mesh;
         let mut points = Vec::with_capacity(mesh.len() * (k * k) as usize);
         for e in 0..mesh.len() {
@@ -80,6 +97,7 @@ impl<'a> AreaIntegrator<'a> {
             .collect();
         AreaIntegrator {
             ctx,
+            kernel,
             per_element: (k * k) as usize,
             points,
             element_box,
@@ -180,30 +198,97 @@ impl<'a> AreaIntegrator<'a> {
         }
         let candidates = &scratch.pair_candidates;
 
-        let mut sum = 0.0;
         let mut cast = 0;
-        for &(p, wp) in self.samples(i) {
-            for &(q, wq) in self.samples(j) {
-                let d = q - p;
-                let r2 = d.length_squared();
-                let cos_p = ni.dot(d);
-                let cos_q = -nj.dot(d);
-                if cos_p <= 0.0 || cos_q <= 0.0 || r2 == 0.0 {
-                    continue;
-                }
-                if !candidates.is_empty() {
-                    cast += 1;
-                    if occ.segment_blocked_by(candidates, p, q) {
-                        continue;
+        let g = match self.kernel {
+            PairKernel::Area => self
+                .samples(i)
+                .iter()
+                .map(|&(p, wp)| self.kernel_from(p, wp, ni, j, candidates, &mut cast).0)
+                .sum(),
+            PairKernel::Contour => {
+                let exact = ei.area * exact::polygon_to_polygon(&self.corners(i), &self.corners(j));
+                if exact <= 0.0 || candidates.is_empty() {
+                    exact
+                } else {
+                    // Exact geometry times the kernel-weighted fraction of point pairs that
+                    // see each other.
+                    let (visible, total) =
+                        self.samples(i).iter().fold((0.0, 0.0), |acc, &(p, wp)| {
+                            let (v, t) = self.kernel_from(p, wp, ni, j, candidates, &mut cast);
+                            (acc.0 + v, acc.1 + t)
+                        });
+                    if total > 0.0 {
+                        exact * visible / total
+                    } else {
+                        exact
                     }
                 }
-                // cos_p and cos_q carry a factor |d| each, so this is
-                // cos cos w_p w_q / (pi r^2 + w) with unit cosines (see the module doc).
-                sum += cos_p * cos_q / (r2 * (PI * r2 + wp.max(wq))) * wp * wq;
             }
-        }
+            PairKernel::Analytic => {
+                let cj = self.corners(j);
+                self.samples(i)
+                    .iter()
+                    .map(|&(p, wp)| {
+                        let f = exact::point_to_polygon(p, ni, &cj);
+                        if f <= 0.0 || candidates.is_empty() {
+                            return wp * f;
+                        }
+                        let (v, t) = self.kernel_from(p, wp, ni, j, candidates, &mut cast);
+                        if t > 0.0 {
+                            wp * f * v / t
+                        } else {
+                            wp * f
+                        }
+                    })
+                    .sum()
+            }
+        };
         rays.add(cast);
-        sum
+        g
+    }
+
+    /// The corners of element e.
+    fn corners(&self, e: usize) -> Vec<DVec3> {
+        self.ctx.mesh.corner_positions(e).collect()
+    }
+
+    /// The area kernel from point p (weight `wp`, on an element with normal `np`) to the
+    /// samples of element j: (sum over visible samples, sum over all samples) of
+    /// cos cos w_p w_q / (r^2 (pi r^2 + w)) with unit cosines (see the module doc).
+    /// Visibility is tested against `candidates`, counting the rays cast in `cast`.
+    #[inline]
+    fn kernel_from(
+        &self,
+        p: DVec3,
+        wp: f64,
+        np: DVec3,
+        j: usize,
+        candidates: &[u32],
+        cast: &mut u64,
+    ) -> (f64, f64) {
+        let nj = self.ctx.mesh.elements[j].normal;
+        let occ = self.ctx.occluders;
+        let (mut visible, mut total) = (0.0, 0.0);
+        for &(q, wq) in self.samples(j) {
+            let d = q - p;
+            let r2 = d.length_squared();
+            let cos_p = np.dot(d);
+            let cos_q = -nj.dot(d);
+            if cos_p <= 0.0 || cos_q <= 0.0 || r2 == 0.0 {
+                continue;
+            }
+            // cos_p and cos_q carry a factor |d| each, hence r^2 twice.
+            let k = cos_p * cos_q / (r2 * (PI * r2 + wp.max(wq))) * wp * wq;
+            total += k;
+            if !candidates.is_empty() {
+                *cast += 1;
+                if occ.segment_blocked_by(candidates, p, q) {
+                    continue;
+                }
+            }
+            visible += k;
+        }
+        (visible, total)
     }
 }
 
@@ -233,7 +318,7 @@ pub fn area_integral_pair(poly1: &[DVec3], poly2: &[DVec3], k: u32) -> f64 {
         mesh: &mesh,
         occluders: &empty,
     };
-    let integrator = AreaIntegrator::new(&ctx, k);
+    let integrator = AreaIntegrator::new(&ctx, k, PairKernel::Area);
     integrator.couplings(0, 1..2, &RayCounter::default(), &mut Scratch::default())[0]
         / mesh.elements[0].area
 }

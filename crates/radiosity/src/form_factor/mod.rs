@@ -38,6 +38,22 @@ pub enum FormFactorMethod {
         /// k, points along each axis of each element (`INTEGRAL_STEPS`).
         steps: u32,
     },
+    /// The exact form factor between the two elements (the paper's double contour integral,
+    /// figure 5, with the shared-edge and shared-vertex cases in closed form; see
+    /// `exact.rs`). Exact for unoccluded pairs; where an occluder may intervene it is
+    /// multiplied by the visible fraction of `steps` x `steps` by `steps` x `steps` point
+    /// pairs, weighted by the area kernel.
+    Contour {
+        /// Points along each axis of each element for the visibility estimate.
+        steps: u32,
+    },
+    /// Lambert's exact point-to-polygon form factor at `steps` x `steps` points on the
+    /// receiving element, each times the visible fraction of `steps` x `steps` points on
+    /// the source (Wallace, Elmquist and Haines 1989). Accurate at shared edges.
+    Analytic {
+        /// Points along each axis of each element.
+        steps: u32,
+    },
     /// The hemicube (Cohen and Greenberg 1985): each element's view rasterised on the CPU
     /// onto a half cube of `resolution` x `resolution` cells on top.
     Hemicube {
@@ -58,13 +74,20 @@ impl FormFactorMethod {
     /// True when the method's estimate is symmetric (A_i F_ij = A_j F_ji exactly), so only
     /// the upper triangle need be computed.
     pub fn is_reciprocal(&self) -> bool {
-        matches!(self, FormFactorMethod::AreaIntegral { .. })
+        matches!(
+            self,
+            FormFactorMethod::AreaIntegral { .. } | FormFactorMethod::Contour { .. }
+        )
     }
 
     /// How the method handles occlusion, for the command line's help and notes.
     pub fn occlusion(&self) -> &'static str {
         match self {
             FormFactorMethod::AreaIntegral { .. } => "ray cast per point pair",
+            FormFactorMethod::Contour { .. } => {
+                "exact when unoccluded; pairs with a possible occluder are scaled by the visible fraction of their point pairs"
+            }
+            FormFactorMethod::Analytic { .. } => "rays from each receiver point to the source's points",
             FormFactorMethod::Hemicube { .. } => "depth buffer",
             FormFactorMethod::MonteCarlo { .. } => "closest hit of each ray",
         }
@@ -75,6 +98,8 @@ impl std::fmt::Display for FormFactorMethod {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             FormFactorMethod::AreaIntegral { steps } => write!(f, "area k={steps}"),
+            FormFactorMethod::Contour { steps } => write!(f, "contour k={steps}"),
+            FormFactorMethod::Analytic { steps } => write!(f, "analytic k={steps}"),
             FormFactorMethod::Hemicube { resolution } => {
                 write!(f, "hemicube resolution={resolution}")
             }
@@ -343,9 +368,21 @@ struct Scratch {
 impl<'a> Engine<'a> {
     fn new(ctx: &'a FormFactorContext<'a>, method: FormFactorMethod) -> Engine<'a> {
         match method {
-            FormFactorMethod::AreaIntegral { steps } => {
-                Engine::Pairs(area::AreaIntegrator::new(ctx, steps))
-            }
+            FormFactorMethod::AreaIntegral { steps } => Engine::Pairs(area::AreaIntegrator::new(
+                ctx,
+                steps,
+                area::PairKernel::Area,
+            )),
+            FormFactorMethod::Contour { steps } => Engine::Pairs(area::AreaIntegrator::new(
+                ctx,
+                steps,
+                area::PairKernel::Contour,
+            )),
+            FormFactorMethod::Analytic { steps } => Engine::Pairs(area::AreaIntegrator::new(
+                ctx,
+                steps,
+                area::PairKernel::Analytic,
+            )),
             FormFactorMethod::Hemicube { resolution } => {
                 Engine::Hemicube(hemicube::Hemicube::new(resolution))
             }
