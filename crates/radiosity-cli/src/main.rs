@@ -1,6 +1,22 @@
 //! `radiosity`: the command-line program. A thin layer over the `radiosity` library:
 //! parse the arguments, run the pipeline, report progress and timings.
 
+/// `eprintln!` that ignores a closed or failing stderr (a `| head` must not abort a run).
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
+/// `println!` that ignores a closed or failing stdout.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod progress_bar;
 
 use std::path::{Path, PathBuf};
@@ -164,7 +180,7 @@ struct RenderArgs {
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     up: Option<String>,
     /// Vertical field of view in degrees.
-    #[arg(long, value_name = "DEGREES")]
+    #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
     fov: Option<f64>,
     /// Image width in pixels.
     #[arg(long, default_value_t = 512)]
@@ -203,6 +219,12 @@ struct CheckArgs {
     scene: SceneArgs,
     #[command(flatten)]
     solve: SolveOptions,
+    /// Instead of checking a scene, print the accuracy table: every form-factor method
+    /// against closed forms (opposed and perpendicular squares, coaxial discs, a small
+    /// element under a rectangle), its row-sum error in a closed box, its reciprocity
+    /// error and its time, as Markdown.
+    #[arg(long)]
+    compare_methods: bool,
 }
 
 #[derive(Args)]
@@ -240,9 +262,26 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            errln!("{}", describe(&err));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The message for a failed run: the error and the causes its text does not already
+/// include, after "error: " (scene errors carry their own "file:line:column: error:").
+fn describe(err: &anyhow::Error) -> String {
+    let mut text = err.to_string();
+    for cause in err.chain().skip(1) {
+        let cause = cause.to_string();
+        if !text.contains(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    if err.downcast_ref::<scene::SceneError>().is_some() {
+        text
+    } else {
+        format!("error: {text}")
     }
 }
 
@@ -257,7 +296,13 @@ fn run(cli: Cli) -> Result<()> {
 }
 
 /// The scene (from its file or built in), meshed, with a short name for default outputs.
-fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
+/// Refuses, before any work, a problem whose matrices would not fit in memory (for
+/// `solver`, or the form factors alone when `None`).
+fn prepare(
+    args: &SceneArgs,
+    solver: Option<Solver>,
+    reporter: &Reporter,
+) -> Result<(Prepared, String)> {
     let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
     let overrides = Overrides {
         max_patch_area: args.max_area,
@@ -296,6 +341,7 @@ fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> 
             }
         }
     };
+    prepared.check_memory(solver)?;
     reporter.note(&format!(
         "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
         stem,
@@ -373,7 +419,7 @@ fn solver(options: &SolveOptions) -> Result<Solver> {
 fn render_command(args: RenderArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let settings = render_settings(&args)?;
-    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let (prepared, stem) = prepare(&args.scene, Some(solver(&args.solve)?), &reporter)?;
     let camera = camera(&args, &prepared.scene)?;
     let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
@@ -422,6 +468,17 @@ fn shade_and_render(
 }
 
 fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
+    if let Some(out) = &args.output {
+        let png = out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !png {
+            bail!(
+                "{}: only PNG images are written; give the output a .png name",
+                out.display()
+            );
+        }
+    }
     if args.width == 0 || args.height == 0 {
         bail!("--width and --height must be at least 1");
     }
@@ -503,7 +560,7 @@ fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
 
 fn formfactors_command(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let (prepared, stem) = prepare(&args.scene, None, &reporter)?;
     let (f, _) = form_factors(&prepared, None, &reporter)?;
     let output = args
         .output
@@ -522,7 +579,7 @@ fn formfactors_command(args: FormFactorArgs) -> Result<()> {
 
 fn solve_command(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let (prepared, stem) = prepare(&args.scene, Some(solver(&args.solve)?), &reporter)?;
     let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     let output = args
@@ -546,10 +603,44 @@ fn solve_command(args: SolveArgs) -> Result<()> {
     Ok(())
 }
 
+/// Prints the accuracy table of `form_factor::accuracy` as Markdown.
+fn compare_methods(max_area: f64) {
+    use radiosity::form_factor::accuracy::{measure, standard_methods};
+    outln!(
+        "Elements of at most {max_area} (unit squares in {} elements); relative errors.",
+        (1.0 / max_area).round()
+    );
+    outln!();
+    outln!(
+        "| method | opposed squares | perpendicular squares | coaxial discs | element to rectangle | mean | closed box max abs(row sum - 1) | reciprocity | time (ms) | mean error x time |"
+    );
+    outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for method in standard_methods() {
+        let r = measure(method, max_area);
+        outln!(
+            "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.1} | {:.2e} |",
+            r.method,
+            r.opposed,
+            r.perpendicular,
+            r.discs,
+            r.differential,
+            r.mean_error(),
+            r.closed_box,
+            r.reciprocity,
+            r.seconds * 1e3,
+            r.mean_error() * r.seconds
+        );
+    }
+}
+
 fn check_command(args: CheckArgs) -> Result<()> {
+    if args.compare_methods {
+        compare_methods(args.scene.max_area.unwrap_or(1.0 / 64.0));
+        return Ok(());
+    }
     // `check` always prints its report; --quiet only silences the progress bars.
     let reporter = Reporter::new(true);
-    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let (prepared, stem) = prepare(&args.scene, Some(solver(&args.solve)?), &reporter)?;
     let (f, stats) = match args.solve.form_factors.as_deref() {
         Some(path) => {
             let f = prepared.load_form_factors(path, &reporter)?;
@@ -565,44 +656,48 @@ fn check_command(args: CheckArgs) -> Result<()> {
     };
     let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     let scene = &prepared.scene;
-    println!("scene             {stem}");
-    println!("surfaces          {}", scene.surfaces.len());
-    println!("elements          {}", prepared.mesh.len());
-    println!("total area        {:.6}", prepared.mesh.total_area());
-    println!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
-    println!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
-    println!("method            {}", prepared.method());
-    println!(
+    outln!("scene             {stem}");
+    outln!("surfaces          {}", scene.surfaces.len());
+    outln!("elements          {}", prepared.mesh.len());
+    outln!("total area        {:.6}", prepared.mesh.total_area());
+    outln!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
+    outln!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
+    outln!("method            {}", prepared.method());
+    outln!(
         "row sums          min {:.6}  mean {:.6}  max {:.6}",
-        stats.row_sums.min, stats.row_sums.mean, stats.row_sums.max
+        stats.row_sums.min,
+        stats.row_sums.mean,
+        stats.row_sums.max
     );
-    println!(
+    outln!(
         "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max; {:.3e} of all exchanged power",
         stats.reciprocity.max_relative, stats.reciprocity.total_relative
     );
     if stats.rays > 0 {
-        println!(
+        outln!(
             "visibility rays   {} ({:.1} M rays/s)",
             stats.rays,
             stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
         );
     }
     let r = solution.report.residual;
-    println!(
+    outln!(
         "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
-        r[0], r[1], r[2]
+        r[0],
+        r[1],
+        r[2]
     );
     let b = &solution.balance;
-    println!(
+    outln!(
         "energy (R)        emitted {:.6e} = absorbed {:.6e} + escaped {:.6e} (relative error {:.1e})",
         b.emitted[0],
         b.absorbed[0],
         b.escaped[0],
         b.relative_error()
     );
-    println!("stage times:");
+    outln!("stage times:");
     for (stage, d) in reporter.timings() {
-        println!("  {:<14}{}", stage.name(), format_duration(d));
+        outln!("  {:<14}{}", stage.name(), format_duration(d));
     }
     Ok(())
 }
@@ -649,7 +744,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let solver = solver(&options)?;
     let reporter = Reporter::new(true);
     let start = std::time::Instant::now();
-    let (prepared, _) = prepare(&scene_args, &reporter)?;
+    let (prepared, _) = prepare(&scene_args, Some(solver), &reporter)?;
     let (f, stats) = form_factors(&prepared, None, &reporter)?;
     let solution = prepared.solve(&f, solver, &reporter)?;
     drop(f);
@@ -730,21 +825,21 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         SolverArg::Lu => "LU",
         SolverArg::GaussSeidel => "Gauss-Seidel",
     };
-    eprintln!(
+    errln!(
         "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
         args.repeat, args.size, args.supersample
     );
-    println!(
+    outln!(
         "| scene | max area | elements | k | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for max_area in areas {
         let runs = (0..args.repeat)
             .map(|_| bench_run(&args, max_area))
             .collect::<Result<Vec<_>>>()?;
         let first = &runs[0];
         if runs.iter().any(|r| r.rays != first.rays) {
-            eprintln!("note: the ray count differed between runs");
+            errln!("note: the ray count differed between runs");
         }
         let stage = |k: usize| median(runs.iter().map(|r| r.stages[k]).collect());
         let total = median(runs.iter().map(|r| r.total).collect());
@@ -761,7 +856,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         let ff = stage(3);
         let area = max_area.map_or("scene's".to_string(), |a| a.to_string());
         let stages: Vec<String> = (0..BENCH_STAGES.len()).map(|k| ms(stage(k))).collect();
-        println!(
+        outln!(
             "| {name} | {area} | {} | {} | {} | {} | {} | {} | {} | {:.2} M |",
             first.elements,
             first.steps,

@@ -37,7 +37,7 @@ impl Reporter {
         if !self.quiet {
             match self.bar.lock().unwrap().as_ref() {
                 Some(bar) => bar.println(text),
-                None => eprintln!("{text}"),
+                None => errln!("{text}"),
             }
         }
     }
@@ -53,7 +53,7 @@ impl Reporter {
             .iter()
             .map(|(s, d)| format!("{} {}", s.name(), format_duration(*d)))
             .collect();
-        eprintln!(
+        errln!(
             "timings: {}; total {}",
             parts.join(", "),
             format_duration(total)

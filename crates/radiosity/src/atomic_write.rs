@@ -7,10 +7,29 @@ use std::path::Path;
 ///
 /// The rename is atomic on POSIX file systems, so `path` either keeps its old content or gets
 /// the whole new content, never part of it. On error the temporary file is removed.
+///
+/// A symbolic link is followed (its target is replaced, the link kept), and an existing
+/// path that is not a regular file (a device such as /dev/stdout, a named pipe) is written
+/// to directly, since it cannot be replaced by renaming.
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut io::BufWriter<std::fs::File>) -> io::Result<()>,
 ) -> io::Result<()> {
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() {
+            let mut out = io::BufWriter::new(std::fs::OpenOptions::new().write(true).open(path)?);
+            write(&mut out)?;
+            return out.flush();
+        }
+    }
+    let resolved;
+    let path = match std::fs::symlink_metadata(path) {
+        Ok(meta) if meta.file_type().is_symlink() => {
+            resolved = std::fs::canonicalize(path)?;
+            resolved.as_path()
+        }
+        _ => path,
+    };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => std::path::PathBuf::from("."),
@@ -60,6 +79,29 @@ mod tests {
         );
         write_atomically(&path, |w| w.write_all(b"whole")).unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "whole");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn writes_through_symlinks_and_to_devices() {
+        let dir = std::env::temp_dir().join(format!("radiosity-aw-link-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let target = dir.join("target.txt");
+        std::fs::write(&target, "old").unwrap();
+        let link = dir.join("link.txt");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        write_atomically(&link, |w| w.write_all(b"new")).unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink(),
+            "link kept"
+        );
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        // A device is written to, not replaced.
+        write_atomically(Path::new("/dev/null"), |w| w.write_all(b"x")).unwrap();
+        assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

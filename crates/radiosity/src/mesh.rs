@@ -68,7 +68,7 @@ pub enum MeshError {
     /// The subdivision would make more elements than the limit.
     #[error(
         "meshing with MAX_PATCH_AREA = {max_area} would make {count} elements, more than the \
-         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.4}"
+         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.3e}"
     )]
     TooManyElements {
         /// The requested maximum element area.
@@ -105,17 +105,26 @@ impl Plan {
 }
 
 /// Plans the cut of one polygon so that no element exceeds `max_area`.
-fn plan(vertices: &[DVec3], max_area: f64) -> Plan {
+/// Plans the cut of one polygon so that no element exceeds `max_area`, or returns the
+/// (estimated) element count when that would exceed [`MAX_ELEMENTS`] on its own, before any
+/// integer could overflow or any loop run long.
+fn plan(vertices: &[DVec3], max_area: f64) -> Result<Plan, f64> {
     let area = geometry::polygon_area(vertices);
+    // Area alone needs this many elements; the cut below stays within a small factor of it.
+    let target = (area / max_area).ceil().max(1.0);
+    if target > MAX_ELEMENTS as f64 {
+        return Err(target);
+    }
     match vertices.len() {
         4 => {
             // Grid counts follow the mean lengths of opposite edges, so elements are near
-            // square; grow the finer direction until the largest bilinear cell fits.
+            // square where the area allows (never more columns than the area needs: a
+            // sliver within the area limit stays one element); then the finer direction
+            // grows until the largest bilinear cell fits.
             let [a, b, c, d] = [vertices[0], vertices[1], vertices[2], vertices[3]];
             let lu = 0.5 * ((b - a).length() + (c - d).length());
             let lv = 0.5 * ((d - a).length() + (c - b).length());
-            let target = (area / max_area).ceil().max(1.0);
-            let mut nu = ((target * lu / lv).sqrt().round() as u32).max(1);
+            let mut nu = ((target * lu / lv).sqrt().round().clamp(1.0, target)) as u32;
             let mut nv = ((target / nu as f64).ceil() as u32).max(1);
             while max_quad_cell_area(vertices, nu, nv) > max_area * (1.0 + 1e-12) {
                 if lu / nu as f64 >= lv / nv as f64 {
@@ -123,16 +132,22 @@ fn plan(vertices: &[DVec3], max_area: f64) -> Plan {
                 } else {
                     nv += 1;
                 }
+                if nu as u64 * nv as u64 > MAX_ELEMENTS {
+                    return Err(nu as f64 * nv as f64);
+                }
             }
-            Plan::QuadGrid { nu, nv }
+            Ok(Plan::QuadGrid { nu, nv })
         }
         k => {
             let fans = if k == 3 { 1 } else { k as u32 };
             let fan_areas =
                 fan_triangles(vertices).map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length());
             let largest = fan_areas.fold(0.0, f64::max);
-            let m = ((largest / max_area).sqrt().ceil() as u32).max(1);
-            Plan::TriangleFan { fans, m }
+            let m = (largest / max_area).sqrt().ceil().max(1.0);
+            if fans as f64 * m * m > MAX_ELEMENTS as f64 {
+                return Err(fans as f64 * m * m);
+            }
+            Ok(Plan::TriangleFan { fans, m: m as u32 })
         }
     }
 }
@@ -177,14 +192,19 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
     if !(max_area.is_finite() && max_area > 0.0) {
         return Err(MeshError::BadMaxArea(max_area));
     }
-    let plans: Vec<Plan> = scene
+    let planned: Vec<Result<Plan, f64>> = scene
         .surfaces
         .iter()
         .map(|s| plan(&s.vertices, max_area))
         .collect();
-    let count: u64 = plans.iter().map(|p| p.element_count()).sum();
-    if count > MAX_ELEMENTS {
-        let suggested = max_area * count as f64 / MAX_ELEMENTS as f64 * 1.05;
+    // Counted in f64: a refused request may be astronomically large.
+    let estimate: f64 = planned
+        .iter()
+        .map(|p| p.map_or_else(|n| n, |p| p.element_count() as f64))
+        .sum();
+    if estimate > MAX_ELEMENTS as f64 {
+        let count = estimate.min(u64::MAX as f64) as u64;
+        let suggested = max_area * estimate / MAX_ELEMENTS as f64 * 1.05;
         return Err(MeshError::TooManyElements {
             max_area,
             count,
@@ -193,6 +213,11 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
         });
     }
 
+    let plans: Vec<Plan> = planned
+        .into_iter()
+        .map(|p| p.expect("checked above"))
+        .collect();
+    let count: u64 = plans.iter().map(|p| p.element_count()).sum();
     let mut mesh = Mesh {
         elements: Vec::with_capacity(count as usize),
         ..Mesh::default()
@@ -588,6 +613,27 @@ mod tests {
                 assert!((c - mesh.elements[e].centroid).length() < 0.2 / (k * k) as f64);
             }
         }
+    }
+
+    #[test]
+    fn refuses_absurd_areas_at_once() {
+        // Regression (QA): these overflowed u32 grid counts and then looped for ever.
+        for tiny in [1e-16, 1e-30, 1e-300] {
+            let scene = scene_of(vec![
+                rect(1.0, 1.0),
+                vec![dvec3(0., 0., 1.), dvec3(3., 0., 1.), dvec3(0., 3., 1.)],
+            ]);
+            assert!(matches!(
+                mesh_scene(&scene, tiny),
+                Err(MeshError::TooManyElements { .. })
+            ));
+        }
+    }
+
+    #[test]
+    fn sliver_within_the_area_limit_is_one_element() {
+        let scene = scene_of(vec![rect(1.0, 1e-7)]);
+        assert_eq!(mesh_scene(&scene, 0.5).unwrap().len(), 1);
     }
 
     #[test]

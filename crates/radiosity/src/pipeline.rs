@@ -35,8 +35,11 @@ pub enum PipelineError {
     /// The solve failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// A setting cannot be honoured (for example an integration that would not fit).
+    #[error("{0}")]
+    Settings(String),
     /// Writing an output failed.
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot write {path}")]
     Write {
         /// The file.
         path: String,
@@ -133,6 +136,37 @@ impl Prepared {
     /// Element areas.
     pub fn areas(&self) -> Vec<f64> {
         self.mesh.elements.iter().map(|e| e.area).collect()
+    }
+
+    /// Refuses, before any work, settings whose form factors and solve would not fit in
+    /// memory: the f32 matrix (4 n^2 bytes), plus the f64 LU matrix (8 n^2) for `Solver::Lu`,
+    /// plus the integration points (32 k^2 bytes per element).
+    pub fn check_memory(&self, solver: Option<Solver>) -> Result<(), PipelineError> {
+        let n = self.mesh.len();
+        let steps = match self.method {
+            FormFactorMethod::AreaIntegral { steps }
+            | FormFactorMethod::Contour { steps }
+            | FormFactorMethod::Analytic { steps } => steps as f64,
+            _ => 1.0,
+        };
+        let points = n as f64 * steps * steps;
+        if points > 5e7 {
+            return Err(PipelineError::Settings(format!(
+                "INTEGRAL_STEPS {steps} on {n} elements means {points:.2e} integration points (more than 5e7); \
+                 use fewer steps (--steps) or larger elements (--max-area)"
+            )));
+        }
+        let per_entry = match solver {
+            Some(Solver::Lu) => 12.0,
+            _ => 4.0,
+        };
+        let what = if per_entry > 4.0 {
+            "the form factors (f32) and the LU matrix (f64)"
+        } else {
+            "the form-factor matrix (f32)"
+        };
+        form_factor::check_dense_fits(what, n, per_entry, form_factor::available_memory_bytes())?;
+        Ok(())
     }
 
     /// Computes the form-factor matrix.

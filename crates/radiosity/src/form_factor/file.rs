@@ -143,7 +143,8 @@ pub enum FormFactorFileError {
     /// The file was computed with a different form-factor method than asked for.
     #[error(
         "form-factor file {path} was computed with method `{found}`, not `{expected}`; \
-         recompute with `radiosity formfactors` or drop the method setting"
+         recompute it with `radiosity formfactors` and the same --method and --steps, or use \
+         the settings it was made with"
     )]
     MethodMismatch {
         /// The file.

@@ -4,6 +4,7 @@
 //! Properties that hold and are tested: F_ij >= 0; F_ii = 0 for planar elements; each row
 //! sums to at most 1 (to 1 in a closed scene); reciprocity A_i F_ij = A_j F_ji.
 
+pub mod accuracy;
 mod area;
 pub mod exact;
 mod file;
@@ -139,10 +140,11 @@ pub struct OutOfMemory {
     pub fits: usize,
 }
 
-/// Memory this process may use, in bytes: `MemAvailable` from /proc/meminfo where there is
-/// one, otherwise 8 GiB.
+/// Memory this process may use, in bytes: `MemAvailable` from /proc/meminfo (8 GiB where
+/// there is none), capped by the cgroup v2 limit (`/sys/fs/cgroup/memory.max`) when one is
+/// set. A `ulimit -v` address-space limit is not seen.
 pub fn available_memory_bytes() -> u64 {
-    std::fs::read_to_string("/proc/meminfo")
+    let available = std::fs::read_to_string("/proc/meminfo")
         .ok()
         .and_then(|s| {
             s.lines()
@@ -150,7 +152,14 @@ pub fn available_memory_bytes() -> u64 {
                 .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
         })
         .map(|kib| kib * 1024)
-        .unwrap_or(8 << 30)
+        .unwrap_or(8 << 30);
+    let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
+        .ok()
+        .and_then(|s| s.trim().parse::<u64>().ok());
+    match cgroup {
+        Some(limit) => available.min(limit),
+        None => available,
+    }
 }
 
 /// Checks that `bytes_per_entry` x n^2 bytes (plus 10 % headroom) fit in `available` bytes.
