@@ -54,6 +54,36 @@ pub struct Camera {
     pub height: u32,
 }
 
+/// True when most of a 5 x 5 grid of rays from the bounding box's centre towards its front
+/// (-z) face leave the scene without hitting a surface: the box is open there.
+fn front_side_is_open(scene: &Scene, lo: DVec3, hi: DVec3) -> bool {
+    let polygons: Vec<&[DVec3]> = scene
+        .surfaces
+        .iter()
+        .map(|s| s.vertices.as_slice())
+        .collect();
+    let ids: Vec<u32> = (0..polygons.len() as u32).collect();
+    let bvh = PolygonBvh::new(&polygons, &ids);
+    let centre = 0.5 * (lo + hi);
+    let mut escaped = 0;
+    for i in 0..5 {
+        for j in 0..5 {
+            let target = DVec3::new(
+                lo.x + (i as f64 + 0.5) / 5.0 * (hi.x - lo.x),
+                lo.y + (j as f64 + 0.5) / 5.0 * (hi.y - lo.y),
+                lo.z - 1e-3 * (hi - lo).length(),
+            );
+            let d = target - centre;
+            if let Some(dir) = d.try_normalize() {
+                if bvh.closest_hit(centre, dir, 0.0, d.length()).is_none() {
+                    escaped += 1;
+                }
+            }
+        }
+    }
+    escaped > 12
+}
+
 /// The field of view of the cameras [`Camera::framing`] and [`Camera::for_scene`] make.
 pub const DEFAULT_FOV_Y_DEGREES: f64 = 60.0;
 
@@ -129,30 +159,63 @@ impl Camera {
         cam
     }
 
-    /// The camera to render `scene` with when the user gives none: the scene's own
-    /// [`Scene::camera`] when it has one; otherwise [`Camera::framing`] when from that eye
-    /// most of the surface area (by area) shows its front (a room seen from inside), and
-    /// [`Camera::outside`] when it does not (objects seen from outside).
+    /// The camera to render `scene` with when the user gives none:
+    ///
+    /// * the scene's own [`Scene::camera`] when it has one;
+    /// * for a box open at its front (-z) side, like the Cornell box without its camera: from
+    ///   outside, through the opening, with the Cornell camera's 39.3 degree view;
+    /// * for a closed room (most surface area faces the inside eye): [`Camera::framing`]'s
+    ///   eye moved to eye height (60 % up) just inside the front wall, looking down a little
+    ///   across the room with a 75 degree view;
+    /// * otherwise (objects): [`Camera::outside`].
     pub fn for_scene(scene: &Scene, width: u32, height: u32) -> Camera {
         if let Some(hint) = &scene.camera {
             return Camera::from_hint(hint, width, height);
         }
         let bounds = scene.bounds();
+        let (lo, hi) = bounds;
         let inside = Camera::framing(bounds, width, height);
+        if !(lo.is_finite() && hi.is_finite()) {
+            return inside;
+        }
+        let (centre, size) = (0.5 * (lo + hi), hi - lo);
         let (mut front, mut total) = (0.0, 0.0);
         for s in &scene.surfaces {
             let area = crate::geometry::area_vector(&s.vertices);
-            let centre = crate::geometry::vertex_mean(&s.vertices);
+            let c = crate::geometry::vertex_mean(&s.vertices);
             total += area.length();
-            if area.dot(inside.eye - centre) > 0.0 {
+            if area.dot(inside.eye - c) > 0.0 {
                 front += area.length();
             }
         }
-        if front >= 0.5 * total {
-            inside
-        } else {
-            Camera::outside(bounds, width, height)
+        if front < 0.5 * total {
+            return Camera::outside(bounds, width, height);
         }
+        if front_side_is_open(scene, lo, hi) {
+            let fov: f64 = 39.3;
+            let aspect = (width.max(1) as f64 / height.max(1) as f64).min(1.0);
+            let tan_half = (0.5 * fov).to_radians().tan();
+            let dist = 0.52 * size.x.max(size.y) / (tan_half * aspect);
+            return Camera {
+                eye: DVec3::new(centre.x, centre.y, lo.z - dist),
+                look_at: DVec3::new(centre.x, centre.y, lo.z),
+                up: DVec3::Y,
+                fov_y_degrees: fov,
+                width,
+                height,
+            };
+        }
+        if size.z >= 0.25 * size.x.max(size.y) {
+            return Camera {
+                eye: DVec3::new(centre.x, lo.y + 0.6 * size.y, lo.z + 0.03 * size.z),
+                look_at: DVec3::new(centre.x, lo.y + 0.3 * size.y, centre.z + 0.2 * size.z),
+                up: DVec3::Y,
+                fov_y_degrees: 75.0,
+                width,
+                height,
+            };
+        }
+        inside
     }
 
     /// The unit vectors (forward, right, true_up) of the camera frame. When `up` is parallel
