@@ -2,6 +2,7 @@
 //! and the invariants of a full matrix: F >= 0, F_ii = 0, row sums, reciprocity.
 
 use glam::{dvec3, DVec3};
+use radiosity::form_factor::accuracy::surface_to_surface;
 use radiosity::form_factor::{
     area_integral_pair, compute_matrix, compute_rows, occluder_bvh, reference, FormFactorContext,
     FormFactorMethod, RayCounter,
@@ -103,55 +104,9 @@ fn surface(name: &str, vertices: Vec<DVec3>) -> Surface {
     }
 }
 
-/// A closed unit cube, every face facing in.
+/// A closed unit cube, every face facing in, 3 x 3 elements a face.
 fn unit_cube() -> Scene {
-    let c = |x: f64, y: f64, z: f64| dvec3(x, y, z);
-    let faces = vec![
-        surface(
-            "bottom",
-            vec![c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
-        ),
-        surface(
-            "top",
-            vec![c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)],
-        ),
-        surface(
-            "x0",
-            vec![c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)],
-        ),
-        surface(
-            "x1",
-            vec![c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)],
-        ),
-        surface(
-            "y0",
-            vec![c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)],
-        ),
-        surface(
-            "y1",
-            vec![c(0., 1., 0.), c(0., 1., 1.), c(1., 1., 1.), c(1., 1., 0.)],
-        ),
-    ];
-    // Turn every face to look into the cube.
-    let faces = faces
-        .into_iter()
-        .map(|mut s| {
-            let n = radiosity::geometry::polygon_normal(&s.vertices).unwrap();
-            let c = radiosity::geometry::polygon_centroid(&s.vertices);
-            if n.dot(dvec3(0.5, 0.5, 0.5) - c) < 0.0 {
-                s.vertices.reverse();
-            }
-            s
-        })
-        .collect();
-    Scene {
-        settings: MeshSettings {
-            max_patch_area: 1.0 / 9.0,
-            integral_steps: 8,
-        },
-        surfaces: faces,
-        camera: None,
-    }
+    radiosity::form_factor::accuracy::closed_cube(1.0 / 9.0)
 }
 
 // Closed cube, 3 x 3 elements per face, k = 8. Row sums equal 1 exactly for the true
@@ -252,26 +207,6 @@ fn occluder_blocks_opposed_squares() {
             );
         }
     }
-}
-
-/// F from surface `a` to surface `b` of a meshed scene: sum over a's elements i and b's
-/// elements j of A_i F_ij, over the area of a.
-fn surface_to_surface(
-    f: &radiosity::form_factor::FormFactorMatrix,
-    mesh: &radiosity::mesh::Mesh,
-    a: usize,
-    b: usize,
-) -> f64 {
-    let mut total = 0.0;
-    let mut area = 0.0;
-    for i in mesh.surface_elements[a].clone() {
-        let ai = mesh.elements[i as usize].area;
-        area += ai;
-        for j in mesh.surface_elements[b].clone() {
-            total += ai * f.get(i as usize, j as usize);
-        }
-    }
-    total / area
 }
 
 fn matrix_for(
