@@ -381,6 +381,11 @@ fn form_factors(
         reporter.note(&format!("form factors read from {}", path.display()));
         return Ok((f, None));
     }
+    reporter.note(&format!(
+        "form factors by {}; occlusion: {}",
+        prepared.method(),
+        prepared.method().occlusion()
+    ));
     let (f, stats) = prepared.form_factors(reporter)?;
     reporter.note(&format!(
         "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
@@ -663,6 +668,7 @@ fn check_command(args: CheckArgs) -> Result<()> {
     outln!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
     outln!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
     outln!("method            {}", prepared.method());
+    outln!("occlusion         {}", prepared.method().occlusion());
     outln!(
         "row sums          min {:.6}  mean {:.6}  max {:.6}",
         stats.row_sums.min,
