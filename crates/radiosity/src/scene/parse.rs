@@ -268,14 +268,29 @@ impl<'a> Parser<'a> {
         Ok((v, token, line))
     }
 
-    /// A `KEYWORD x y z` line; `what` names the three numbers ("coordinate", "size").
+    /// A `KEYWORD value` line whose bad number is recorded but does not stop the block:
+    /// the block is dropped at its end (it has errors), and the lines after it are still
+    /// read and checked, so one file shows all its mistakes. The value is then 0.
+    fn value_or_recorded(&mut self, keyword: Keyword) -> Step<(f64, Option<Token<'a>>, Line<'a>)> {
+        let line = self.expect(keyword)?;
+        let found = self.number(&line, 1, "a number").ok();
+        self.line_end(&line, 2);
+        Ok((found.map_or(0.0, |f| f.0), found.map(|f| f.1), line))
+    }
+
+    /// A `KEYWORD x y z` line; `what` names the three numbers ("coordinate", "size"). A bad
+    /// number is recorded and read as 0 (see [`Parser::value_or_recorded`]).
     fn triple(&mut self, keyword: Keyword, what: &str) -> Step<(DVec3, Line<'a>)> {
         let line = self.expect(keyword)?;
         let mut xyz = [0.0; 3];
         for (i, axis) in ["x", "y", "z"].iter().enumerate() {
-            xyz[i] = self
-                .number(&line, i + 1, &format!("a number (the {axis} {what})"))?
-                .0;
+            if let Ok((v, _)) = self.number(&line, i + 1, &format!("a number (the {axis} {what})"))
+            {
+                xyz[i] = v;
+            } else {
+                // Recorded; the rest of the line would only repeat the complaint.
+                return Ok((dvec3(xyz[0], xyz[1], xyz[2]), line));
+            }
         }
         self.line_end(&line, 4);
         Ok((dvec3(xyz[0], xyz[1], xyz[2]), line))
@@ -534,8 +549,8 @@ impl<'a> Parser<'a> {
             .into_iter()
             .enumerate()
         {
-            let (v, token, line) = self.value(k)?;
-            if v < 0.0 {
+            let (v, token, line) = self.value_or_recorded(k)?;
+            if let (true, Some(token)) = (v < 0.0, token) {
                 let msg = format!("emission must not be negative, found \"{}\"", token.text);
                 self.error_at(token, &line, msg);
             }
@@ -546,8 +561,8 @@ impl<'a> Parser<'a> {
             .into_iter()
             .enumerate()
         {
-            let (v, token, line) = self.value(k)?;
-            if !(0.0..1.0).contains(&v) {
+            let (v, token, line) = self.value_or_recorded(k)?;
+            if let (false, Some(token)) = ((0.0..1.0).contains(&v), token) {
                 let msg = format!(
                     "reflectance must be at least 0 and below 1, found \"{}\"",
                     token.text

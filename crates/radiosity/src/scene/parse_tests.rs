@@ -747,3 +747,13 @@ fn error_count_is_bounded() {
     assert_eq!(errs.len(), MAX_ERRORS + 1);
     assert!(errs[MAX_ERRORS].2.contains("too many errors"));
 }
+
+// Regression (QA): a bad number used to end the reading of its patch, hiding later
+// mistakes in the same patch. Now each is reported at its own line.
+#[test]
+fn bad_numbers_do_not_hide_later_errors_in_the_patch() {
+    let text = with_lines(&[(10, "Rr x"), (12, "Rb 1.5"), (16, "VERTEX3 0 y 0")]);
+    let errs = errors(&text);
+    let at: Vec<(usize, usize)> = errs.iter().map(|e| (e.0, e.1)).collect();
+    assert_eq!(at, vec![(10, 4), (12, 4), (16, 11)], "{errs:#?}");
+}
