@@ -27,7 +27,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 use image::RgbImage;
 use radiosity::form_factor::{FormFactorMatrix, FormFactorMethod};
-use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution};
+use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution, SolutionReport};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
 use radiosity::scene::{self, Scene};
@@ -680,13 +680,27 @@ fn check_command(args: CheckArgs) -> Result<()> {
             stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
         );
     }
-    let r = solution.report.residual;
-    outln!(
-        "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
-        r[0],
-        r[1],
-        r[2]
-    );
+    match &solution.report {
+        SolutionReport::Matrix(report) => {
+            let r = report.residual;
+            outln!(
+                "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
+                r[0],
+                r[1],
+                r[2]
+            );
+        }
+        SolutionReport::Progressive(report) => {
+            outln!(
+                "progressive       {} shots; unshot power {:.2e} of emitted; ambient {:.3e} / {:.3e} / {:.3e}",
+                report.shots,
+                report.unshot_fraction,
+                report.ambient[0],
+                report.ambient[1],
+                report.ambient[2]
+            );
+        }
+    }
     let b = &solution.balance;
     outln!(
         "energy (R)        emitted {:.6e} = absorbed {:.6e} + escaped {:.6e} (relative error {:.1e})",
