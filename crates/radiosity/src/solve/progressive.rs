@@ -259,8 +259,10 @@ pub fn solve_progressive(
         elapsed: start.elapsed(),
     };
     progress.message(&format!(
-        "progressive refinement ({method}): {n} elements, {shots} shots, unshot power {:.2e} of emitted{}",
+        "progressive refinement ({method}): {n} elements, {shots} shots, unshot power {:.2e} of emitted, {} visibility rays, {:.3} s{}",
         report.unshot_fraction,
+        report.rays,
+        report.elapsed.as_secs_f64(),
         if stopped { " (stopped early)" } else { "" }
     ));
     let radiosity = Radiosity {
