@@ -19,6 +19,7 @@ macro_rules! outln {
 
 mod progress_bar;
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -27,12 +28,12 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 use image::RgbImage;
 use radiosity::form_factor::{FormFactorMatrix, FormFactorMethod};
-use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution};
+use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution, SolutionReport};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
 use radiosity::scene::{self, Scene};
 use radiosity::shade::{self, Exposure};
-use radiosity::solve::Solver;
+use radiosity::solve::{ProgressiveState, Solver};
 
 use progress_bar::{format_duration, Reporter};
 
@@ -102,12 +103,17 @@ struct MethodArgs {
 /// Options of commands that solve.
 #[derive(Args)]
 struct SolveOptions {
-    /// Linear solver for (I - rho F) B = E.
+    /// Solver for (I - rho F) B = E.
     #[arg(long, value_enum, default_value_t = SolverArg::GaussSeidel)]
     solver: SolverArg,
-    /// Relative residual at which Gauss-Seidel stops.
-    #[arg(long, default_value_t = 1e-9, value_name = "TOL")]
-    tolerance: f64,
+    /// Where the solver stops. Gauss-Seidel: the relative residual (default 1e-9).
+    /// Progressive: the unshot power as a fraction of the emitted power, in every band (the
+    /// convergence value of Cohen et al. 1988; default 0.01 = 1 %).
+    #[arg(long, value_name = "TOL")]
+    tolerance: Option<f64>,
+    /// Progressive: give up after this many shots.
+    #[arg(long, default_value_t = 1_000_000, value_name = "N")]
+    max_shots: usize,
     /// Read form factors from this file (written by `radiosity formfactors`) instead of
     /// computing them; refused if it was made for another mesh or method.
     #[arg(long, value_name = "FILE")]
@@ -139,6 +145,9 @@ enum SolverArg {
     Lu,
     /// Gauss-Seidel iteration to --tolerance.
     GaussSeidel,
+    /// Progressive refinement (Cohen et al. 1988): shoot the brightest element's unshot
+    /// power, one row of form factors per shot, no matrix stored; to --tolerance unshot.
+    Progressive,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -191,6 +200,13 @@ struct RenderArgs {
     /// Rays per pixel along each axis: 2 or more antialiases edges (N^2 times the rays).
     #[arg(long, default_value_t = 1, value_name = "N")]
     supersample: u32,
+    /// Progressive: write the picture as it converges to DIR/shot-00010.png and so on, every
+    /// --snapshot-every shots (with the ambient term added for display).
+    #[arg(long, value_name = "DIR")]
+    snapshots: Option<PathBuf>,
+    /// Progressive: shots between snapshots.
+    #[arg(long, default_value_t = 10, value_name = "N")]
+    snapshot_every: usize,
 }
 
 #[derive(Args)]
@@ -243,12 +259,13 @@ struct BenchArgs {
     /// Runs per configuration; the table shows the median of each column.
     #[arg(long, default_value_t = 5, value_name = "N")]
     repeat: usize,
-    /// Linear solver for (I - rho F) B = E.
+    /// Solver for (I - rho F) B = E.
     #[arg(long, value_enum, default_value_t = SolverArg::GaussSeidel)]
     solver: SolverArg,
-    /// Relative residual at which Gauss-Seidel stops.
-    #[arg(long, default_value_t = 1e-9, value_name = "TOL")]
-    tolerance: f64,
+    /// Where the solver stops (as for `render --tolerance`: 1e-9 residual for Gauss-Seidel,
+    /// 0.01 unshot for progressive).
+    #[arg(long, value_name = "TOL")]
+    tolerance: Option<f64>,
     /// Image width and height in pixels.
     #[arg(long, default_value_t = 512, value_name = "PIXELS")]
     size: u32,
@@ -404,33 +421,125 @@ fn form_factors(
 }
 
 fn solver(options: &SolveOptions) -> Result<Solver> {
+    if let Some(t) = options.tolerance {
+        if !(t > 0.0 && t.is_finite()) {
+            bail!("--tolerance must be a positive number, got {t}");
+        }
+    }
     Ok(match options.solver {
         SolverArg::Lu => Solver::Lu,
-        SolverArg::GaussSeidel => {
-            if !(options.tolerance > 0.0 && options.tolerance.is_finite()) {
-                bail!(
-                    "--tolerance must be a positive number, got {}",
-                    options.tolerance
-                );
+        SolverArg::GaussSeidel => Solver::GaussSeidel {
+            tolerance: options.tolerance.unwrap_or(1e-9),
+            max_iterations: 10_000,
+        },
+        SolverArg::Progressive => {
+            if options.form_factors.is_some() {
+                bail!("--form-factors cannot be used with --solver progressive, which computes its rows as it shoots");
             }
-            Solver::GaussSeidel {
-                tolerance: options.tolerance,
-                max_iterations: 10_000,
+            if options.max_shots == 0 {
+                bail!("--max-shots must be at least 1");
+            }
+            Solver::Progressive {
+                tolerance: options
+                    .tolerance
+                    .unwrap_or(radiosity::solve::DEFAULT_PROGRESSIVE_TOLERANCE),
+                max_shots: options.max_shots,
             }
         }
     })
 }
 
+/// What a solve watches as it goes: a progressive solve calls it after every shot.
+type Observer<'a> = dyn FnMut(&ProgressiveState) -> ControlFlow<()> + 'a;
+
+/// Solves with `solver`: progressive refinement straight from the scene (no matrix), any
+/// other solver on the form factors (read from `file` or computed, then dropped). Returns
+/// the form-factor statistics when they were computed.
+fn solve_scene(
+    prepared: &Prepared,
+    solver: Solver,
+    file: Option<&Path>,
+    observer: &mut Observer,
+    reporter: &Reporter,
+) -> Result<(Solution, Option<FormFactorStats>)> {
+    if let Solver::Progressive {
+        tolerance,
+        max_shots,
+    } = solver
+    {
+        // The library reports the shots and the unshot fraction through the reporter.
+        let solution = prepared.solve_progressive(tolerance, max_shots, observer, reporter)?;
+        return Ok((solution, None));
+    }
+    let (f, stats) = form_factors(prepared, file, reporter)?;
+    let solution = prepared.solve(&f, solver, reporter)?;
+    Ok((solution, stats))
+}
+
 fn render_command(args: RenderArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let settings = render_settings(&args)?;
-    let (prepared, stem) = prepare(&args.scene, Some(solver(&args.solve)?), &reporter)?;
+    let solver = solver(&args.solve)?;
+    if args.snapshots.is_some() && solver.needs_matrix() {
+        bail!("--snapshots needs --solver progressive");
+    }
+    if args.snapshot_every == 0 {
+        bail!("--snapshot-every must be at least 1");
+    }
+    let (prepared, stem) = prepare(&args.scene, Some(solver), &reporter)?;
     let camera = camera(&args, &prepared.scene)?;
-    let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
-    let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
-    drop(f);
     let exposure = parse_exposure(&args.exposure)?;
-    let image = shade_and_render(&prepared, &solution, &camera, settings, exposure, &reporter);
+    if let Some(dir) = &args.snapshots {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    // Snapshots render the display radiosity (B plus the ambient term) with a quiet
+    // reporter, so that their shading and rendering do not count in the stage times.
+    let mut snapshot_error = None;
+    let mut written = 0usize;
+    let mut observer = |state: &ProgressiveState| {
+        let Some(dir) = &args.snapshots else {
+            return ControlFlow::Continue(());
+        };
+        if state.shot % args.snapshot_every != 0 {
+            return ControlFlow::Continue(());
+        }
+        let quiet = Reporter::new(true);
+        let display = state.display_radiosity();
+        let image = shade_and_render(&prepared, &display, &camera, settings, exposure, &quiet);
+        let path = dir.join(format!("shot-{:05}.png", state.shot));
+        match render::write_png(&image, &path) {
+            Ok(()) => {
+                written += 1;
+                ControlFlow::Continue(())
+            }
+            Err(e) => {
+                snapshot_error =
+                    Some(anyhow::Error::new(e).context(format!("cannot write {}", path.display())));
+                ControlFlow::Break(())
+            }
+        }
+    };
+    let (solution, _) = solve_scene(
+        &prepared,
+        solver,
+        args.solve.form_factors.as_deref(),
+        &mut observer,
+        &reporter,
+    )?;
+    if let Some(e) = snapshot_error {
+        return Err(e);
+    }
+    if let Some(dir) = &args.snapshots {
+        reporter.note(&format!("wrote {written} snapshots to {}", dir.display()));
+    }
+    let image = shade_and_render(
+        &prepared,
+        &solution.element_rgb(),
+        &camera,
+        settings,
+        exposure,
+        &reporter,
+    );
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
@@ -451,25 +560,22 @@ fn render_command(args: RenderArgs) -> Result<()> {
 /// Vertex radiosities (the shade stage), exposure, then the image (the render stage).
 fn shade_and_render(
     prepared: &Prepared,
-    solution: &Solution,
+    element_b: &[[f64; 3]],
     camera: &Camera,
     settings: RenderSettings,
     exposure: Exposure,
     reporter: &Reporter,
 ) -> RgbImage {
-    let element_b = solution.element_rgb();
     let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(&prepared.mesh, &element_b)
+        shade::vertex_radiosity(&prepared.mesh, element_b)
     });
-    let scale = exposure.scale(&prepared.scene, &prepared.mesh, &element_b);
+    let scale = exposure.scale(&prepared.scene, &prepared.mesh, element_b);
     let settings = RenderSettings {
         exposure_scale: scale,
         ..settings
     };
     let renderer = Renderer::new(&prepared.mesh);
-    render::render(
-        &renderer, camera, &element_b, &vertex_b, &settings, reporter,
-    )
+    render::render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
 }
 
 fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
@@ -584,9 +690,15 @@ fn formfactors_command(args: FormFactorArgs) -> Result<()> {
 
 fn solve_command(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem) = prepare(&args.scene, Some(solver(&args.solve)?), &reporter)?;
-    let (f, _) = form_factors(&prepared, args.solve.form_factors.as_deref(), &reporter)?;
-    let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
+    let solver = solver(&args.solve)?;
+    let (prepared, stem) = prepare(&args.scene, Some(solver), &reporter)?;
+    let (solution, _) = solve_scene(
+        &prepared,
+        solver,
+        args.solve.form_factors.as_deref(),
+        &mut |_| ControlFlow::Continue(()),
+        &reporter,
+    )?;
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{stem}.csv")));
@@ -645,21 +757,28 @@ fn check_command(args: CheckArgs) -> Result<()> {
     }
     // `check` always prints its report; --quiet only silences the progress bars.
     let reporter = Reporter::new(true);
-    let (prepared, stem) = prepare(&args.scene, Some(solver(&args.solve)?), &reporter)?;
-    let (f, stats) = match args.solve.form_factors.as_deref() {
-        Some(path) => {
-            let f = prepared.load_form_factors(path, &reporter)?;
-            let stats = radiosity::pipeline::FormFactorStats {
-                rays: 0,
-                seconds: 0.0,
-                row_sums: f.row_sums(),
-                reciprocity: f.reciprocity(&prepared.areas()),
-            };
-            (f, stats)
-        }
-        None => prepared.form_factors(&reporter)?,
+    let solver = solver(&args.solve)?;
+    let (prepared, stem) = prepare(&args.scene, Some(solver), &reporter)?;
+    let (solution, stats) = if solver.needs_matrix() {
+        let (f, stats) = match args.solve.form_factors.as_deref() {
+            Some(path) => {
+                let f = prepared.load_form_factors(path, &reporter)?;
+                let stats = radiosity::pipeline::FormFactorStats {
+                    rays: 0,
+                    seconds: 0.0,
+                    row_sums: f.row_sums(),
+                    reciprocity: f.reciprocity(&prepared.areas()),
+                };
+                (f, stats)
+            }
+            None => prepared.form_factors(&reporter)?,
+        };
+        (prepared.solve(&f, solver, &reporter)?, Some(stats))
+    } else {
+        // Progressive refinement never holds the matrix: no row sums or reciprocity.
+        let observer = &mut |_: &ProgressiveState| ControlFlow::Continue(());
+        solve_scene(&prepared, solver, None, observer, &reporter)?
     };
-    let solution = prepared.solve(&f, solver(&args.solve)?, &reporter)?;
     let scene = &prepared.scene;
     outln!("scene             {stem}");
     outln!("surfaces          {}", scene.surfaces.len());
@@ -669,30 +788,47 @@ fn check_command(args: CheckArgs) -> Result<()> {
     outln!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
     outln!("method            {}", prepared.method());
     outln!("occlusion         {}", prepared.method().occlusion());
-    outln!(
-        "row sums          min {:.6}  mean {:.6}  max {:.6}",
-        stats.row_sums.min,
-        stats.row_sums.mean,
-        stats.row_sums.max
-    );
-    outln!(
-        "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max; {:.3e} of all exchanged power",
-        stats.reciprocity.max_relative, stats.reciprocity.total_relative
-    );
-    if stats.rays > 0 {
+    outln!("solver            {solver}");
+    if let Some(stats) = &stats {
         outln!(
-            "visibility rays   {} ({:.1} M rays/s)",
-            stats.rays,
-            stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+            "row sums          min {:.6}  mean {:.6}  max {:.6}",
+            stats.row_sums.min,
+            stats.row_sums.mean,
+            stats.row_sums.max
         );
+        outln!(
+            "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max; {:.3e} of all exchanged power",
+            stats.reciprocity.max_relative, stats.reciprocity.total_relative
+        );
+        if stats.rays > 0 {
+            outln!(
+                "visibility rays   {} ({:.1} M rays/s)",
+                stats.rays,
+                stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+            );
+        }
     }
-    let r = solution.report.residual;
-    outln!(
-        "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
-        r[0],
-        r[1],
-        r[2]
-    );
+    match &solution.report {
+        SolutionReport::Matrix(report) => {
+            let r = report.residual;
+            outln!(
+                "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
+                r[0],
+                r[1],
+                r[2]
+            );
+        }
+        SolutionReport::Progressive(report) => {
+            outln!(
+                "progressive       {} shots; unshot power {:.2e} of emitted; ambient {:.3e} / {:.3e} / {:.3e}",
+                report.shots,
+                report.unshot_fraction,
+                report.ambient[0],
+                report.ambient[1],
+                report.ambient[2]
+            );
+        }
+    }
     let b = &solution.balance;
     outln!(
         "energy (R)        emitted {:.6e} = absorbed {:.6e} + escaped {:.6e} (relative error {:.1e})",
@@ -701,6 +837,11 @@ fn check_command(args: CheckArgs) -> Result<()> {
         b.escaped[0],
         b.relative_error()
     );
+    if let SolutionReport::Progressive(_) = solution.report {
+        outln!(
+            "                  (progressive: the unshot power is neither absorbed nor escaped yet)"
+        );
+    }
     outln!("stage times:");
     for (stage, d) in reporter.timings() {
         outln!("  {:<14}{}", stage.name(), format_duration(d));
@@ -741,6 +882,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let options = SolveOptions {
         solver: args.solver,
         tolerance: args.tolerance,
+        max_shots: 1_000_000,
         form_factors: None,
     };
     let settings = RenderSettings {
@@ -751,13 +893,17 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let reporter = Reporter::new(true);
     let start = std::time::Instant::now();
     let (prepared, _) = prepare(&scene_args, Some(solver), &reporter)?;
-    let (f, stats) = form_factors(&prepared, None, &reporter)?;
-    let solution = prepared.solve(&f, solver, &reporter)?;
-    drop(f);
+    let observer = &mut |_: &ProgressiveState| ControlFlow::Continue(());
+    let (solution, stats) = solve_scene(&prepared, solver, None, observer, &reporter)?;
+    let rays = match (&stats, &solution.report) {
+        (Some(s), _) => s.rays,
+        (None, SolutionReport::Progressive(r)) => r.rays,
+        (None, _) => 0,
+    };
     let camera = Camera::for_scene(&prepared.scene, args.size, args.size);
     let image = shade_and_render(
         &prepared,
-        &solution,
+        &solution.element_rgb(),
         &camera,
         settings,
         Exposure::Brightest,
@@ -776,7 +922,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         steps: prepared.scene.settings.integral_steps,
         stages,
         total,
-        rays: stats.map_or(0, |s| s.rays),
+        rays,
     })
 }
 
@@ -830,6 +976,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     let solver_name = match args.solver {
         SolverArg::Lu => "LU",
         SolverArg::GaussSeidel => "Gauss-Seidel",
+        SolverArg::Progressive => "progressive (form factors computed within the solve)",
     };
     errln!(
         "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",

@@ -254,3 +254,97 @@ fn bad_arguments_are_refused_with_a_message() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn progressive_render_writes_snapshots() {
+    let dir = scratch_dir("progressive");
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--solver",
+            "progressive",
+            "--snapshots",
+            "snaps",
+            "--snapshot-every",
+            "20",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "-o",
+            "box.png",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("shots, unshot power"), "{err}");
+    assert!(dir.join("box.png").exists());
+    let mut snaps: Vec<String> = std::fs::read_dir(dir.join("snaps"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    snaps.sort();
+    assert!(!snaps.is_empty());
+    assert_eq!(snaps[0], "shot-00020.png");
+    for (k, name) in snaps.iter().enumerate() {
+        assert_eq!(*name, format!("shot-{:05}.png", 20 * (k + 1)));
+        let img = image::open(dir.join("snaps").join(name)).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (32, 32));
+    }
+
+    // check and solve with the progressive solver; no form-factor statistics.
+    let out = radiosity(
+        &[
+            "check",
+            "--max-area",
+            "20000",
+            "--solver",
+            "progressive",
+            "--tolerance",
+            "0.001",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("progressive "), "{text}");
+    assert!(!text.contains("row sums"), "{text}");
+    let out = radiosity(
+        &[
+            "solve",
+            "--max-area",
+            "20000",
+            "--solver",
+            "progressive",
+            "-o",
+            "b.csv",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.join("b.csv").exists());
+
+    for (args, needle) in [
+        (vec!["render", "--snapshots", "s"], "--snapshots"),
+        (
+            vec!["render", "--solver", "progressive", "--snapshot-every", "0"],
+            "--snapshot-every",
+        ),
+        (
+            vec!["solve", "--solver", "progressive", "--tolerance", "0"],
+            "--tolerance",
+        ),
+        (
+            vec!["solve", "--solver", "progressive", "--form-factors", "x.ff"],
+            "--form-factors",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

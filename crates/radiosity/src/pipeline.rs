@@ -4,6 +4,7 @@
 //! Each stage reports through [`Progress`], so its time and progress reach whoever
 //! listens (a progress bar, a window, a distributed runner).
 
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Instant;
 
@@ -16,7 +17,8 @@ use crate::mesh::{mesh_scene, Mesh, MeshError};
 use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::Scene;
 use crate::solve::{
-    self, energy_balance, EnergyBalance, Radiosity, SolveError, SolveReport, Solver,
+    self, energy_balance, EnergyBalance, ProgressiveReport, ProgressiveState, Radiosity,
+    SolveError, SolveReport, Solver,
 };
 use crate::visibility::PolygonBvh;
 
@@ -88,9 +90,21 @@ pub struct Solution {
     /// Element radiosities.
     pub radiosity: Radiosity,
     /// How the solve went.
-    pub report: SolveReport,
-    /// Where the emitted power went.
+    pub report: SolutionReport,
+    /// Where the emitted power went. For a matrix solve, from B and the matrix
+    /// ([`energy_balance`]); for progressive refinement, from the shots' bookkeeping, where
+    /// the power still unshot is neither absorbed nor escaped (so the relative error is the
+    /// unshot fraction).
     pub balance: EnergyBalance,
+}
+
+/// How a solve went, by kind of solver.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SolutionReport {
+    /// LU or Gauss-Seidel on the form-factor matrix.
+    Matrix(SolveReport),
+    /// Progressive refinement.
+    Progressive(ProgressiveReport),
 }
 
 impl Prepared {
@@ -140,7 +154,8 @@ impl Prepared {
 
     /// Refuses, before any work, settings whose form factors and solve would not fit in
     /// memory: the f32 matrix (4 n^2 bytes), plus the f64 LU matrix (8 n^2) for `Solver::Lu`,
-    /// plus the integration points (32 k^2 bytes per element).
+    /// plus the integration points (32 k^2 bytes per element). Progressive refinement stores
+    /// no matrix, so only the integration points are checked for it.
     pub fn check_memory(&self, solver: Option<Solver>) -> Result<(), PipelineError> {
         let n = self.mesh.len();
         let steps = match self.method {
@@ -157,6 +172,8 @@ impl Prepared {
             )));
         }
         let per_entry = match solver {
+            // No matrix: O(n) vectors and one row.
+            Some(Solver::Progressive { .. }) => return Ok(()),
             Some(Solver::Lu) => 12.0,
             _ => 4.0,
         };
@@ -231,8 +248,40 @@ impl Prepared {
         let balance = energy_balance(f, &self.areas(), &reflectance, &emission, &radiosity);
         Ok(Solution {
             radiosity,
-            report,
+            report: SolutionReport::Matrix(report),
             balance,
+        })
+    }
+
+    /// Solves by progressive refinement (see [`solve::solve_progressive`]) with this
+    /// scene's method, without any form-factor matrix. `observer` is called after every
+    /// shot (for snapshots or a viewer) and may stop the solve.
+    pub fn solve_progressive(
+        &self,
+        tolerance: f64,
+        max_shots: usize,
+        observer: &mut dyn FnMut(&ProgressiveState) -> ControlFlow<()>,
+        progress: &dyn Progress,
+    ) -> Result<Solution, PipelineError> {
+        let (reflectance, emission) = solve::element_properties(&self.mesh, &self.scene);
+        let ctx = FormFactorContext {
+            mesh: &self.mesh,
+            occluders: &self.occluders,
+        };
+        let (radiosity, report) = solve::solve_progressive(
+            &ctx,
+            self.method(),
+            &reflectance,
+            &emission,
+            tolerance,
+            max_shots,
+            observer,
+            progress,
+        )?;
+        Ok(Solution {
+            radiosity,
+            balance: report.balance,
+            report: SolutionReport::Progressive(report),
         })
     }
 }

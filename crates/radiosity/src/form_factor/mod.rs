@@ -438,6 +438,62 @@ impl<'a> Engine<'a> {
     }
 }
 
+/// Computes single rows of the matrix on demand, building the per-method machinery (the
+/// integration points, the hemicube's delta form factors, the element BVH) once: for
+/// progressive refinement, which needs one row per shot and never the whole matrix.
+///
+/// `row(i)` gives the same numbers as row i of [`compute_rows`] (no reciprocity is used),
+/// in f64. The pair methods (area, contour, analytic) split the row's columns over the
+/// thread pool; the hemicube and Monte Carlo compute it on the calling thread.
+pub struct RowComputer<'a> {
+    ctx: &'a FormFactorContext<'a>,
+    engine: Engine<'a>,
+    scratch: Scratch,
+}
+
+impl<'a> RowComputer<'a> {
+    /// Prepares `method` for the elements and occluders of `ctx`.
+    pub fn new(ctx: &'a FormFactorContext<'a>, method: FormFactorMethod) -> RowComputer<'a> {
+        RowComputer {
+            ctx,
+            engine: Engine::new(ctx, method),
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// The number of elements (the length of every row).
+    pub fn n(&self) -> usize {
+        self.ctx.mesh.len()
+    }
+
+    /// Row i: F_ij for every element j, counting visibility rays in `rays`.
+    pub fn row(&mut self, i: usize, rays: &RayCounter) -> Vec<f64> {
+        const CHUNK: usize = 256;
+        let mesh = self.ctx.mesh;
+        let n = mesh.len();
+        match &self.engine {
+            Engine::Pairs(integrator) if n > CHUNK => {
+                let a_i = mesh.elements[i].area;
+                let chunks: Vec<usize> = (0..n).step_by(CHUNK).collect();
+                chunks
+                    .into_par_iter()
+                    .map_init(Scratch::default, |scratch, start| {
+                        integrator.couplings(
+                            i,
+                            start..(start + CHUNK).min(n),
+                            rays,
+                            &mut scratch.area,
+                        )
+                    })
+                    .flatten_iter()
+                    .map(|g| g / a_i)
+                    .collect()
+            }
+            engine => engine.row(self.ctx, i, rays, &mut self.scratch),
+        }
+    }
+}
+
 /// Computes the full matrix with `method`, in parallel over rows, reporting progress in
 /// element pairs (n (n - 1) / 2 in all) as each row of the upper triangle finishes.
 ///

@@ -16,6 +16,11 @@
 
 mod gauss_seidel;
 mod lu;
+mod progressive;
+
+pub use progressive::{
+    solve_progressive, ProgressiveReport, ProgressiveState, DEFAULT_PROGRESSIVE_TOLERANCE,
+};
 
 use std::time::{Duration, Instant};
 
@@ -43,6 +48,17 @@ pub enum Solver {
         /// Give up with [`SolveError::NotConverged`] after this many sweeps (default 10 000).
         max_iterations: usize,
     },
+    /// Progressive refinement (Cohen, Chen, Wallace and Greenberg 1988): shoot the unshot
+    /// power of the brightest element, one row of F computed per shot, no matrix stored
+    /// (O(n) memory). Solved by [`solve_progressive`], not [`solve`], since it needs the
+    /// scene rather than a form-factor matrix.
+    Progressive {
+        /// Stop when the unshot power is below this fraction of the emitted power in every
+        /// band (the paper's convergence value; default 0.01 = 1 %).
+        tolerance: f64,
+        /// Give up with [`SolveError::ProgressiveNotConverged`] after this many shots.
+        max_shots: usize,
+    },
 }
 
 impl Solver {
@@ -51,6 +67,19 @@ impl Solver {
         tolerance: 1e-9,
         max_iterations: 10_000,
     };
+}
+
+impl Solver {
+    /// Progressive refinement to 1 % unshot power, at most 1 000 000 shots.
+    pub const DEFAULT_PROGRESSIVE: Solver = Solver::Progressive {
+        tolerance: DEFAULT_PROGRESSIVE_TOLERANCE,
+        max_shots: 1_000_000,
+    };
+
+    /// True for solvers that need the dense form-factor matrix (all but progressive).
+    pub fn needs_matrix(&self) -> bool {
+        !matches!(self, Solver::Progressive { .. })
+    }
 }
 
 impl Default for Solver {
@@ -70,6 +99,13 @@ impl std::fmt::Display for Solver {
             } => write!(
                 f,
                 "Gauss-Seidel (tolerance {tolerance:e}, at most {max_iterations} sweeps)"
+            ),
+            Solver::Progressive {
+                tolerance,
+                max_shots,
+            } => write!(
+                f,
+                "progressive refinement (unshot power below {tolerance:e} of emitted, at most {max_shots} shots)"
             ),
         }
     }
@@ -132,6 +168,23 @@ pub enum SolveError {
         /// The tolerance asked for.
         tolerance: f64,
     },
+    /// Progressive refinement did not reach the tolerance within the allowed shots.
+    #[error(
+        "progressive refinement did not converge: after {shots} shots the unshot power is \
+         {unshot_fraction:e} of the emitted power, above the tolerance {tolerance:e} (raise \
+         the shot limit or loosen the tolerance)"
+    )]
+    ProgressiveNotConverged {
+        /// Shots made.
+        shots: usize,
+        /// Unshot power / emitted power, the largest over the bands.
+        unshot_fraction: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+    /// The progressive solver was given to [`solve`], which takes a matrix.
+    #[error("progressive refinement computes its own form factors: use solve_progressive")]
+    NeedsScene,
     /// An input vector does not have one entry per row of the form-factor matrix.
     #[error("{what} has {len} entries but the form-factor matrix has {n} rows")]
     LengthMismatch {
@@ -215,6 +268,7 @@ fn solve_with_memory(
             })?;
             (b, Some(iterations))
         }
+        Solver::Progressive { .. } => return Err(SolveError::NeedsScene),
     };
     let residual = relative_residual(f, reflectance, emission, &radiosity);
     let report = SolveReport {
@@ -262,7 +316,24 @@ fn check_inputs(
     emission: &[[f64; 3]],
     solver: Solver,
 ) -> Result<(), SolveError> {
-    let n = f.n();
+    check_properties(f.n(), reflectance, emission)?;
+    match solver {
+        Solver::GaussSeidel { tolerance, .. } if !(tolerance > 0.0 && tolerance.is_finite()) => {
+            Err(SolveError::BadSettings(format!(
+                "the Gauss-Seidel tolerance must be a positive number, got {tolerance}"
+            )))
+        }
+        Solver::Progressive { .. } => Err(SolveError::NeedsScene),
+        _ => Ok(()),
+    }
+}
+
+/// One reflectance in [0, 1) and one finite emission per element, n elements.
+fn check_properties(
+    n: usize,
+    reflectance: &[[f64; 3]],
+    emission: &[[f64; 3]],
+) -> Result<(), SolveError> {
     for (what, len) in [
         ("reflectance", reflectance.len()),
         ("emission", emission.len()),
@@ -286,13 +357,6 @@ fn check_inputs(
             if !e[band].is_finite() {
                 return Err(bad("emission", e[band], "not a finite number"));
             }
-        }
-    }
-    if let Solver::GaussSeidel { tolerance, .. } = solver {
-        if !(tolerance > 0.0 && tolerance.is_finite()) {
-            return Err(SolveError::BadSettings(format!(
-                "the Gauss-Seidel tolerance must be a positive number, got {tolerance}"
-            )));
         }
     }
     Ok(())
