@@ -348,3 +348,68 @@ fn progressive_render_writes_snapshots() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn generate_building_writes_a_scene_that_reads_back() {
+    let dir = scratch_dir("generate");
+    let out = radiosity(
+        &[
+            "generate",
+            "building",
+            "-o",
+            "b.scene",
+            "--floors",
+            "1",
+            "--rooms-x",
+            "2",
+            "--rooms-z",
+            "1",
+            "--max-area",
+            "4",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    // 2 rooms x (6 + 294) + 6 windows x 9 + 1 door x 10.
+    assert!(stdout.contains("664 surfaces"), "{stdout}");
+    assert!(stdout.contains("elements"), "{stdout}");
+    let scene = radiosity::scene::read_scene(&dir.join("b.scene")).unwrap();
+    assert_eq!(scene.surfaces.len(), 664);
+    assert_eq!(scene.settings.max_patch_area, 4.0);
+    // The committed examples are what the documented commands write.
+    for (file, args) in [
+        (
+            "building.scene",
+            &["--floors", "2", "--rooms-x", "3", "--rooms-z", "3"][..],
+        ),
+        (
+            "building_small.scene",
+            &[
+                "--floors",
+                "1",
+                "--rooms-x",
+                "2",
+                "--rooms-z",
+                "2",
+                "--max-area",
+                "2",
+            ][..],
+        ),
+    ] {
+        let mut all = vec!["generate", "building", "-o", "x.scene"];
+        all.extend_from_slice(args);
+        let out = radiosity(&all, &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let written = radiosity::scene::read_scene(&dir.join("x.scene")).unwrap();
+        let committed = radiosity::scene::read_scene(Path::new(&example(file))).unwrap();
+        assert!(written == committed, "examples/{file} is out of date");
+    }
+    let bad = radiosity(
+        &["generate", "building", "-o", "c.scene", "--room-size", "3"],
+        &dir,
+    );
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("room size"), "{}", stderr(&bad));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -75,12 +75,14 @@
 use glam::DVec3;
 
 mod builtin;
+pub mod generate;
 mod lex;
 mod parse;
 mod shape;
 mod write;
 
 pub use builtin::cornell_box;
+pub use generate::{building, BuildingParams};
 pub use parse::{parse_scene, read_scene, ParseError, SceneError};
 pub use shape::PLANARITY_TOLERANCE;
 pub use write::{write_scene, write_scene_file};
