@@ -14,8 +14,11 @@ fn examples() -> Vec<std::path::PathBuf> {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "scene"))
-        // The generated buildings (thousands of surfaces) are too large to run every method
-        // on here; `radiosity generate building` has its own tests.
+        // The generated buildings (thousands of surfaces) are left out: every method on
+        // them takes over two minutes on two cores, and at their coarse MAX_PATCH_AREA the
+        // area method's rows reach 1.19 where furniture pieces nearly touch, above the
+        // bound below (a known limit of the coarse mesh, not a leak: the rows come down
+        // as the mesh is refined). `radiosity generate building` has its own tests.
         .filter(|p| {
             !p.file_name()
                 .is_some_and(|n| n.to_string_lossy().starts_with("building"))
