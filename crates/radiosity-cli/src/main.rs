@@ -154,7 +154,7 @@ struct MethodArgs {
 #[derive(Args)]
 struct SolveOptions {
     /// Solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg::GaussSeidel)]
+    #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
     solver: SolverArg,
     /// Where the solver stops. Gauss-Seidel: the relative residual (default 1e-9).
     /// Progressive: the unshot power as a fraction of the emitted power, in every band (the
@@ -191,6 +191,9 @@ enum MethodArg {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum SolverArg {
+    /// Gauss-Seidel on the dense matrix when it fits comfortably and the scene is small,
+    /// progressive refinement otherwise; says which and why.
+    Auto,
     /// LU factorisation with partial pivoting (the paper's Gaussian elimination).
     Lu,
     /// Gauss-Seidel iteration to --tolerance.
@@ -310,7 +313,7 @@ struct BenchArgs {
     #[arg(long, default_value_t = 5, value_name = "N")]
     repeat: usize,
     /// Solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg::GaussSeidel)]
+    #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
     solver: SolverArg,
     /// Where the solver stops (as for `render --tolerance`: 1e-9 residual for Gauss-Seidel,
     /// 0.01 unshot for progressive).
@@ -370,9 +373,9 @@ fn run(cli: Cli) -> Result<()> {
 /// `solver`, or the form factors alone when `None`).
 fn prepare(
     args: &SceneArgs,
-    solver: Option<Solver>,
+    options: Option<&SolveOptions>,
     reporter: &Reporter,
-) -> Result<(Prepared, String)> {
+) -> Result<(Prepared, String, Option<Solver>)> {
     let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
     let overrides = Overrides {
         max_patch_area: args.max_area,
@@ -411,6 +414,10 @@ fn prepare(
             }
         }
     };
+    let solver = match options {
+        Some(options) => Some(solver(options, prepared.mesh.len(), reporter)?),
+        None => None,
+    };
     prepared.check_memory(solver)?;
     reporter.note(&format!(
         "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
@@ -420,7 +427,7 @@ fn prepare(
         prepared.scene.settings.max_patch_area,
         prepared.scene.settings.integral_steps
     ));
-    Ok((prepared, stem))
+    Ok((prepared, stem, solver))
 }
 
 fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
@@ -473,13 +480,32 @@ fn form_factors(
     Ok((f, Some(stats)))
 }
 
-fn solver(options: &SolveOptions) -> Result<Solver> {
+/// The solver the options ask for; `auto` is decided from the element count `n` and the
+/// memory available, and the choice and its reason are noted.
+fn solver(options: &SolveOptions, n: usize, reporter: &Reporter) -> Result<Solver> {
     if let Some(t) = options.tolerance {
         if !(t > 0.0 && t.is_finite()) {
             bail!("--tolerance must be a positive number, got {t}");
         }
     }
-    Ok(match options.solver {
+    let choice = match options.solver {
+        SolverArg::Auto if options.form_factors.is_some() => SolverArg::GaussSeidel,
+        SolverArg::Auto => {
+            let (dense, reason) = radiosity::pipeline::choose_dense(
+                n,
+                radiosity::form_factor::available_memory_bytes(),
+            );
+            reporter.note(&format!("solver auto: {reason}"));
+            if dense {
+                SolverArg::GaussSeidel
+            } else {
+                SolverArg::Progressive
+            }
+        }
+        other => other,
+    };
+    Ok(match choice {
+        SolverArg::Auto => unreachable!("auto is resolved above"),
         SolverArg::Lu => Solver::Lu,
         SolverArg::GaussSeidel => Solver::GaussSeidel {
             tolerance: options.tolerance.unwrap_or(1e-9),
@@ -532,14 +558,14 @@ fn solve_scene(
 fn render_command(args: RenderArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let settings = render_settings(&args)?;
-    let solver = solver(&args.solve)?;
-    if args.snapshots.is_some() && solver.needs_matrix() {
-        bail!("--snapshots needs --solver progressive");
-    }
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
-    let (prepared, stem) = prepare(&args.scene, Some(solver), &reporter)?;
+    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
+    if args.snapshots.is_some() && solver.needs_matrix() {
+        bail!("--snapshots needs --solver progressive (or auto choosing it)");
+    }
     let camera = camera(&args, &prepared.scene)?;
     let exposure = parse_exposure(&args.exposure)?;
     if let Some(dir) = &args.snapshots {
@@ -724,7 +750,7 @@ fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
 
 fn formfactors_command(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem) = prepare(&args.scene, None, &reporter)?;
+    let (prepared, stem, _) = prepare(&args.scene, None, &reporter)?;
     let (f, _) = form_factors(&prepared, None, &reporter)?;
     let output = args
         .output
@@ -743,8 +769,8 @@ fn formfactors_command(args: FormFactorArgs) -> Result<()> {
 
 fn solve_command(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let solver = solver(&args.solve)?;
-    let (prepared, stem) = prepare(&args.scene, Some(solver), &reporter)?;
+    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
     let (solution, _) = solve_scene(
         &prepared,
         solver,
@@ -854,8 +880,8 @@ fn check_command(args: CheckArgs) -> Result<()> {
     }
     // `check` always prints its report; --quiet only silences the progress bars.
     let reporter = Reporter::new(true);
-    let solver = solver(&args.solve)?;
-    let (prepared, stem) = prepare(&args.scene, Some(solver), &reporter)?;
+    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
     let (solution, stats) = if solver.needs_matrix() {
         let (f, stats) = match args.solve.form_factors.as_deref() {
             Some(path) => {
@@ -986,10 +1012,10 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         supersample: args.supersample,
         ..RenderSettings::default()
     };
-    let solver = solver(&options)?;
     let reporter = Reporter::new(true);
     let start = std::time::Instant::now();
-    let (prepared, _) = prepare(&scene_args, Some(solver), &reporter)?;
+    let (prepared, _, solver) = prepare(&scene_args, Some(&options), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
     let observer = &mut |_: &ProgressiveState| ControlFlow::Continue(());
     let (solution, stats) = solve_scene(&prepared, solver, None, observer, &reporter)?;
     let rays = match (&stats, &solution.report) {
@@ -1071,6 +1097,9 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         args.max_area.iter().copied().map(Some).collect()
     };
     let solver_name = match args.solver {
+        SolverArg::Auto => {
+            "auto (dense Gauss-Seidel up to 20,000 elements when it fits, else progressive)"
+        }
         SolverArg::Lu => "LU",
         SolverArg::GaussSeidel => "Gauss-Seidel",
         SolverArg::Progressive => "progressive (form factors computed within the solve)",

@@ -50,6 +50,39 @@ pub enum PipelineError {
     },
 }
 
+/// The most elements `choose_dense` will give the dense solve: its form factors cost
+/// O(n^2) (about 5 s at 10,000 elements on two cores, BENCHMARKS.md), so beyond this the
+/// O(n)-memory progressive solver is chosen even when the matrix would fit.
+pub const AUTO_DENSE_MAX_ELEMENTS: usize = 20_000;
+
+/// The `auto` solver's decision for `n` elements and `available` bytes of memory: true for
+/// the dense solve (Gauss-Seidel on the stored matrix), false for progressive refinement;
+/// with the reason, including the memory estimate, to tell the user.
+pub fn choose_dense(n: usize, available: u64) -> (bool, String) {
+    let matrix = 4.0 * (n as f64).powi(2) * 1.1;
+    let mib = |b: f64| b / (1u64 << 20) as f64;
+    let estimate = format!(
+        "{n} elements; the dense form-factor matrix needs {:.0} MiB of the {:.0} MiB available",
+        mib(matrix),
+        mib(available as f64)
+    );
+    if n > AUTO_DENSE_MAX_ELEMENTS {
+        (false, format!("{estimate}; more than {AUTO_DENSE_MAX_ELEMENTS} elements: progressive refinement (no matrix, O(n) memory)"))
+    } else if matrix > 0.5 * available as f64 {
+        (
+            false,
+            format!(
+                "{estimate}, more than half of it: progressive refinement (no matrix, O(n) memory)"
+            ),
+        )
+    } else {
+        (
+            true,
+            format!("{estimate}: Gauss-Seidel on the dense matrix"),
+        )
+    }
+}
+
 /// Settings from the command line that override the scene file's.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Overrides {
@@ -292,5 +325,25 @@ impl Solution {
         (0..self.radiosity.len())
             .map(|i| self.radiosity.element(i))
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_picks_dense_only_when_small_and_comfortable() {
+        let gib = 1u64 << 30;
+        assert!(choose_dense(2_000, 16 * gib).0);
+        // 20,000 elements need 1.64 GiB with headroom: dense with 16 GiB, not with 2 GiB
+        // (more than half of it).
+        assert!(choose_dense(20_000, 16 * gib).0);
+        assert!(!choose_dense(20_000, 2 * gib).0);
+        assert!(!choose_dense(20_001, 1 << 50).0);
+        assert!(
+            choose_dense(9_805, 16 * gib).1.contains("MiB"),
+            "the reason states the estimate"
+        );
     }
 }
