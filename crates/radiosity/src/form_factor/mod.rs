@@ -125,7 +125,8 @@ pub struct FormFactorMatrix {
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[error(
     "{what} for {n} elements needs {needed_mib:.0} MiB, but only {available_mib:.0} MiB of memory \
-     is available; at most {fits} elements would fit (raise MAX_PATCH_AREA or use --max-area)"
+     is available; at most {fits} elements would fit (raise MAX_PATCH_AREA with --max-area, \
+     or use --solver progressive, which keeps no matrix)"
 )]
 pub struct OutOfMemory {
     /// What was to be allocated.
