@@ -65,9 +65,10 @@
 //! polygon is accepted when no corner is further from its best-fit plane (Newell normal
 //! through the corner mean) than [`PLANARITY_TOLERANCE`] (0.2 %) of its diameter, and its
 //! corners are then projected onto that plane. Measured data needs the tolerance: the
-//! Cornell box's red (left) wall is 0.80 mm out of plane over a 783.5 mm diagonal (0.10 %),
-//! so the built-in box accepts it and flattens it onto its best-fit plane, moving each
-//! corner by 0.80 mm. Corners are only moved when they are more than 1e-12 of the diameter
+//! Cornell box's red (left) wall is 0.80 mm out of plane over a 783.5 mm diagonal (0.10 %).
+//! Flattening it would move each corner 0.80 mm off its neighbours' and open gaps that rays
+//! slip through, so the built-in box gives that wall as the two triangles of its measured
+//! corners instead (exactly planar, watertight). Corners are only moved when they are more than 1e-12 of the diameter
 //! off the plane, so reading a written scene changes nothing and `read(write(scene))`
 //! gives back `scene` bit for bit (for scenes whose coordinates are not many thousands of
 //! times larger than their polygons).
