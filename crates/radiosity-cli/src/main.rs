@@ -42,7 +42,7 @@ use progress_bar::{format_duration, Reporter};
 /// Every command takes an optional scene file in the paper's Appendix A format; without one
 /// it uses the built-in Cornell box.
 #[derive(Parser)]
-#[command(name = "radiosity", version, about, long_about = None)]
+#[command(name = "radiosity", version)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
