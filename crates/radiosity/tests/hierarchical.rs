@@ -89,15 +89,17 @@ fn dense_cornell() -> Vec<[f64; 3]> {
     per_surface(&prepared.mesh, &dense.radiosity)
 }
 
-/// Area-weighted RMS of the per-surface difference, relative to the area-weighted RMS of the
-/// reference, over all bands.
+/// Area-weighted RMS over the surfaces and bands of the difference of the reflected
+/// radiosity B - E (the part a solver computes; the light's E would otherwise dominate),
+/// relative to the area-weighted RMS of the reference's reflected radiosity.
 fn relative_rms(scene: &Scene, got: &[[f64; 3]], want: &[[f64; 3]]) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
     for (i, s) in scene.surfaces.iter().enumerate() {
         let a = radiosity::geometry::polygon_area(&s.vertices);
         for k in 0..3 {
+            let e = s.emission.0[k];
             num += a * (got[i][k] - want[i][k]).powi(2);
-            den += a * want[i][k].powi(2);
+            den += a * (want[i][k] - e).powi(2);
         }
     }
     (num / den).sqrt()
@@ -161,21 +163,31 @@ fn refined_closed_cube_is_close_to_the_closed_form() {
 
 #[test]
 fn cornell_box_agrees_with_the_dense_solve() {
+    const EPS: f64 = 0.01;
     let scene = cornell_box();
     let dense = dense_cornell();
     let t = std::time::Instant::now();
-    let s = solve(&scene, 0.03, 250.0);
+    let s = solve(&scene, EPS, 250.0);
     let elapsed = t.elapsed();
     let h = per_surface(&s.mesh, &s.radiosity);
     let rms = relative_rms(&scene, &h, &dense);
+    for (i, x) in scene.surfaces.iter().enumerate() {
+        eprintln!(
+            "{:28} dense {:9.4} hier {:9.4}",
+            x.name, dense[i][0], h[i][0]
+        );
+    }
     eprintln!(
-        "cornell eps 0.03 min 250: {elapsed:?}, {} leaves, {} links ({} initial), {} rounds, {} sweeps, {} rays, relative RMS {rms:.3e}",
+        "cornell eps {EPS} min 250: {elapsed:?}, {} leaves, {} links ({} initial), {} rounds, {} sweeps, {} rays, relative RMS {rms:.3e}",
         s.report.leaves, s.report.links, s.report.initial_links, s.report.rounds, s.report.iterations, s.report.rays
     );
-    // Measured: 1.02e-2 (8051 leaves, about 1 s on two cores). The reference has its own
-    // discretisation error (piecewise constant on ~1000 elements, 2 x 2 point area
-    // integral), of the same order, so the bound is 3 %.
-    assert!(rms < 0.03, "relative RMS {rms:e}");
+    // Measured: 1.8e-2 (15 173 leaves, 739 096 links, about 3 s on two cores); the largest
+    // per-surface differences are 6 % (short block side 4, the green ceiling strip), the
+    // hierarchical solution being low. The reference has its own error of about 1 % (its
+    // absorbed power is 0.8 % below that of exact contour form factors on 7 900 elements),
+    // so the bound is 4 %. Coarser epsilon is biased low (see the module documentation):
+    // 0.05 gives about 10 % less reflected radiosity.
+    assert!(rms < 0.04, "relative RMS {rms:e}");
     // Energy: emitted = absorbed + escaped to the solve tolerance; the box is open at the
     // front, so much of the power escapes.
     let b = s.report.balance;

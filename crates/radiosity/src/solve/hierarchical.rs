@@ -11,7 +11,8 @@
 //! F_pq is estimated as the mean of Lambert's exact point-to-polygon form factor
 //! ([`crate::form_factor::exact::point_to_polygon`]) from four points of p (the centroids of
 //! its four children; p's normal) to the polygon q, times the visible fraction of 16 point pairs (4 x 4 stratified points on
-//! each, paired by a fixed permutation) tested against the occluder BVH (only the occluders
+//! each, paired by a fixed permutation; only the pairs whose points are each in front of
+//! the other's plane count) tested against the occluder BVH (only the occluders
 //! whose boxes overlap the pair's box, less the two surfaces themselves; none means fully
 //! visible, no ray cast). Each point estimate is bounded by 1 and exact for its point; the
 //! mean of four approximates p's area average. (The centroid alone was tried first: in the
@@ -50,6 +51,14 @@
 //! 1e-7 of the largest emission. Then every link is tested again with the new B, refined
 //! links are replaced by links from or to the children, and the solve repeats, until no link
 //! is refined. The leaves are the elements returned, as a [`Mesh`].
+//!
+//! # Accuracy (measured on the built-in Cornell box, against Gauss-Seidel on ~1000 elements)
+//!
+//! Links kept at coarse levels carry form factors averaged over large nodes, and their
+//! visibility from 16 point pairs; on the Cornell box these are biased low: the reflected
+//! radiosity is about 10 % low at epsilon 0.05 and 2 % (area-weighted RMS over the
+//! surfaces) at epsilon 0.01; without the blocks (no occlusion) it agrees within 1 to 3 %
+//! already at 0.05. `--epsilon` trades this error for time.
 //!
 //! # Energy account
 //!
@@ -307,11 +316,26 @@ impl Solver<'_> {
             return link;
         }
         let (a, b) = (sample_points(np.polygon()), sample_points(nq.polygon()));
-        let visible = (0..16)
-            .filter(|&i| !occ.segment_blocked_by(&self.candidates, a[i], b[(i * 5 + 3) % 16]))
-            .count();
-        self.rays += 16;
-        let fraction = visible as f64 / 16.0;
+        // Only pairs that face each other count: a pair with a point behind the other's
+        // plane carries no energy, and counting it as blocked would bias the fraction low
+        // for nodes that straddle each other's planes (a floor node round a block's side).
+        let (mut facing, mut visible) = (0u32, 0u32);
+        for i in 0..16 {
+            let (x, y) = (a[i], b[(i * 5 + 3) % 16]);
+            if normal_p.dot(y - x) <= 0.0 || normal_q.dot(x - y) <= 0.0 {
+                continue;
+            }
+            facing += 1;
+            if !occ.segment_blocked_by(&self.candidates, x, y) {
+                visible += 1;
+            }
+        }
+        self.rays += facing as u64;
+        let fraction = if facing == 0 {
+            1.0
+        } else {
+            visible as f64 / facing as f64
+        };
         link.ff *= fraction;
         link.oracle *= fraction;
         link
