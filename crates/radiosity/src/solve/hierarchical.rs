@@ -58,7 +58,11 @@
 //! visibility from 16 point pairs; on the Cornell box these are biased low: the reflected
 //! radiosity is about 10 % low at epsilon 0.05 and 2 % (area-weighted RMS over the
 //! surfaces) at epsilon 0.01; without the blocks (no occlusion) it agrees within 1 to 3 %
-//! already at 0.05. `--epsilon` trades this error for time.
+//! already at 0.05. It is not the visibility sampling (all 16 x 16 pairs instead of 16 give
+//! the same bias); the likely cause is that a coarse link multiplies a visible fraction by
+//! the source's *mean* radiosity, while the hidden part of a source is often its dark part
+//! (the floor under a block is both unseen and unlit), so occlusion is counted twice until
+//! the link is refined. `--epsilon` trades this error for time.
 //!
 //! # Energy account
 //!
