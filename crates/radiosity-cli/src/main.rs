@@ -28,6 +28,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 use image::RgbImage;
 use radiosity::form_factor::{FormFactorMatrix, FormFactorMethod};
+use radiosity::mesh::Mesh;
 use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution, SolutionReport};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
@@ -161,6 +162,14 @@ struct SolveOptions {
     /// convergence value of Cohen et al. 1988; default 0.01 = 1 %).
     #[arg(long, value_name = "TOL")]
     tolerance: Option<f64>,
+    /// Hierarchical: the BF refinement threshold, relative to the mean radiosity (smaller is
+    /// finer and slower).
+    #[arg(long, default_value_t = 0.05, value_name = "E")]
+    epsilon: f64,
+    /// Hierarchical: nodes of at most this area (scene units squared) are not split
+    /// (default: MAX_PATCH_AREA / 16).
+    #[arg(long, value_name = "AREA")]
+    min_area: Option<f64>,
     /// Progressive: give up after this many shots.
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     max_shots: usize,
@@ -201,6 +210,9 @@ enum SolverArg {
     /// Progressive refinement (Cohen et al. 1988): shoot the brightest element's unshot
     /// power, one row of form factors per shot, no matrix stored; to --tolerance unshot.
     Progressive,
+    /// Hierarchical radiosity (Hanrahan et al. 1991): quadtrees and links, no matrix,
+    /// refined to --epsilon down to --min-area; the leaves are the elements shaded.
+    Hierarchical,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -415,7 +427,12 @@ fn prepare(
         }
     };
     let solver = match options {
-        Some(options) => Some(solver(options, prepared.mesh.len(), reporter)?),
+        Some(options) => Some(solver(
+            options,
+            prepared.mesh.len(),
+            prepared.scene.settings.max_patch_area,
+            reporter,
+        )?),
         None => None,
     };
     prepared.check_memory(solver)?;
@@ -482,7 +499,12 @@ fn form_factors(
 
 /// The solver the options ask for; `auto` is decided from the element count `n` and the
 /// memory available, and the choice and its reason are noted.
-fn solver(options: &SolveOptions, n: usize, reporter: &Reporter) -> Result<Solver> {
+fn solver(
+    options: &SolveOptions,
+    n: usize,
+    max_patch_area: f64,
+    reporter: &Reporter,
+) -> Result<Solver> {
     if let Some(t) = options.tolerance {
         if !(t > 0.0 && t.is_finite()) {
             bail!("--tolerance must be a positive number, got {t}");
@@ -525,6 +547,25 @@ fn solver(options: &SolveOptions, n: usize, reporter: &Reporter) -> Result<Solve
                 max_shots: options.max_shots,
             }
         }
+        SolverArg::Hierarchical => {
+            if options.form_factors.is_some() {
+                bail!("--form-factors cannot be used with --solver hierarchical, which uses links, not a matrix");
+            }
+            let min_area = options.min_area.unwrap_or(max_patch_area / 16.0);
+            if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
+                bail!(
+                    "--epsilon must be a positive number, got {}",
+                    options.epsilon
+                );
+            }
+            if !(min_area > 0.0 && min_area.is_finite()) {
+                bail!("--min-area must be a positive number, got {min_area}");
+            }
+            Solver::Hierarchical {
+                epsilon: options.epsilon,
+                min_area,
+            }
+        }
     })
 }
 
@@ -548,6 +589,10 @@ fn solve_scene(
     {
         // The library reports the shots and the unshot fraction through the reporter.
         let solution = prepared.solve_progressive(tolerance, max_shots, observer, reporter)?;
+        return Ok((solution, None));
+    }
+    if let Solver::Hierarchical { epsilon, min_area } = solver {
+        let solution = prepared.solve_hierarchical(epsilon, min_area, reporter)?;
         return Ok((solution, None));
     }
     let (f, stats) = form_factors(prepared, file, reporter)?;
@@ -584,7 +629,15 @@ fn render_command(args: RenderArgs) -> Result<()> {
         }
         let quiet = Reporter::new(true);
         let display = state.display_radiosity();
-        let image = shade_and_render(&prepared, &display, &camera, settings, exposure, &quiet);
+        let image = shade_and_render(
+            &prepared,
+            &prepared.mesh,
+            &display,
+            &camera,
+            settings,
+            exposure,
+            &quiet,
+        );
         let path = dir.join(format!("shot-{:05}.png", state.shot));
         match render::write_png(&image, &path) {
             Ok(()) => {
@@ -613,6 +666,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     }
     let image = shade_and_render(
         &prepared,
+        solution.mesh(&prepared),
         &solution.element_rgb(),
         &camera,
         settings,
@@ -639,6 +693,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
 /// Vertex radiosities (the shade stage), exposure, then the image (the render stage).
 fn shade_and_render(
     prepared: &Prepared,
+    mesh: &Mesh,
     element_b: &[[f64; 3]],
     camera: &Camera,
     settings: RenderSettings,
@@ -646,14 +701,14 @@ fn shade_and_render(
     reporter: &Reporter,
 ) -> RgbImage {
     let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(&prepared.mesh, element_b)
+        shade::vertex_radiosity(mesh, element_b)
     });
-    let scale = exposure.scale(&prepared.scene, &prepared.mesh, element_b);
+    let scale = exposure.scale(&prepared.scene, mesh, element_b);
     let settings = RenderSettings {
         exposure_scale: scale,
         ..settings
     };
-    let renderer = Renderer::new(&prepared.mesh);
+    let renderer = Renderer::new(mesh);
     render::render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
 }
 
@@ -785,7 +840,7 @@ fn solve_command(args: SolveArgs) -> Result<()> {
         radiosity::solution::write_solution(
             &output,
             &prepared.scene,
-            &prepared.mesh,
+            solution.mesh(&prepared),
             &solution.element_rgb(),
         )
     })
@@ -793,7 +848,7 @@ fn solve_command(args: SolveArgs) -> Result<()> {
     reporter.note(&format!(
         "wrote {} ({} elements)",
         output.display(),
-        prepared.mesh.len()
+        solution.mesh(&prepared).len()
     ));
     reporter.print_timings();
     Ok(())
@@ -905,8 +960,11 @@ fn check_command(args: CheckArgs) -> Result<()> {
     let scene = &prepared.scene;
     outln!("scene             {stem}");
     outln!("surfaces          {}", scene.surfaces.len());
-    outln!("elements          {}", prepared.mesh.len());
-    outln!("total area        {:.6}", prepared.mesh.total_area());
+    outln!("elements          {}", solution.mesh(&prepared).len());
+    outln!(
+        "total area        {:.6}",
+        solution.mesh(&prepared).total_area()
+    );
     outln!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
     outln!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
     outln!("method            {}", prepared.method());
@@ -939,6 +997,18 @@ fn check_command(args: CheckArgs) -> Result<()> {
                 r[0],
                 r[1],
                 r[2]
+            );
+        }
+        SolutionReport::Hierarchical(report) => {
+            outln!(
+                "hierarchical      {} leaves, {} links ({} initial, O(s^2), no clustering), {} rounds, {} sweeps, {} rays, {:.3} s",
+                report.leaves,
+                report.links,
+                report.initial_links,
+                report.rounds,
+                report.iterations,
+                report.rays,
+                report.elapsed.as_secs_f64()
             );
         }
         SolutionReport::Progressive(report) => {
@@ -1007,6 +1077,9 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         tolerance: args.tolerance,
         max_shots: 1_000_000,
         form_factors: None,
+        // Hierarchical: the defaults of `render`.
+        epsilon: 0.05,
+        min_area: None,
     };
     let settings = RenderSettings {
         supersample: args.supersample,
@@ -1021,11 +1094,13 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let rays = match (&stats, &solution.report) {
         (Some(s), _) => s.rays,
         (None, SolutionReport::Progressive(r)) => r.rays,
+        (None, SolutionReport::Hierarchical(r)) => r.rays,
         (None, _) => 0,
     };
     let camera = Camera::for_scene(&prepared.scene, args.size, args.size);
     let image = shade_and_render(
         &prepared,
+        solution.mesh(&prepared),
         &solution.element_rgb(),
         &camera,
         settings,
@@ -1041,7 +1116,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         }
     }
     Ok(BenchRun {
-        elements: prepared.mesh.len(),
+        elements: solution.mesh(&prepared).len(),
         steps: prepared.scene.settings.integral_steps,
         stages,
         total,
@@ -1103,6 +1178,7 @@ fn bench_command(args: BenchArgs) -> Result<()> {
         SolverArg::Lu => "LU",
         SolverArg::GaussSeidel => "Gauss-Seidel",
         SolverArg::Progressive => "progressive (form factors computed within the solve)",
+        SolverArg::Hierarchical => "hierarchical (links computed within the solve)",
     };
     errln!(
         "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",

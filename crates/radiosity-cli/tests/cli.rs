@@ -413,3 +413,79 @@ fn generate_building_writes_a_scene_that_reads_back() {
     assert!(stderr(&bad).contains("room size"), "{}", stderr(&bad));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn hierarchical_solves_checks_and_renders_its_leaves() {
+    let dir = scratch_dir("hierarchical");
+    let out = radiosity(
+        &["check", "--solver", "hierarchical", "--epsilon", "0.2"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("hierarchical "), "{text}");
+    assert!(text.contains("leaves"), "{text}");
+    assert!(!text.contains("row sums"), "{text}");
+    let out = radiosity(
+        &[
+            "render",
+            "--solver",
+            "hierarchical",
+            "--epsilon",
+            "0.2",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "-o",
+            "h.png",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.join("h.png").exists());
+    // The solution file lists the leaves, not the prepared mesh's elements.
+    let out = radiosity(
+        &[
+            "solve",
+            "--solver",
+            "hierarchical",
+            "--epsilon",
+            "0.2",
+            "-o",
+            "h.csv",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rows = std::fs::read_to_string(dir.join("h.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    assert!(rows > 100, "{rows} rows");
+    for (args, needle) in [
+        (
+            vec!["solve", "--solver", "hierarchical", "--epsilon", "0"],
+            "--epsilon",
+        ),
+        (
+            vec!["solve", "--solver", "hierarchical", "--min-area", "0"],
+            "--min-area",
+        ),
+        (
+            vec![
+                "solve",
+                "--solver",
+                "hierarchical",
+                "--form-factors",
+                "x.ff",
+            ],
+            "--form-factors",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success());
+        assert!(stderr(&out).contains(needle), "{}", stderr(&out));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

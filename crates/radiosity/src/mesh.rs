@@ -247,6 +247,32 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
 }
 
 impl Mesh {
+    /// A mesh from given elements, surface by surface: `surfaces[s]` holds surface s's
+    /// vertices, its elements (3 or 4 indices into those vertices, counter-clockwise from the
+    /// front, planar and convex) and its unit normal. Used for the leaves of hierarchical
+    /// radiosity, which may have T-junctions (neighbours are then only the elements that
+    /// share a whole edge).
+    pub(crate) fn from_surfaces(surfaces: Vec<(Vec<DVec3>, Vec<Vec<u32>>, DVec3)>) -> Mesh {
+        let mut mesh = Mesh::default();
+        for (s, (vertices, elements, normal)) in surfaces.into_iter().enumerate() {
+            let first_vertex = mesh.vertices.len() as u32;
+            let first_element = mesh.elements.len() as u32;
+            mesh.vertices.extend(vertices);
+            for corners in elements {
+                let global: Vec<u32> = corners.iter().map(|&c| c + first_vertex).collect();
+                mesh.push_element(s as u32, &global, normal);
+            }
+            mesh.surface_vertices
+                .push(first_vertex..mesh.vertices.len() as u32);
+            mesh.surface_elements
+                .push(first_element..mesh.elements.len() as u32);
+        }
+        mesh.build_neighbours();
+        mesh
+    }
+}
+
+impl Mesh {
     /// The number of elements.
     pub fn len(&self) -> usize {
         self.elements.len()

@@ -17,8 +17,8 @@ use crate::mesh::{mesh_scene, Mesh, MeshError};
 use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::Scene;
 use crate::solve::{
-    self, energy_balance, EnergyBalance, ProgressiveReport, ProgressiveState, Radiosity,
-    SolveError, SolveReport, Solver,
+    self, energy_balance, EnergyBalance, HierarchicalReport, ProgressiveReport, ProgressiveState,
+    Radiosity, SolveError, SolveReport, Solver,
 };
 use crate::visibility::PolygonBvh;
 
@@ -129,6 +129,9 @@ pub struct Solution {
     /// the power still unshot is neither absorbed nor escaped (so the relative error is the
     /// unshot fraction).
     pub balance: EnergyBalance,
+    /// The elements the radiosities belong to when they are not the prepared mesh's: the
+    /// leaves of hierarchical radiosity. `None` for every other solver.
+    pub mesh: Option<Mesh>,
 }
 
 /// How a solve went, by kind of solver.
@@ -138,6 +141,8 @@ pub enum SolutionReport {
     Matrix(SolveReport),
     /// Progressive refinement.
     Progressive(ProgressiveReport),
+    /// Hierarchical radiosity.
+    Hierarchical(HierarchicalReport),
 }
 
 impl Prepared {
@@ -206,7 +211,7 @@ impl Prepared {
         }
         let per_entry = match solver {
             // No matrix: O(n) vectors and one row.
-            Some(Solver::Progressive { .. }) => return Ok(()),
+            Some(Solver::Progressive { .. } | Solver::Hierarchical { .. }) => return Ok(()),
             Some(Solver::Lu) => 12.0,
             _ => 4.0,
         };
@@ -283,6 +288,7 @@ impl Prepared {
             radiosity,
             report: SolutionReport::Matrix(report),
             balance,
+            mesh: None,
         })
     }
 
@@ -315,11 +321,35 @@ impl Prepared {
             radiosity,
             balance: report.balance,
             report: SolutionReport::Progressive(report),
+            mesh: None,
+        })
+    }
+
+    /// Solves by hierarchical radiosity (see [`solve::solve_hierarchical`]): no matrix; the
+    /// solution carries its own elements (the leaves) in [`Solution::mesh`].
+    pub fn solve_hierarchical(
+        &self,
+        epsilon: f64,
+        min_area: f64,
+        progress: &dyn Progress,
+    ) -> Result<Solution, PipelineError> {
+        let h =
+            solve::solve_hierarchical(&self.scene, &self.occluders, epsilon, min_area, progress)?;
+        Ok(Solution {
+            radiosity: h.radiosity,
+            balance: h.report.balance,
+            report: SolutionReport::Hierarchical(h.report),
+            mesh: Some(h.mesh),
         })
     }
 }
 
 impl Solution {
+    /// The elements the radiosities belong to: [`Solution::mesh`] when set, else `prepared`'s.
+    pub fn mesh<'a>(&'a self, prepared: &'a Prepared) -> &'a Mesh {
+        self.mesh.as_ref().unwrap_or(&prepared.mesh)
+    }
+
     /// B per element as RGB triples.
     pub fn element_rgb(&self) -> Vec<[f64; 3]> {
         (0..self.radiosity.len())

@@ -15,9 +15,11 @@
 //! either absorbed by some element or escapes the scene.
 
 mod gauss_seidel;
+mod hierarchical;
 mod lu;
 mod progressive;
 
+pub use hierarchical::{solve_hierarchical, HierarchicalReport, HierarchicalSolution};
 pub use progressive::{
     solve_progressive, ProgressiveReport, ProgressiveState, DEFAULT_PROGRESSIVE_TOLERANCE,
 };
@@ -59,6 +61,15 @@ pub enum Solver {
         /// Give up with [`SolveError::ProgressiveNotConverged`] after this many shots.
         max_shots: usize,
     },
+    /// Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991) with BF refinement:
+    /// quadtrees over the input surfaces, links instead of a matrix. Solved by
+    /// [`solve_hierarchical`], which returns its own elements (the leaves).
+    Hierarchical {
+        /// Refinement threshold relative to the mean radiosity (smaller: finer, slower).
+        epsilon: f64,
+        /// Nodes of at most this area (scene units squared) are not split.
+        min_area: f64,
+    },
 }
 
 impl Solver {
@@ -76,9 +87,13 @@ impl Solver {
         max_shots: 1_000_000,
     };
 
-    /// True for solvers that need the dense form-factor matrix (all but progressive).
+    /// True for solvers that need the dense form-factor matrix (all but progressive and
+    /// hierarchical).
     pub fn needs_matrix(&self) -> bool {
-        !matches!(self, Solver::Progressive { .. })
+        !matches!(
+            self,
+            Solver::Progressive { .. } | Solver::Hierarchical { .. }
+        )
     }
 }
 
@@ -106,6 +121,10 @@ impl std::fmt::Display for Solver {
             } => write!(
                 f,
                 "progressive refinement (unshot power below {tolerance:e} of emitted, at most {max_shots} shots)"
+            ),
+            Solver::Hierarchical { epsilon, min_area } => write!(
+                f,
+                "hierarchical radiosity (BF refinement, epsilon {epsilon:e}, minimum area {min_area:e})"
             ),
         }
     }
@@ -183,7 +202,10 @@ pub enum SolveError {
         tolerance: f64,
     },
     /// The progressive solver was given to [`solve`], which takes a matrix.
-    #[error("progressive refinement computes its own form factors: use solve_progressive")]
+    #[error(
+        "progressive refinement and hierarchical radiosity compute their own form factors: use \
+         solve_progressive or solve_hierarchical"
+    )]
     NeedsScene,
     /// An input vector does not have one entry per row of the form-factor matrix.
     #[error("{what} has {len} entries but the form-factor matrix has {n} rows")]
@@ -268,7 +290,9 @@ fn solve_with_memory(
             })?;
             (b, Some(iterations))
         }
-        Solver::Progressive { .. } => return Err(SolveError::NeedsScene),
+        Solver::Progressive { .. } | Solver::Hierarchical { .. } => {
+            return Err(SolveError::NeedsScene)
+        }
     };
     let residual = relative_residual(f, reflectance, emission, &radiosity);
     let report = SolveReport {
@@ -323,7 +347,7 @@ fn check_inputs(
                 "the Gauss-Seidel tolerance must be a positive number, got {tolerance}"
             )))
         }
-        Solver::Progressive { .. } => Err(SolveError::NeedsScene),
+        Solver::Progressive { .. } | Solver::Hierarchical { .. } => Err(SolveError::NeedsScene),
         _ => Ok(()),
     }
 }
