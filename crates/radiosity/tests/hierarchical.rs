@@ -61,8 +61,8 @@ fn per_surface(mesh: &radiosity::mesh::Mesh, b: &radiosity::solve::Radiosity) ->
             for e in range.clone() {
                 let a = mesh.elements[e as usize].area;
                 area += a;
-                for k in 0..3 {
-                    sum[k] += a * b.bands[k][e as usize];
+                for (s, band) in sum.iter_mut().zip(&b.bands) {
+                    *s += a * band[e as usize];
                 }
             }
             sum.map(|s| s / area)
