@@ -209,6 +209,15 @@ fn occluder_blocks_opposed_squares() {
     }
 }
 
+/// Asserts |row sum - 1| < `tolerance` for every row of `f` (a closed scene).
+#[track_caller]
+fn assert_rows_sum_to_one(f: &radiosity::form_factor::FormFactorMatrix, tolerance: f64) {
+    for i in 0..f.n() {
+        let sum = f.row_sum(i);
+        assert!((sum - 1.0).abs() < tolerance, "row {i} sums to {sum}");
+    }
+}
+
 fn matrix_for(
     scene: &Scene,
     method: FormFactorMethod,
@@ -260,12 +269,8 @@ fn hemicube_opposed_squares_and_closed_cube() {
     // Closed cube: every cell of every hemicube sees a wall, and the deltas sum to 1, so
     // each row sums to 1 up to f32 rounding of its entries (n x 6e-8).
     let (f, _) = matrix_for(&unit_cube(), FormFactorMethod::Hemicube { resolution: 64 });
+    assert_rows_sum_to_one(&f, 1e-5);
     for i in 0..f.n() {
-        assert!(
-            (f.row_sum(i) - 1.0).abs() < 1e-5,
-            "row {i} sums to {}",
-            f.row_sum(i)
-        );
         assert_eq!(f.get(i, i), 0.0);
     }
 }
@@ -308,13 +313,7 @@ fn montecarlo_is_deterministic_and_converges() {
             seed: 1,
         },
     );
-    for i in 0..f.n() {
-        assert!(
-            (f.row_sum(i) - 1.0).abs() < 1e-5,
-            "row {i} sums to {}",
-            f.row_sum(i)
-        );
-    }
+    assert_rows_sum_to_one(&f, 1e-5);
 }
 
 // Methods agree on an occluded scene: opposed unit squares with a 0.5 x 0.5 blocker halfway.
@@ -420,13 +419,7 @@ fn contour_reproduces_closed_forms() {
     // A closed cube: exact form factors of a closed convex enclosure sum to 1 in every
     // row; f32 storage of 54 entries bounds the error by ~54 x 6e-8.
     let (f, _) = matrix_for(&unit_cube(), FormFactorMethod::Contour { steps: 2 });
-    for i in 0..f.n() {
-        assert!(
-            (f.row_sum(i) - 1.0).abs() < 4e-6,
-            "row {i} sums to {}",
-            f.row_sum(i)
-        );
-    }
+    assert_rows_sum_to_one(&f, 4e-6);
 }
 
 // The analytic method integrates Lambert's exact point-to-polygon form factor over the

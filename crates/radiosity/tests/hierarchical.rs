@@ -1,49 +1,20 @@
 //! Hierarchical radiosity against the closed form in a closed cube and against the dense
 //! Gauss-Seidel solve on the Cornell box.
 
-use glam::dvec3;
 use radiosity::form_factor::occluder_bvh;
 use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::NoProgress;
-use radiosity::scene::{cornell_box, MeshSettings, Rgb, Scene, Surface};
+use radiosity::scene::{cornell_box, Rgb, Scene};
 use radiosity::solve::{solve_hierarchical, HierarchicalSolution, Solver};
 
 /// A closed unit cube, every face facing in, E and rho uniform.
 fn unit_cube(e: [f64; 3], rho: [f64; 3]) -> Scene {
-    let c = |x: f64, y: f64, z: f64| dvec3(x, y, z);
-    let faces = [
-        vec![c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
-        vec![c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)],
-        vec![c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)],
-        vec![c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)],
-        vec![c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)],
-        vec![c(0., 1., 0.), c(0., 1., 1.), c(1., 1., 1.), c(1., 1., 0.)],
-    ];
-    let surfaces = faces
-        .into_iter()
-        .enumerate()
-        .map(|(i, mut vertices)| {
-            let n = radiosity::geometry::polygon_normal(&vertices).unwrap();
-            let centre = radiosity::geometry::polygon_centroid(&vertices);
-            if n.dot(dvec3(0.5, 0.5, 0.5) - centre) < 0.0 {
-                vertices.reverse();
-            }
-            Surface {
-                name: format!("face{i}"),
-                emission: Rgb(e),
-                reflectance: Rgb(rho),
-                vertices,
-            }
-        })
-        .collect();
-    Scene {
-        settings: MeshSettings {
-            max_patch_area: 1.0,
-            integral_steps: 2,
-        },
-        surfaces,
-        camera: None,
+    let mut scene = radiosity::form_factor::accuracy::closed_cube(1.0);
+    for s in &mut scene.surfaces {
+        s.emission = Rgb(e);
+        s.reflectance = Rgb(rho);
     }
+    scene
 }
 
 fn solve(scene: &Scene, epsilon: f64, min_area: f64) -> HierarchicalSolution {

@@ -2,14 +2,13 @@
 
 use std::ops::ControlFlow;
 
-use glam::dvec3;
 use radiosity::form_factor::{
     compute_matrix, compute_rows, occluder_bvh, FormFactorContext, FormFactorMatrix,
     FormFactorMethod, RayCounter, RowComputer,
 };
 use radiosity::mesh::{mesh_scene, Mesh};
 use radiosity::progress::NoProgress;
-use radiosity::scene::{cornell_box, MeshSettings, Rgb, Scene, Surface};
+use radiosity::scene::{cornell_box, Rgb, Scene};
 use radiosity::solve::{
     element_properties, energy_balance, solve, solve_progressive, ProgressiveReport, Radiosity,
     SolveError, Solver,
@@ -19,40 +18,12 @@ use radiosity::visibility::PolygonBvh;
 /// A closed unit cube, every face facing in, rho 0.5 everywhere; `emit` gives each face's
 /// emission.
 fn unit_cube(max_area: f64, emit: impl Fn(usize) -> [f64; 3]) -> Scene {
-    let c = |x: f64, y: f64, z: f64| dvec3(x, y, z);
-    let faces = [
-        vec![c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
-        vec![c(0., 0., 1.), c(1., 0., 1.), c(1., 1., 1.), c(0., 1., 1.)],
-        vec![c(0., 0., 0.), c(0., 0., 1.), c(0., 1., 1.), c(0., 1., 0.)],
-        vec![c(1., 0., 0.), c(1., 1., 0.), c(1., 1., 1.), c(1., 0., 1.)],
-        vec![c(0., 0., 0.), c(1., 0., 0.), c(1., 0., 1.), c(0., 0., 1.)],
-        vec![c(0., 1., 0.), c(0., 1., 1.), c(1., 1., 1.), c(1., 1., 0.)],
-    ];
-    let surfaces = faces
-        .into_iter()
-        .enumerate()
-        .map(|(i, mut vertices)| {
-            let n = radiosity::geometry::polygon_normal(&vertices).unwrap();
-            let centre = radiosity::geometry::polygon_centroid(&vertices);
-            if n.dot(dvec3(0.5, 0.5, 0.5) - centre) < 0.0 {
-                vertices.reverse();
-            }
-            Surface {
-                name: format!("face{i}"),
-                emission: Rgb(emit(i)),
-                reflectance: Rgb([0.5, 0.3, 0.7]),
-                vertices,
-            }
-        })
-        .collect();
-    Scene {
-        settings: MeshSettings {
-            max_patch_area: max_area,
-            integral_steps: 2,
-        },
-        surfaces,
-        camera: None,
+    let mut scene = radiosity::form_factor::accuracy::closed_cube(max_area);
+    for (i, s) in scene.surfaces.iter_mut().enumerate() {
+        s.emission = Rgb(emit(i));
+        s.reflectance = Rgb([0.5, 0.3, 0.7]);
     }
+    scene
 }
 
 struct Setup {
