@@ -54,6 +54,18 @@ pub(super) struct AreaIntegrator<'a> {
     surface_box: Vec<(DVec3, DVec3)>,
 }
 
+/// An element's 3 or 4 corners without a heap allocation.
+struct Corners {
+    points: [DVec3; 4],
+    len: usize,
+}
+
+impl Corners {
+    fn as_slice(&self) -> &[DVec3] {
+        &self.points[..self.len]
+    }
+}
+
 /// Scratch space for one worker thread, reused across rows.
 #[derive(Default)]
 pub(super) struct Scratch {
@@ -206,7 +218,8 @@ impl<'a> AreaIntegrator<'a> {
                 .map(|&(p, wp)| self.kernel_from(p, wp, ni, j, candidates, &mut cast).0)
                 .sum(),
             PairKernel::Contour => {
-                let exact = ei.area * exact::polygon_to_polygon(&self.corners(i), &self.corners(j));
+                let (ci, cj) = (self.corners(i), self.corners(j));
+                let exact = ei.area * exact::polygon_to_polygon(ci.as_slice(), cj.as_slice());
                 if exact <= 0.0 || candidates.is_empty() {
                     exact
                 } else {
@@ -229,7 +242,7 @@ impl<'a> AreaIntegrator<'a> {
                 self.samples(i)
                     .iter()
                     .map(|&(p, wp)| {
-                        let f = exact::point_to_polygon(p, ni, &cj);
+                        let f = exact::point_to_polygon(p, ni, cj.as_slice());
                         if f <= 0.0 || candidates.is_empty() {
                             return wp * f;
                         }
@@ -247,9 +260,17 @@ impl<'a> AreaIntegrator<'a> {
         g
     }
 
-    /// The corners of element e.
-    fn corners(&self, e: usize) -> Vec<DVec3> {
-        self.ctx.mesh.corner_positions(e).collect()
+    /// The corners of element e (3 or 4), on the stack: this runs once per element pair.
+    fn corners(&self, e: usize) -> Corners {
+        let mut c = Corners {
+            points: [DVec3::ZERO; 4],
+            len: 0,
+        };
+        for p in self.ctx.mesh.corner_positions(e) {
+            c.points[c.len] = p;
+            c.len += 1;
+        }
+        c
     }
 
     /// The area kernel from point p (weight `wp`, on an element with normal `np`) to the
