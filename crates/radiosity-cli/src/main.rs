@@ -561,10 +561,17 @@ fn solver(
             if !(min_area > 0.0 && min_area.is_finite()) {
                 bail!("--min-area must be a positive number, got {min_area}");
             }
-            Solver::Hierarchical {
+            let tolerance = options
+                .tolerance
+                .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
+            if !(tolerance > 0.0 && tolerance < 1.0) {
+                bail!("--tolerance must be a number in (0, 1) for --solver hierarchical, got {tolerance}");
+            }
+            Solver::Hierarchical(radiosity::solve::HierarchicalSettings {
                 epsilon: options.epsilon,
                 min_area,
-            }
+                tolerance,
+            })
         }
     })
 }
@@ -591,8 +598,8 @@ fn solve_scene(
         let solution = prepared.solve_progressive(tolerance, max_shots, observer, reporter)?;
         return Ok((solution, None));
     }
-    if let Solver::Hierarchical { epsilon, min_area } = solver {
-        let solution = prepared.solve_hierarchical(epsilon, min_area, reporter)?;
+    if let Solver::Hierarchical(settings) = solver {
+        let solution = prepared.solve_hierarchical(&settings, reporter)?;
         return Ok((solution, None));
     }
     let (f, stats) = form_factors(prepared, file, reporter)?;

@@ -211,7 +211,7 @@ impl Prepared {
         }
         let per_entry = match solver {
             // No matrix: O(n) vectors and one row.
-            Some(Solver::Progressive { .. } | Solver::Hierarchical { .. }) => return Ok(()),
+            Some(Solver::Progressive { .. } | Solver::Hierarchical(_)) => return Ok(()),
             Some(Solver::Lu) => 12.0,
             _ => 4.0,
         };
@@ -329,12 +329,10 @@ impl Prepared {
     /// solution carries its own elements (the leaves) in [`Solution::mesh`].
     pub fn solve_hierarchical(
         &self,
-        epsilon: f64,
-        min_area: f64,
+        settings: &solve::HierarchicalSettings,
         progress: &dyn Progress,
     ) -> Result<Solution, PipelineError> {
-        let h =
-            solve::solve_hierarchical(&self.scene, &self.occluders, epsilon, min_area, progress)?;
+        let h = solve::solve_hierarchical(&self.scene, &self.occluders, settings, progress)?;
         Ok(Solution {
             radiosity: h.radiosity,
             balance: h.report.balance,

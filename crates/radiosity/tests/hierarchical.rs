@@ -5,7 +5,10 @@ use radiosity::form_factor::occluder_bvh;
 use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::NoProgress;
 use radiosity::scene::{cornell_box, Rgb, Scene};
-use radiosity::solve::{solve_hierarchical, HierarchicalSolution, Solver};
+use radiosity::solve::{
+    solve_hierarchical, HierarchicalSettings, HierarchicalSolution, Solver,
+    DEFAULT_HIERARCHICAL_TOLERANCE,
+};
 
 /// A closed unit cube, every face facing in, E and rho uniform.
 fn unit_cube(e: [f64; 3], rho: [f64; 3]) -> Scene {
@@ -19,7 +22,12 @@ fn unit_cube(e: [f64; 3], rho: [f64; 3]) -> Scene {
 
 fn solve(scene: &Scene, epsilon: f64, min_area: f64) -> HierarchicalSolution {
     let bvh = occluder_bvh(scene);
-    solve_hierarchical(scene, &bvh, epsilon, min_area, &NoProgress).unwrap()
+    let settings = HierarchicalSettings {
+        epsilon,
+        min_area,
+        tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
+    };
+    solve_hierarchical(scene, &bvh, &settings, &NoProgress).unwrap()
 }
 
 /// Area-weighted mean B of every input surface, per band.
@@ -202,7 +210,19 @@ fn deterministic() {
 fn refuses_bad_settings() {
     let scene = cornell_box();
     let bvh = occluder_bvh(&scene);
-    for (eps, min) in [(0.0, 1.0), (f64::NAN, 1.0), (0.1, 0.0), (0.1, -1.0)] {
-        assert!(solve_hierarchical(&scene, &bvh, eps, min, &NoProgress).is_err());
+    for (epsilon, min_area, tolerance) in [
+        (0.0, 1.0, 1e-6),
+        (f64::NAN, 1.0, 1e-6),
+        (0.1, 0.0, 1e-6),
+        (0.1, -1.0, 1e-6),
+        (0.1, 1.0, 0.0),
+        (0.1, 1.0, 1.0),
+    ] {
+        let settings = HierarchicalSettings {
+            epsilon,
+            min_area,
+            tolerance,
+        };
+        assert!(solve_hierarchical(&scene, &bvh, &settings, &NoProgress).is_err());
     }
 }
