@@ -587,6 +587,7 @@ fn solver(
                 epsilon: options.epsilon,
                 min_area,
                 tolerance,
+                max_memory_bytes: None,
             })
         }
     })

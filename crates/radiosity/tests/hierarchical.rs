@@ -27,6 +27,7 @@ fn solve(scene: &Scene, epsilon: f64, min_area: f64) -> HierarchicalSolution {
         epsilon,
         min_area,
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
+        max_memory_bytes: None,
     };
     solve_hierarchical(scene, &bvh, &settings, &NoProgress).unwrap()
 }
@@ -282,7 +283,32 @@ fn refuses_bad_settings() {
             epsilon,
             min_area,
             tolerance,
+            max_memory_bytes: None,
         };
         assert!(solve_hierarchical(&scene, &bvh, &settings, &NoProgress).is_err());
     }
+}
+
+#[test]
+fn refuses_to_outgrow_its_memory_limit() {
+    // The Cornell box at epsilon 0.01 holds about 340,000 links (over 10 MiB); with a 4 MiB
+    // limit refinement must stop with the error that says what to change, not allocate on.
+    let scene = cornell_box();
+    let bvh = occluder_bvh(&scene);
+    let settings = HierarchicalSettings {
+        epsilon: 0.01,
+        min_area: 125.0,
+        tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
+        max_memory_bytes: Some(4 << 20),
+    };
+    let err = solve_hierarchical(&scene, &bvh, &settings, &NoProgress).unwrap_err();
+    let text = err.to_string();
+    assert!(text.contains("--epsilon"), "{text}");
+    assert!(
+        matches!(
+            err,
+            radiosity::solve::SolveError::HierarchicalTooBig { limit_mib: 4, .. }
+        ),
+        "{err:?}"
+    );
 }

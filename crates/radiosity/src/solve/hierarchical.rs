@@ -121,6 +121,9 @@ pub struct HierarchicalSettings {
     /// Sweeps stop when sum A |dB| over the leaves is at most this fraction of the emitted
     /// power, in every band.
     pub tolerance: f64,
+    /// Refinement stops with [`SolveError::HierarchicalTooBig`] when nodes and links would
+    /// take more than this; `None`: 80 % of the memory available.
+    pub max_memory_bytes: Option<u64>,
 }
 
 /// How a hierarchical solve went.
@@ -392,6 +395,10 @@ struct Solver<'a> {
     occluders: &'a PolygonBvh,
     settings: HierarchicalSettings,
     rays: u64,
+    /// Links held by all nodes.
+    link_count: usize,
+    /// Refinement stops with an error when [`Solver::memory_bytes`] passes this.
+    memory_limit: u64,
 }
 
 impl Solver<'_> {
@@ -832,9 +839,18 @@ impl Solver<'_> {
     /// Refines the candidate pairs (p, q) breadth first until the oracle is satisfied,
     /// storing the resulting links (estimates in parallel, splits in order); returns whether
     /// anything was split.
-    fn refine(&mut self, mut frontier: Vec<(u32, u32)>, b_ref: f64) -> bool {
+    fn refine(&mut self, mut frontier: Vec<(u32, u32)>, b_ref: f64) -> Result<bool, SolveError> {
         let mut split = false;
         while !frontier.is_empty() {
+            let used = self.memory_bytes();
+            if used > self.memory_limit {
+                return Err(SolveError::HierarchicalTooBig {
+                    used_mib: used >> 20,
+                    limit_mib: self.memory_limit >> 20,
+                    nodes: self.nodes.len(),
+                    links: self.link_count,
+                });
+            }
             // A cluster's link to itself becomes the links between its children.
             let mut pairs = Vec::with_capacity(frontier.len());
             for &(p, q) in &frontier {
@@ -901,7 +917,10 @@ impl Solver<'_> {
                             next.push(if split_p { (c, other) } else { (other, c) });
                         }
                     }
-                    (None, Some(link)) => self.nodes[p as usize].links.push(link),
+                    (None, Some(link)) => {
+                        self.link_count += 1;
+                        self.nodes[p as usize].links.push(link);
+                    }
                     (None, None) => {
                         unreachable!("a pair that involves a cluster can always be split")
                     }
@@ -909,11 +928,18 @@ impl Solver<'_> {
             }
             frontier = next;
         }
-        split
+        Ok(split)
+    }
+
+    /// Bytes held by nodes, clusters and links (links with the slack of their vectors).
+    fn memory_bytes(&self) -> u64 {
+        (self.nodes.len() * (std::mem::size_of::<Node>() + 28)
+            + self.clusters.len() * (std::mem::size_of::<Cluster>() + CLUSTER_SAMPLES * 48)
+            + self.link_count * std::mem::size_of::<Link>() * 3 / 2) as u64
     }
 
     /// One refinement pass over all links with the current B; returns the links refined.
-    fn refine_all(&mut self, b_ref: f64) -> usize {
+    fn refine_all(&mut self, b_ref: f64) -> Result<usize, SolveError> {
         let mut pairs = Vec::new();
         for p in 0..self.nodes.len() {
             let links = std::mem::take(&mut self.nodes[p].links);
@@ -930,12 +956,13 @@ impl Solver<'_> {
             self.nodes[p].links = kept;
         }
         let refined = pairs.len();
+        self.link_count -= refined;
         if refined > 0 {
             // The pairs are estimated again (cheap next to their children) so that `refine`
             // handles them like any candidate.
-            self.refine(pairs, b_ref);
+            self.refine(pairs, b_ref)?;
         }
-        refined
+        Ok(refined)
     }
 
     /// Pushes irradiance down and pulls radiosity (and power bins) up from node `n`;
@@ -1144,6 +1171,7 @@ pub fn solve_hierarchical(
         epsilon,
         min_area,
         tolerance,
+        ..
     } = *settings;
     if !(epsilon.is_finite() && epsilon > 0.0) {
         return Err(SolveError::BadSettings(format!(
@@ -1201,7 +1229,18 @@ pub fn solve_hierarchical(
         occluders,
         settings: *settings,
         rays: 0,
+        link_count: 0,
+        memory_limit: settings
+            .max_memory_bytes
+            .unwrap_or_else(|| crate::form_factor::available_memory_bytes() / 10 * 8),
     };
+    progress.message(&format!(
+        "hierarchical radiosity: memory grows with the refinement, about {} bytes per node \
+         and {} per link; refinement stops with an error past {} MiB",
+        std::mem::size_of::<Node>() + 28,
+        std::mem::size_of::<Link>() * 3 / 2,
+        solver.memory_limit >> 20
+    ));
     for (s, surface) in scene.surfaces.iter().enumerate() {
         let v = &surface.vertices;
         solver
@@ -1254,7 +1293,7 @@ pub fn solve_hierarchical(
             // mean emission over 1 - the mean reflectance (area weighted, largest band).
             let b_ref = max3(solver.b[solver.top as usize]) / (1.0 - mean_rho).max(1e-3);
             let top = solver.top;
-            solver.refine(vec![(top, top)], b_ref);
+            solver.refine(vec![(top, top)], b_ref)?;
             let initial_links = solver.nodes.iter().map(|n| n.links.len()).sum();
             let (mut iterations, mut rounds, mut residual) = (0, 0, 0.0);
             if max3(emitted) == 0.0 {
@@ -1266,7 +1305,7 @@ pub fn solve_hierarchical(
                 iterations += sweeps;
                 residual = r;
                 let b_ref = max3(solver.b[solver.top as usize]);
-                let refined = solver.refine_all(b_ref);
+                let refined = solver.refine_all(b_ref)?;
                 progress.advance(1);
                 progress.message(&format!(
                     "hierarchical round {rounds}: {} nodes, {} links, {refined} refined",
@@ -1347,10 +1386,7 @@ pub fn solve_hierarchical(
         escaped: std::array::from_fn(|k| leaving[k] - carried[k]),
     };
     let links: usize = solver.nodes.iter().map(|n| n.links.len()).sum();
-    let memory_bytes = (solver.nodes.len() * (std::mem::size_of::<Node>() + 28)
-        + links * std::mem::size_of::<Link>()
-        + solver.clusters.len() * (std::mem::size_of::<Cluster>() + CLUSTER_SAMPLES * 48))
-        as u64;
+    let memory_bytes = solver.memory_bytes();
     let report = HierarchicalReport {
         leaves: leaf_ids.len(),
         nodes: solver.nodes.len(),
@@ -1413,7 +1449,10 @@ mod tests {
             DVec3::Y,
         ] {
             let d = d.normalize();
-            let want: f64 = patches.iter().map(|&(a, b, n)| a * b * n.dot(d).max(0.0)).sum();
+            let want: f64 = patches
+                .iter()
+                .map(|&(a, b, n)| a * b * n.dot(d).max(0.0))
+                .sum();
             let got = cluster_emission(&power, d);
             assert!((got[0] - want).abs() < 1e-12 * want, "{got:?} vs {want}");
         }

@@ -170,6 +170,22 @@ pub enum SolveError {
     /// The dense LU matrix would not fit in memory (nothing was allocated).
     #[error(transparent)]
     OutOfMemory(#[from] OutOfMemory),
+    /// Hierarchical radiosity's nodes and links would outgrow the memory.
+    #[error(
+        "hierarchical radiosity stopped refining at {nodes} nodes and {links} links: they \
+         take about {used_mib} MiB, past the limit of {limit_mib} MiB (80 % of the memory \
+         available unless set); raise --epsilon or --min-area"
+    )]
+    HierarchicalTooBig {
+        /// Estimated bytes held, in MiB.
+        used_mib: u64,
+        /// The limit, in MiB.
+        limit_mib: u64,
+        /// Nodes made.
+        nodes: usize,
+        /// Links held.
+        links: usize,
+    },
     /// Gauss-Seidel did not reach the tolerance within the allowed sweeps.
     #[error(
         "Gauss-Seidel did not converge: after {iterations} sweeps the relative residual is \
