@@ -374,6 +374,8 @@ enum Estimate {
     Nothing,
     /// A link, and the rays cast for it.
     Link(Link, u64),
+    /// The pair must be refined (the rays cast to decide).
+    Refine(u64),
 }
 
 struct Solver<'a> {
@@ -580,7 +582,15 @@ impl Solver<'_> {
     /// use 16 pairs (4 x 4 stratified points on each, paired by a fixed permutation) and
     /// only the occluders whose boxes overlap the pair's box (none: visible, no ray);
     /// cluster links use up to four pairs of their sample points and the whole BVH.
-    fn visibility(&self, p: u32, q: u32, scratch: &mut Vec<u32>) -> (f64, u64, u32) {
+    /// With `any_open`, stops at the first open facing pair (the fraction is then only
+    /// known to be positive).
+    fn visibility(
+        &self,
+        p: u32,
+        q: u32,
+        any_open: bool,
+        scratch: &mut Vec<u32>,
+    ) -> (f64, u64, u32) {
         let (np, nq) = (&self.nodes[p as usize], &self.nodes[q as usize]);
         let occ = self.occluders;
         let mut pairs = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); 16];
@@ -669,6 +679,9 @@ impl Solver<'_> {
             if faces {
                 facing += 1;
                 visible += u32::from(open);
+                if any_open && open {
+                    break;
+                }
             }
             all_visible += u32::from(open);
         }
@@ -722,7 +735,7 @@ impl Solver<'_> {
     }
 
     /// Estimates the link p <- q.
-    fn estimate(&self, p: u32, q: u32, scratch: &mut Vec<u32>) -> Estimate {
+    fn estimate(&self, p: u32, q: u32, b_ref: f64, scratch: &mut Vec<u32>) -> Estimate {
         let (np, nq) = (&self.nodes[p as usize], &self.nodes[q as usize]);
         let v = np.centre - nq.centre;
         let r = v.length();
@@ -788,7 +801,31 @@ impl Solver<'_> {
         if g <= 0.0 && oracle <= 0.0 {
             return Estimate::Nothing;
         }
-        let (fraction, rays, facing) = self.visibility(p, q, scratch);
+        let link = Link {
+            source: q,
+            g: g as f32,
+            oracle: oracle as f32,
+            dir: [d.x as f32, d.y as f32, d.z as f32],
+        };
+        let cluster_link = np.is_cluster() || nq.is_cluster();
+        if self.wants_refining(p, &link, b_ref) && self.split_choice(p, q).is_some() {
+            // Refined whatever its visibility (see the oracle below), unless two patches
+            // are wholly hidden from each other: then the pair carries nothing. Either way
+            // no visible fraction is needed.
+            if cluster_link {
+                return Estimate::Refine(0);
+            }
+            let (fraction, rays, facing) = self.visibility(p, q, true, scratch);
+            return if fraction == 0.0 && facing >= 8 {
+                Estimate::Nothing
+            } else {
+                Estimate::Refine(rays)
+            };
+        }
+        let (fraction, rays, facing) = self.visibility(p, q, false, scratch);
+        if fraction == 0.0 && facing >= 8 && !cluster_link {
+            return Estimate::Nothing;
+        }
         Estimate::Link(
             Link {
                 source: q,
@@ -875,7 +912,7 @@ impl Solver<'_> {
                         // Expanded again next time round (a child cluster's self-link).
                         Estimate::TooClose
                     } else {
-                        this.estimate(p, q, scratch)
+                        this.estimate(p, q, b_ref, scratch)
                     }
                 })
                 .collect();
@@ -893,6 +930,10 @@ impl Solver<'_> {
                     Estimate::Link(link, rays) => {
                         self.rays += rays;
                         Some(link)
+                    }
+                    Estimate::Refine(rays) => {
+                        self.rays += rays;
+                        None
                     }
                 };
                 let refine = match &link {
@@ -922,7 +963,7 @@ impl Solver<'_> {
                         self.nodes[p as usize].links.push(link);
                     }
                     (None, None) => {
-                        unreachable!("a pair that involves a cluster can always be split")
+                        unreachable!("a pair without a link is one that can be split")
                     }
                 }
             }
