@@ -900,6 +900,19 @@ fn mib(bytes: Option<u64>, reset: bool) -> String {
     }
 }
 
+/// A solver and its main settings, short enough for a table cell.
+fn short_name(solver: &Solver) -> String {
+    match solver {
+        Solver::Lu => "lu".into(),
+        Solver::GaussSeidel { tolerance, .. } => format!("gauss-seidel {tolerance:e}"),
+        Solver::Progressive { tolerance, .. } => format!("progressive {tolerance:e}"),
+        Solver::Hierarchical(h) => format!(
+            "hierarchical eps {} min {} tol {:e}",
+            h.epsilon, h.min_area, h.tolerance
+        ),
+    }
+}
+
 fn compare_command(args: CompareArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
@@ -953,8 +966,9 @@ fn compare_command(args: CompareArgs) -> Result<()> {
     outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense time (s) | dense peak (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
     outln!("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     outln!(
-        "| {stem} | {} | {solver} | {elements} | {time:.2} | {} | {} | {} | {} | {} | {} |",
+        "| {stem} | {} | {} | {elements} | {time:.2} | {} | {} | {} | {} | {} | {} |",
         prepared.mesh.len(),
+        short_name(&solver),
         mib(peak, reset),
         reference.0,
         reference.1,
