@@ -71,10 +71,10 @@
 //! # Accuracy
 //!
 //! On the Cornell box at epsilon 0.01 the per-surface mean radiosity is within 2.5 % RMS of
-//! the dense solve and about 1 % darker; element by element the difference is 7 % RMS,
-//! mostly along shadow edges and block footprints, where each solution's elements straddle
-//! the discontinuity differently (two dense solves on meshes 4x apart differ by 2.5 % by the
-//! same measure; see [`crate::compare`] and BENCHMARKS.md).
+//! the dense solve and 1 % darker; averaged over each dense element the difference is 6-7 %
+//! RMS (3.7 % at epsilon 0.003), mostly along shadow edges and block footprints, where
+//! coarse links push one irradiance to children that an occluder hides from part of the
+//! source (see [`crate::compare`] and BENCHMARKS.md).
 //!
 //! # Energy account
 //!
