@@ -18,6 +18,7 @@ macro_rules! outln {
 }
 
 mod progress_bar;
+mod view;
 
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -63,6 +64,8 @@ enum Command {
     /// Time the whole pipeline (parse, mesh, BVH, form factors, solve, shade, render) and
     /// print one Markdown table row per MAX_PATCH_AREA with the median time of each stage.
     Bench(BenchArgs),
+    /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
+    View(view::ViewArgs),
     /// Generate a scene file procedurally.
     Generate {
         #[command(subcommand)]
@@ -374,6 +377,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Solve(args) => solve_command(args),
         Command::Check(args) => check_command(args),
         Command::Bench(args) => bench_command(args),
+        Command::View(args) => view::view_command(args),
         Command::Generate {
             what: GenerateCommand::Building(args),
         } => generate_building(args),
