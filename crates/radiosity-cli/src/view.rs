@@ -31,6 +31,9 @@ pub struct ViewArgs {
     /// Show the modeller panel in the `--screenshot` (the window always shows it otherwise).
     #[arg(long)]
     panel: bool,
+    /// Select the first surface whose name starts with this (as a click on it would).
+    #[arg(long, value_name = "NAME")]
+    select: Option<String>,
     /// No window: measure frame time offscreen (Cornell box and a tiled scene of
     /// `--bench-triangles`) and edit-to-picture time at `--bench-elements`, print Markdown.
     #[arg(long)]
@@ -86,6 +89,7 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
     options.screenshot = args.screenshot;
     options.frames = args.frames;
     options.panel = args.panel;
+    options.select = args.select;
     for note in radiosity_viewer::run(options)? {
         outln!("{note}");
     }

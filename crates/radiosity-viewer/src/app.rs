@@ -190,6 +190,17 @@ impl ViewerApp {
                     self.mesh = Some(mesh);
                     self.bvh = Some(bvh);
                     self.gpu_mesh_pending = true;
+                    if let Some(prefix) = &self.options.select {
+                        self.selected = self
+                            .modeller
+                            .scene
+                            .surfaces
+                            .iter()
+                            .position(|s| s.name.starts_with(prefix.as_str()));
+                        self.emission_edit = self
+                            .selected
+                            .map(|s| EmissionEdit::of(self.modeller.colours(s).emission));
+                    }
                 }
                 Update::Solution {
                     element_b,
@@ -349,7 +360,7 @@ impl ViewerApp {
             } else {
                 0.0
             };
-            ui.add(egui::ProgressBar::new(fraction).text(format!("{stage}…")));
+            ui.add(egui::ProgressBar::new(fraction).text(format!("{stage}...")));
             if !self.solve_note.is_empty() {
                 ui.label(&self.solve_note);
             }
@@ -419,8 +430,8 @@ impl ViewerApp {
                 let (first, converged) = self.edit_timing;
                 if let Some(first) = first {
                     ui.label(format!(
-                        "edit → picture: {first:.0} ms first, {} converged",
-                        converged.map_or("…".to_string(), |c| format!("{c:.0} ms"))
+                        "edit to picture: {first:.0} ms (first sweep), {} (converged)",
+                        converged.map_or("...".to_string(), |c| format!("{c:.0} ms"))
                     ));
                 }
             }
@@ -452,9 +463,9 @@ impl ViewerApp {
         }
         ui.separator();
         ui.small(
-            "W/S or ↑/↓: forward/back · A/D or ←/→: left/right · E/Q or PgUp/PgDn: up/down · \
-             drag: look · wheel: speed · click: select · Tab: panel · P or F12: screenshot · \
-             Ctrl+Z: undo · Ctrl+S: save",
+            "W/S or Up/Down: forward/back · A/D or Left/Right: left/right · E/Q or \
+             PageUp/PageDown: up/down · drag: look · wheel: speed · click: select · Tab: panel · \
+             P or F12: screenshot · Ctrl+Z: undo · Ctrl+S: save",
         );
         if let Some(c) = &self.controller {
             ui.small(format!("speed {:.3} units/s", c.speed));

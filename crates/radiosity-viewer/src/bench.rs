@@ -76,9 +76,12 @@ pub fn frame_time(
     }
 }
 
+/// A solved scene: the scene, its mesh, radiosity per element, the automatic exposure.
+pub type Solved = (Scene, Mesh, Vec<[f64; 3]>, f64);
+
 /// The Cornell box's mesh at `max_area` with its solution (dense Gauss-Seidel) and the
 /// exposure scale of its default view.
-pub fn solved_cornell(max_area: f64) -> Result<(Scene, Mesh, Vec<[f64; 3]>, f64), String> {
+pub fn solved_cornell(max_area: f64) -> Result<Solved, String> {
     let prepared = Prepared::new(
         cornell_box(),
         Overrides {

@@ -63,6 +63,9 @@ pub struct ViewerOptions {
     pub panel: bool,
     /// Window size in points.
     pub size: [f32; 2],
+    /// Select the first surface whose name starts with this once the mesh is ready (for
+    /// screenshots of the modeller).
+    pub select: Option<String>,
 }
 
 impl ViewerOptions {
@@ -77,6 +80,7 @@ impl ViewerOptions {
             frames: 30,
             panel: false,
             size: [1280.0, 800.0],
+            select: None,
         }
     }
 }

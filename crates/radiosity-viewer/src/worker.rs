@@ -214,6 +214,7 @@ fn run(
         match &matrix {
             Some(f) => {
                 *progress.shared.stage.lock().unwrap() = "solve";
+                progress.shared.total.store(0, Ordering::Relaxed);
                 let report = resolve(f, &rho, &e, &mut b, VIEW_TOLERANCE, 10_000, |b, change| {
                     if let Ok(Some(r)) = newest(edits) {
                         interrupted = Some(r);
@@ -245,6 +246,7 @@ fn run(
             }
             None => {
                 *progress.shared.stage.lock().unwrap() = "progressive";
+                progress.shared.total.store(0, Ordering::Relaxed);
                 let start = Instant::now();
                 let mut observer = |state: &radiosity::solve::ProgressiveState| {
                     if let Ok(Some(r)) = newest(edits) {
