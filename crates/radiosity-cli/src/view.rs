@@ -8,6 +8,7 @@ use clap::Args;
 
 /// Options of `radiosity view`.
 #[derive(Args)]
+#[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub struct ViewArgs {
     /// Scene file (Appendix A format); the built-in Cornell box when omitted.
     scene: Option<PathBuf>,

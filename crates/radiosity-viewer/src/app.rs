@@ -208,7 +208,7 @@ impl ViewerApp {
                     note,
                     edit,
                 } => {
-                    if edit == 0 && (self.auto_scale.is_none() || !self.solved) {
+                    if (edit == 0 && !self.solved) || self.auto_scale.is_none() {
                         if let Some(mesh) = &self.mesh {
                             self.auto_scale = Some(Exposure::Brightest.scale(
                                 &self.modeller.scene,

@@ -244,6 +244,30 @@ mod tests {
         assert_eq!(m.undo(), None);
     }
 
+    #[test]
+    fn saved_edits_read_back_in_the_papers_format() {
+        let mut m = Modeller::new(cornell_box());
+        let s = m
+            .scene
+            .surfaces
+            .iter()
+            .position(|s| s.name == "Floor")
+            .unwrap();
+        let colours = SurfaceColours {
+            reflectance: Rgb([0.25, 0.5, 0.125]),
+            emission: Rgb([1.5, 0.0, 3.25]),
+        };
+        m.set(s, colours, false);
+        let path =
+            std::env::temp_dir().join(format!("radiosity-modeller-{}.scene", std::process::id()));
+        radiosity::scene::write_scene_file(&m.scene, &path).unwrap();
+        let back = radiosity::scene::read_scene(&path).unwrap();
+        let _ = std::fs::remove_file(&path);
+        assert_eq!(back.surfaces[s].reflectance, colours.reflectance);
+        assert_eq!(back.surfaces[s].emission, colours.emission);
+        assert_eq!(back.surfaces.len(), m.scene.surfaces.len());
+    }
+
     /// The modeller's re-solve after a reflectance change equals a fresh full solve of the
     /// edited scene.
     ///

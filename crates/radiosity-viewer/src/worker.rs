@@ -315,3 +315,84 @@ fn recoloured(prepared: &mut Prepared, r: Recolour) -> (Vec<[f64; 3]>, Vec<[f64;
     let (rho, e) = element_properties(&prepared.mesh, &prepared.scene);
     (rho, e, r.edit)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiosity::progress::NoProgress;
+    use radiosity::scene::cornell_box;
+    use radiosity::solve::Solver;
+
+    /// Waits for the converged solution answering `edit`.
+    fn converged(updates: &Receiver<Update>, edit: u64) -> Vec<[f64; 3]> {
+        loop {
+            match updates
+                .recv_timeout(Duration::from_secs(120))
+                .expect("worker answers")
+            {
+                Update::Solution {
+                    element_b,
+                    done: true,
+                    edit: e,
+                    ..
+                } if e == edit => return element_b,
+                Update::Error(m) => panic!("worker failed: {m}"),
+                _ => {}
+            }
+        }
+    }
+
+    /// The window's path: the worker solves, gets new colours, re-solves from its cached
+    /// matrix; the result equals a fresh solve of the edited scene within the viewer's
+    /// tolerance (largest sweep change 1e-6 of max E, so an error of at most
+    /// 1e-6 / (1 - 0.8) = 5e-6 of max E with rho <= 0.8; checked at 1e-5).
+    #[test]
+    fn worker_resolves_an_edit_like_a_fresh_solve() {
+        let overrides = Overrides {
+            max_patch_area: Some(8000.0),
+            integral_steps: Some(2),
+        };
+        let scene = cornell_box();
+        let (edits, updates, _) = spawn(scene.clone(), overrides, Strategy::Auto, Arc::new(|| {}));
+        converged(&updates, 0);
+        let mut edited = scene.clone();
+        for s in edited
+            .surfaces
+            .iter_mut()
+            .filter(|s| s.name.starts_with("Tall block"))
+        {
+            s.reflectance = Rgb([0.2, 0.3, 0.75]);
+        }
+        edits
+            .send(Recolour {
+                colours: edited
+                    .surfaces
+                    .iter()
+                    .map(|s| (s.reflectance, s.emission))
+                    .collect(),
+                edit: 1,
+            })
+            .unwrap();
+        let b = converged(&updates, 1);
+
+        let fresh = Prepared::new(edited, overrides, &NoProgress).unwrap();
+        let (f, _) = fresh.form_factors(&NoProgress).unwrap();
+        let solution = fresh
+            .solve(&f, Solver::DEFAULT_GAUSS_SEIDEL, &NoProgress)
+            .unwrap();
+        let max_e = fresh
+            .scene
+            .surfaces
+            .iter()
+            .map(|s| s.emission.max_band())
+            .fold(0.0, f64::max);
+        for (i, bi) in b.iter().enumerate() {
+            for (x, y) in bi.iter().zip(solution.radiosity.element(i)) {
+                assert!(
+                    (x - y).abs() < 1e-5 * max_e,
+                    "element {i}: worker {x}, fresh solve {y} (max E {max_e})"
+                );
+            }
+        }
+    }
+}
