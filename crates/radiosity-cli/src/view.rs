@@ -32,6 +32,9 @@ pub struct ViewArgs {
     /// Show the modeller panel in the `--screenshot` (the window always shows it otherwise).
     #[arg(long)]
     panel: bool,
+    /// The shading the window starts with: smooth, flat or wireframe.
+    #[arg(long, default_value = "smooth", value_name = "MODE")]
+    shading: String,
     /// Select the first surface whose name starts with this (as a click on it would).
     #[arg(long, value_name = "NAME")]
     select: Option<String>,
@@ -91,6 +94,12 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
     options.frames = args.frames;
     options.panel = args.panel;
     options.select = args.select;
+    options.shading = match args.shading.as_str() {
+        "smooth" => radiosity::render::Shading::Smooth,
+        "flat" => radiosity::render::Shading::Flat,
+        "wireframe" => radiosity::render::Shading::Wireframe,
+        other => bail!("--shading must be smooth, flat or wireframe, got {other}"),
+    };
     for note in radiosity_viewer::run(options)? {
         outln!("{note}");
     }

@@ -156,7 +156,7 @@ impl ViewerApp {
             gpu,
             controller: None,
             drag_look: false,
-            shading: Shading::Smooth,
+            shading: options.shading,
             exposure_stops: 0.0,
             auto_scale: None,
             gamma: 2.2,

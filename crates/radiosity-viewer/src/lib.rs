@@ -66,6 +66,8 @@ pub struct ViewerOptions {
     /// Select the first surface whose name starts with this once the mesh is ready (for
     /// screenshots of the modeller).
     pub select: Option<String>,
+    /// The shading the window starts with.
+    pub shading: radiosity::render::Shading,
 }
 
 impl ViewerOptions {
@@ -81,6 +83,7 @@ impl ViewerOptions {
             panel: false,
             size: [1280.0, 800.0],
             select: None,
+            shading: radiosity::render::Shading::Smooth,
         }
     }
 }
