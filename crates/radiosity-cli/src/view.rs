@@ -19,9 +19,14 @@ pub struct ViewArgs {
     #[arg(long, value_name = "K")]
     steps: Option<u32>,
     /// Always solve by progressive refinement (no form-factor matrix; colour edits re-run
-    /// it). By default the dense solve is used when it fits, as `--solver auto` chooses.
-    #[arg(long)]
+    /// it). By default the dense solve is used up to 6,000 elements (see --dense).
+    #[arg(long, conflicts_with = "dense")]
     progressive: bool,
+    /// Compute the dense form-factor matrix whenever it fits (up to 20,000 elements), so
+    /// edits are quick re-solves; by default only up to 6,000 elements, beyond which
+    /// progressive refinement shows light sooner.
+    #[arg(long)]
+    dense: bool,
     /// Open the window, draw `--frames` frames of the solved scene, save the window to this
     /// PNG and exit.
     #[arg(long, value_name = "FILE")]
@@ -89,6 +94,8 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
     };
     if args.progressive {
         options.strategy = Strategy::Progressive;
+    } else if args.dense {
+        options.strategy = Strategy::Dense;
     }
     options.screenshot = args.screenshot;
     options.frames = args.frames;

@@ -105,11 +105,21 @@ impl Progress for Reporter {
     }
 }
 
+/// The most elements [`Strategy::Auto`] computes the dense matrix for: about 5 s of form
+/// factors on two cores for the Cornell box (BENCHMARKS.md), more in cluttered scenes, with
+/// nothing lit on screen meanwhile. Beyond it progressive refinement shows light at once.
+pub const VIEW_DENSE_MAX_ELEMENTS: usize = 6_000;
+
 /// How the worker solves.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Strategy {
-    /// `choose_dense`'s choice (dense up to 20,000 elements and half the memory).
+    /// The dense matrix (cached, so edits are re-solves) when `choose_dense` allows it and
+    /// there are at most [`VIEW_DENSE_MAX_ELEMENTS`] elements; progressive refinement
+    /// otherwise.
     Auto,
+    /// The dense matrix whenever `choose_dense` allows it (up to 20,000 elements and half
+    /// the memory), however long the form factors take.
+    Dense,
     /// Always progressive refinement (no matrix; edits re-run it).
     Progressive,
 }
@@ -176,11 +186,29 @@ fn run(
         Arc::new(PolygonBvh::new(&polygons, &ids)),
     ));
     let n = mesh.len();
+    let fits = || {
+        let (dense, why) = choose_dense(n, radiosity::form_factor::available_memory_bytes());
+        (dense && prepared.check_memory(None).is_ok(), why)
+    };
     let dense = match strategy {
         Strategy::Auto => {
-            let (dense, why) = choose_dense(n, radiosity::form_factor::available_memory_bytes());
+            let (fits, why) = fits();
+            if fits && n > VIEW_DENSE_MAX_ELEMENTS {
+                progress.message(&format!(
+                    "{n} elements: more than {VIEW_DENSE_MAX_ELEMENTS}, so progressive refinement \
+                     shows light at once instead of waiting for every form factor (--dense \
+                     computes the matrix, for live edits)"
+                ));
+                false
+            } else {
+                progress.message(&why);
+                fits
+            }
+        }
+        Strategy::Dense => {
+            let (fits, why) = fits();
             progress.message(&why);
-            dense && prepared.check_memory(None).is_ok()
+            fits
         }
         Strategy::Progressive => false,
     };
