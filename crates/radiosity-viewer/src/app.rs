@@ -42,17 +42,31 @@ struct GpuView {
 struct EmissionEdit {
     colour: [f32; 3],
     strength: f64,
+    /// The strength slider's upper end, fixed while the surface is selected (a range that
+    /// followed the value would run away while dragged).
+    top: f64,
 }
 
 impl EmissionEdit {
-    fn of(e: Rgb) -> EmissionEdit {
+    /// The edit state of emission `e` in `scene`: the slider reaches four times the
+    /// brightest emitter of the scene (or of `e`), at least 1.
+    fn of(e: Rgb, scene: &radiosity::scene::Scene) -> EmissionEdit {
         let strength = e.max_band();
         let colour = if strength > 0.0 {
             e.0.map(|x| (x / strength) as f32)
         } else {
             [1.0; 3]
         };
-        EmissionEdit { colour, strength }
+        let brightest = scene
+            .surfaces
+            .iter()
+            .map(|s| s.emission.max_band())
+            .fold(strength, f64::max);
+        EmissionEdit {
+            colour,
+            strength,
+            top: (4.0 * brightest).max(1.0),
+        }
     }
 
     fn rgb(&self) -> Rgb {
@@ -92,8 +106,8 @@ pub(crate) struct ViewerApp {
     last_change: Option<(usize, Instant)>,
     edit_seq: u64,
     edit_sent: VecDeque<(u64, Instant)>,
-    /// (first picture, converged picture) of the last edit, ms.
-    edit_timing: (Option<f64>, Option<f64>),
+    /// (edit, first picture, converged picture) of the last edit timed, ms.
+    edit_timing: (u64, Option<f64>, Option<f64>),
     pending_timing: Option<(u64, Instant, bool)>,
 
     frame_times: VecDeque<f64>,
@@ -166,7 +180,7 @@ impl ViewerApp {
             last_change: None,
             edit_seq: 0,
             edit_sent: VecDeque::new(),
-            edit_timing: (None, None),
+            edit_timing: (0, None, None),
             pending_timing: None,
             frame_times: VecDeque::new(),
             last_frame: None,
@@ -197,9 +211,12 @@ impl ViewerApp {
                             .surfaces
                             .iter()
                             .position(|s| s.name.starts_with(prefix.as_str()));
-                        self.emission_edit = self
-                            .selected
-                            .map(|s| EmissionEdit::of(self.modeller.colours(s).emission));
+                        self.emission_edit = self.selected.map(|s| {
+                            EmissionEdit::of(
+                                self.modeller.colours(s).emission,
+                                &self.modeller.scene,
+                            )
+                        });
                     }
                 }
                 Update::Solution {
@@ -284,7 +301,10 @@ impl ViewerApp {
         if let Some(s) = self.modeller.undo() {
             self.last_change = None;
             if self.selected == Some(s) {
-                self.emission_edit = Some(EmissionEdit::of(self.modeller.colours(s).emission));
+                self.emission_edit = Some(EmissionEdit::of(
+                    self.modeller.colours(s).emission,
+                    &self.modeller.scene,
+                ));
             }
             self.send_edit();
         }
@@ -319,7 +339,7 @@ impl ViewerApp {
     }
 
     fn keys(&self, ctx: &egui::Context) -> MoveKeys {
-        if ctx.egui_wants_keyboard_input() {
+        if ctx.text_edit_focused() {
             return MoveKeys::default();
         }
         ctx.input(|i| {
@@ -411,15 +431,14 @@ impl ViewerApp {
                 });
                 let mut em = self
                     .emission_edit
-                    .unwrap_or_else(|| EmissionEdit::of(colours.emission));
+                    .unwrap_or_else(|| EmissionEdit::of(colours.emission, &self.modeller.scene));
                 ui.horizontal(|ui| {
                     ui.label("emission");
                     changed |=
                         egui::color_picker::color_edit_button_rgb(ui, &mut em.colour).changed();
                 });
-                let top = (4.0 * em.strength).max(100.0);
                 changed |= ui
-                    .add(egui::Slider::new(&mut em.strength, 0.0..=top).text("strength"))
+                    .add(egui::Slider::new(&mut em.strength, 0.0..=em.top).text("strength"))
                     .changed();
                 if changed {
                     colours.reflectance = Rgb(rho.map(f64::from));
@@ -427,7 +446,7 @@ impl ViewerApp {
                     self.emission_edit = Some(em);
                     self.apply_edit(s, colours);
                 }
-                let (first, converged) = self.edit_timing;
+                let (_, first, converged) = self.edit_timing;
                 if let Some(first) = first {
                     ui.label(format!(
                         "edit to picture: {first:.0} ms (first sweep), {} (converged)",
@@ -523,6 +542,16 @@ impl ViewerApp {
         }
         let camera = self.controller.map(|c| c.camera(width, height));
 
+        // A click or drag in the view takes the keyboard back from the panel's widgets
+        // (a slider keeps focus after it is used, and would take the arrow keys).
+        if response.clicked() || response.drag_started() {
+            ui.memory_mut(|m| {
+                if let Some(id) = m.focused() {
+                    m.surrender_focus(id);
+                }
+            });
+        }
+
         // Pick the surface under a click.
         if response.clicked() {
             if let (Some(pos), Some(cam), Some(bvh), Some(mesh)) = (
@@ -538,9 +567,9 @@ impl ViewerApp {
                 let far = (cam.eye - 0.5 * (lo + hi)).length() + (hi - lo).length();
                 let hit = bvh.closest_hit(cam.eye, dir, 0.0, far);
                 self.selected = hit.map(|h| mesh.elements[h.id as usize].surface as usize);
-                self.emission_edit = self
-                    .selected
-                    .map(|s| EmissionEdit::of(self.modeller.colours(s).emission));
+                self.emission_edit = self.selected.map(|s| {
+                    EmissionEdit::of(self.modeller.colours(s).emission, &self.modeller.scene)
+                });
                 self.last_change = None;
                 if self.selected.is_some() {
                     self.show_panel = true;
@@ -613,16 +642,16 @@ impl ViewerApp {
             );
         }
         if drew {
-            if let Some((_, sent, done)) = self.pending_timing.take() {
+            if let Some((edit, sent, done)) = self.pending_timing.take() {
                 let ms = sent.elapsed().as_secs_f64() * 1e3;
-                if done {
-                    if self.edit_timing.0.is_none() {
-                        self.edit_timing.0 = Some(ms);
-                    }
-                    self.edit_timing.1 = Some(ms);
-                } else {
-                    self.edit_timing = (Some(ms), None);
-                }
+                let converged = done.then_some(ms);
+                self.edit_timing = match self.edit_timing {
+                    // A later picture of the same edit: only the converged time is new.
+                    (k, first, _) if k == edit => (k, first, converged),
+                    // The first picture of this edit (converged already when the solve
+                    // took less than one snapshot interval).
+                    _ => (edit, Some(ms), converged),
+                };
             }
         }
 
@@ -669,7 +698,7 @@ impl eframe::App for ViewerApp {
         let ctx = ui.ctx().clone();
 
         // Keyboard shortcuts
-        if !ctx.egui_wants_keyboard_input() {
+        if !ctx.text_edit_focused() {
             let (tab, shot, undo, save) = ctx.input(|i| {
                 (
                     i.key_pressed(egui::Key::Tab),
