@@ -64,6 +64,10 @@ enum Command {
     /// Time the whole pipeline (parse, mesh, BVH, form factors, solve, shade, render) and
     /// print one Markdown table row per MAX_PATCH_AREA with the median time of each stage.
     Bench(BenchArgs),
+    /// Solve a scene with one solver and with the dense reference (area-method form
+    /// factors, Gauss-Seidel) on the same mesh; print time, peak memory and the difference
+    /// of element radiosity as a Markdown table row.
+    Compare(CompareArgs),
     /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
     View(view::ViewArgs),
     /// Generate a scene file procedurally.
@@ -204,7 +208,7 @@ enum MethodArg {
 #[derive(Clone, Copy, ValueEnum)]
 enum SolverArg {
     /// Gauss-Seidel on the dense matrix when it fits comfortably and the scene is small,
-    /// progressive refinement otherwise; says which and why.
+    /// hierarchical radiosity otherwise; says which and why.
     Auto,
     /// LU factorisation with partial pivoting (the paper's Gaussian elimination).
     Lu,
@@ -312,6 +316,17 @@ struct CheckArgs {
 }
 
 #[derive(Args)]
+struct CompareArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    solve: SolveOptions,
+    /// Only time the solver (no dense reference).
+    #[arg(long)]
+    no_reference: bool,
+}
+
+#[derive(Args)]
 struct BenchArgs {
     /// Scene file (Appendix A format); the built-in Cornell box when omitted.
     scene: Option<PathBuf>,
@@ -377,6 +392,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Solve(args) => solve_command(args),
         Command::Check(args) => check_command(args),
         Command::Bench(args) => bench_command(args),
+        Command::Compare(args) => compare_command(args),
         Command::View(args) => view::view_command(args),
         Command::Generate {
             what: GenerateCommand::Building(args),
@@ -525,7 +541,7 @@ fn solver(
             if dense {
                 SolverArg::GaussSeidel
             } else {
-                SolverArg::Progressive
+                SolverArg::Hierarchical
             }
         }
         other => other,
@@ -565,10 +581,18 @@ fn solver(
             if !(min_area > 0.0 && min_area.is_finite()) {
                 bail!("--min-area must be a positive number, got {min_area}");
             }
-            Solver::Hierarchical {
+            let tolerance = options
+                .tolerance
+                .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
+            if !(tolerance > 0.0 && tolerance < 1.0) {
+                bail!("--tolerance must be a number in (0, 1) for --solver hierarchical, got {tolerance}");
+            }
+            Solver::Hierarchical(radiosity::solve::HierarchicalSettings {
                 epsilon: options.epsilon,
                 min_area,
-            }
+                tolerance,
+                max_memory_bytes: None,
+            })
         }
     })
 }
@@ -595,8 +619,8 @@ fn solve_scene(
         let solution = prepared.solve_progressive(tolerance, max_shots, observer, reporter)?;
         return Ok((solution, None));
     }
-    if let Solver::Hierarchical { epsilon, min_area } = solver {
-        let solution = prepared.solve_hierarchical(epsilon, min_area, reporter)?;
+    if let Solver::Hierarchical(settings) = solver {
+        let solution = prepared.solve_hierarchical(&settings, reporter)?;
         return Ok((solution, None));
     }
     let (f, stats) = form_factors(prepared, file, reporter)?;
@@ -613,7 +637,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
     let solver = solver.expect("prepare resolves the solver it is given options for");
     if args.snapshots.is_some() && solver.needs_matrix() {
-        bail!("--snapshots needs --solver progressive (or auto choosing it)");
+        bail!("--snapshots needs --solver progressive");
     }
     let camera = camera(&args, &prepared.scene)?;
     let exposure = parse_exposure(&args.exposure)?;
@@ -858,6 +882,108 @@ fn solve_command(args: SolveArgs) -> Result<()> {
     Ok(())
 }
 
+/// Resets the process's peak resident memory (Linux: `/proc/self/clear_refs`), so that
+/// [`peak_memory_bytes`] measures from now; false where that is not possible.
+fn reset_peak_memory() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// The process's peak resident memory (VmHWM) in bytes, where the system reports it.
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+fn mib(bytes: Option<u64>, reset: bool) -> String {
+    match bytes {
+        Some(b) if reset => format!("{:.0}", b as f64 / (1024.0 * 1024.0)),
+        Some(b) => format!("<= {:.0}", b as f64 / (1024.0 * 1024.0)),
+        None => "?".into(),
+    }
+}
+
+/// A solver and its main settings, short enough for a table cell.
+fn short_name(solver: &Solver) -> String {
+    match solver {
+        Solver::Lu => "lu".into(),
+        Solver::GaussSeidel { tolerance, .. } => format!("gauss-seidel {tolerance:e}"),
+        Solver::Progressive { tolerance, .. } => format!("progressive {tolerance:e}"),
+        Solver::Hierarchical(h) => format!(
+            "hierarchical eps {} min {} tol {:e}",
+            h.epsilon, h.min_area, h.tolerance
+        ),
+    }
+}
+
+fn compare_command(args: CompareArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let reset = reset_peak_memory();
+    let start = std::time::Instant::now();
+    let (solution, _) = solve_scene(
+        &prepared,
+        solver,
+        args.solve.form_factors.as_deref(),
+        &mut |_| ControlFlow::Continue(()),
+        &reporter,
+    )?;
+    let time = start.elapsed().as_secs_f64();
+    let peak = peak_memory_bytes();
+    let elements = solution.mesh(&prepared).len();
+    let mut reference = ("-".to_string(), "-".to_string(), "-".to_string());
+    let mut difference = ("-".to_string(), "-".to_string(), "-".to_string());
+    if !args.no_reference {
+        let dense = Solver::DEFAULT_GAUSS_SEIDEL;
+        match prepared.check_memory(Some(dense)) {
+            Err(e) => reporter.note(&format!("no dense reference: {e}")),
+            Ok(()) => {
+                let reset = reset_peak_memory();
+                let start = std::time::Instant::now();
+                let (f, _) = prepared.form_factors(&reporter)?;
+                let exact = prepared.solve(&f, dense, &reporter)?;
+                drop(f);
+                reference = (
+                    format!("{:.2}", start.elapsed().as_secs_f64()),
+                    mib(peak_memory_bytes(), reset),
+                    String::new(),
+                );
+                let (_, emission) =
+                    radiosity::solve::element_properties(&prepared.mesh, &prepared.scene);
+                let c = radiosity::compare::compare(
+                    &prepared.mesh,
+                    &exact.radiosity,
+                    &emission,
+                    solution.mesh(&prepared),
+                    &solution.radiosity,
+                )?;
+                difference = (
+                    format!("{:.2}", 100.0 * c.rms),
+                    format!("{:.1}", 100.0 * c.max),
+                    format!("{:+.2}", 100.0 * c.bias),
+                );
+            }
+        }
+    }
+    outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense time (s) | dense peak (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
+    outln!("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    outln!(
+        "| {stem} | {} | {} | {elements} | {time:.2} | {} | {} | {} | {} | {} | {} |",
+        prepared.mesh.len(),
+        short_name(&solver),
+        mib(peak, reset),
+        reference.0,
+        reference.1,
+        difference.0,
+        difference.1,
+        difference.2
+    );
+    reporter.print_timings();
+    Ok(())
+}
+
 /// Prints the accuracy table of `form_factor::accuracy` as Markdown.
 fn compare_methods(max_area: f64) {
     use radiosity::form_factor::accuracy::{measure, standard_methods};
@@ -1005,12 +1131,15 @@ fn check_command(args: CheckArgs) -> Result<()> {
         }
         SolutionReport::Hierarchical(report) => {
             outln!(
-                "hierarchical      {} leaves, {} links ({} initial, O(s^2), no clustering), {} rounds, {} sweeps, {} rays, {:.3} s",
+                "hierarchical      {} leaves, {} clusters, {} links ({} before the first solve), about {:.0} MiB, {} rounds, {} sweeps (changing power {:.1e} of emitted), {} rays, {:.3} s",
                 report.leaves,
+                report.clusters,
                 report.links,
                 report.initial_links,
+                report.memory_bytes as f64 / (1024.0 * 1024.0),
                 report.rounds,
                 report.iterations,
+                report.residual,
                 report.rays,
                 report.elapsed.as_secs_f64()
             );

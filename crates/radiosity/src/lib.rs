@@ -26,6 +26,7 @@
 #![deny(missing_docs)]
 
 mod atomic_write;
+pub mod compare;
 pub mod form_factor;
 pub mod geometry;
 pub mod mesh;

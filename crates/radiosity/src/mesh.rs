@@ -82,9 +82,12 @@ pub enum MeshError {
     },
 }
 
-/// The most elements [`mesh_scene`] will make; a dense form-factor matrix of this size would
-/// already take 40 GB in f32, so larger requests are refused before any allocation.
-pub const MAX_ELEMENTS: u64 = 100_000;
+/// The most elements [`mesh_scene`] will make: about 1.2 GB of mesh (112 bytes per element
+/// and about as many vertices of 24 bytes), enough for the million-element scenes that
+/// progressive and hierarchical radiosity handle; larger requests are refused before any
+/// allocation. (The dense solvers refuse much smaller problems: see
+/// [`crate::pipeline::Prepared::check_memory`].)
+pub const MAX_ELEMENTS: u64 = 8_000_000;
 
 /// How one surface is cut.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -52,11 +52,11 @@ pub enum PipelineError {
 
 /// The most elements `choose_dense` will give the dense solve: its form factors cost
 /// O(n^2) (about 5 s at 10,000 elements on two cores, BENCHMARKS.md), so beyond this the
-/// O(n)-memory progressive solver is chosen even when the matrix would fit.
+/// hierarchical solver (no matrix) is chosen even when the matrix would fit.
 pub const AUTO_DENSE_MAX_ELEMENTS: usize = 20_000;
 
 /// The `auto` solver's decision for `n` elements and `available` bytes of memory: true for
-/// the dense solve (Gauss-Seidel on the stored matrix), false for progressive refinement;
+/// the dense solve (Gauss-Seidel on the stored matrix), false for hierarchical radiosity;
 /// with the reason, including the memory estimate, to tell the user.
 pub fn choose_dense(n: usize, available: u64) -> (bool, String) {
     let matrix = 4.0 * (n as f64).powi(2) * 1.1;
@@ -67,12 +67,12 @@ pub fn choose_dense(n: usize, available: u64) -> (bool, String) {
         mib(available as f64)
     );
     if n > AUTO_DENSE_MAX_ELEMENTS {
-        (false, format!("{estimate}; more than {AUTO_DENSE_MAX_ELEMENTS} elements: progressive refinement (no matrix, O(n) memory)"))
+        (false, format!("{estimate}; more than {AUTO_DENSE_MAX_ELEMENTS} elements: hierarchical radiosity with clustering (no matrix; links, memory about linear in the elements)"))
     } else if matrix > 0.5 * available as f64 {
         (
             false,
             format!(
-                "{estimate}, more than half of it: progressive refinement (no matrix, O(n) memory)"
+                "{estimate}, more than half of it: hierarchical radiosity with clustering (no matrix; links, memory about linear in the elements)"
             ),
         )
     } else {
@@ -211,7 +211,7 @@ impl Prepared {
         }
         let per_entry = match solver {
             // No matrix: O(n) vectors and one row.
-            Some(Solver::Progressive { .. } | Solver::Hierarchical { .. }) => return Ok(()),
+            Some(Solver::Progressive { .. } | Solver::Hierarchical(_)) => return Ok(()),
             Some(Solver::Lu) => 12.0,
             _ => 4.0,
         };
@@ -329,12 +329,10 @@ impl Prepared {
     /// solution carries its own elements (the leaves) in [`Solution::mesh`].
     pub fn solve_hierarchical(
         &self,
-        epsilon: f64,
-        min_area: f64,
+        settings: &solve::HierarchicalSettings,
         progress: &dyn Progress,
     ) -> Result<Solution, PipelineError> {
-        let h =
-            solve::solve_hierarchical(&self.scene, &self.occluders, epsilon, min_area, progress)?;
+        let h = solve::solve_hierarchical(&self.scene, &self.occluders, settings, progress)?;
         Ok(Solution {
             radiosity: h.radiosity,
             balance: h.report.balance,

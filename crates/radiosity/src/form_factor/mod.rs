@@ -126,7 +126,7 @@ pub struct FormFactorMatrix {
 #[error(
     "{what} for {n} elements needs {needed_mib:.0} MiB, but only {available_mib:.0} MiB of memory \
      is available; at most {fits} elements would fit (raise MAX_PATCH_AREA with --max-area, \
-     or use --solver progressive, which keeps no matrix)"
+     or use --solver hierarchical or --solver progressive, which keep no matrix)"
 )]
 pub struct OutOfMemory {
     /// What was to be allocated.

@@ -19,7 +19,10 @@ mod hierarchical;
 mod lu;
 mod progressive;
 
-pub use hierarchical::{solve_hierarchical, HierarchicalReport, HierarchicalSolution};
+pub use hierarchical::{
+    solve_hierarchical, HierarchicalReport, HierarchicalSettings, HierarchicalSolution,
+    DEFAULT_HIERARCHICAL_TOLERANCE,
+};
 pub use progressive::{
     solve_progressive, ProgressiveReport, ProgressiveState, DEFAULT_PROGRESSIVE_TOLERANCE,
 };
@@ -61,15 +64,11 @@ pub enum Solver {
         /// Give up with [`SolveError::ProgressiveNotConverged`] after this many shots.
         max_shots: usize,
     },
-    /// Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991) with BF refinement:
-    /// quadtrees over the input surfaces, links instead of a matrix. Solved by
-    /// [`solve_hierarchical`], which returns its own elements (the leaves).
-    Hierarchical {
-        /// Refinement threshold relative to the mean radiosity (smaller: finer, slower).
-        epsilon: f64,
-        /// Nodes of at most this area (scene units squared) are not split.
-        min_area: f64,
-    },
+    /// Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991) with BF refinement and
+    /// clustering: quadtrees over the input surfaces, clusters above them, links instead of
+    /// a matrix. Solved by [`solve_hierarchical`], which returns its own elements (the
+    /// leaves).
+    Hierarchical(HierarchicalSettings),
 }
 
 impl Solver {
@@ -90,10 +89,7 @@ impl Solver {
     /// True for solvers that need the dense form-factor matrix (all but progressive and
     /// hierarchical).
     pub fn needs_matrix(&self) -> bool {
-        !matches!(
-            self,
-            Solver::Progressive { .. } | Solver::Hierarchical { .. }
-        )
+        !matches!(self, Solver::Progressive { .. } | Solver::Hierarchical(_))
     }
 }
 
@@ -122,9 +118,10 @@ impl std::fmt::Display for Solver {
                 f,
                 "progressive refinement (unshot power below {tolerance:e} of emitted, at most {max_shots} shots)"
             ),
-            Solver::Hierarchical { epsilon, min_area } => write!(
+            Solver::Hierarchical(h) => write!(
                 f,
-                "hierarchical radiosity (BF refinement, epsilon {epsilon:e}, minimum area {min_area:e})"
+                "hierarchical radiosity with clustering (BF refinement, epsilon {:e}, minimum area {:e}, changing power below {:e} of emitted)",
+                h.epsilon, h.min_area, h.tolerance
             ),
         }
     }
@@ -173,6 +170,22 @@ pub enum SolveError {
     /// The dense LU matrix would not fit in memory (nothing was allocated).
     #[error(transparent)]
     OutOfMemory(#[from] OutOfMemory),
+    /// Hierarchical radiosity's nodes and links would outgrow the memory.
+    #[error(
+        "hierarchical radiosity stopped refining at {nodes} nodes and {links} links: they \
+         take about {used_mib} MiB, past the limit of {limit_mib} MiB (80 % of the memory \
+         available unless set); raise --epsilon or --min-area"
+    )]
+    HierarchicalTooBig {
+        /// Estimated bytes held, in MiB.
+        used_mib: u64,
+        /// The limit, in MiB.
+        limit_mib: u64,
+        /// Nodes made.
+        nodes: usize,
+        /// Links held.
+        links: usize,
+    },
     /// Gauss-Seidel did not reach the tolerance within the allowed sweeps.
     #[error(
         "Gauss-Seidel did not converge: after {iterations} sweeps the relative residual is \
@@ -290,9 +303,7 @@ fn solve_with_memory(
             })?;
             (b, Some(iterations))
         }
-        Solver::Progressive { .. } | Solver::Hierarchical { .. } => {
-            return Err(SolveError::NeedsScene)
-        }
+        Solver::Progressive { .. } | Solver::Hierarchical(_) => return Err(SolveError::NeedsScene),
     };
     let residual = relative_residual(f, reflectance, emission, &radiosity);
     let report = SolveReport {
@@ -347,7 +358,7 @@ fn check_inputs(
                 "the Gauss-Seidel tolerance must be a positive number, got {tolerance}"
             )))
         }
-        Solver::Progressive { .. } | Solver::Hierarchical { .. } => Err(SolveError::NeedsScene),
+        Solver::Progressive { .. } | Solver::Hierarchical(_) => Err(SolveError::NeedsScene),
         _ => Ok(()),
     }
 }
