@@ -188,7 +188,21 @@ fn run(
     let n = mesh.len();
     let fits = || {
         let (dense, why) = choose_dense(n, radiosity::form_factor::available_memory_bytes());
-        (dense && prepared.check_memory(None).is_ok(), why)
+        if dense && prepared.check_memory(None).is_ok() {
+            (true, why)
+        } else {
+            // choose_dense names the CLI's fallback; the window's is progressive refinement
+            // (it shows light from the first shot).
+            let estimate = why
+                .split([';', ',', ':'])
+                .next()
+                .unwrap_or_default()
+                .to_string();
+            (
+                false,
+                format!("{estimate}: no dense matrix; progressive refinement"),
+            )
+        }
     };
     let dense = match strategy {
         Strategy::Auto => {
