@@ -355,6 +355,12 @@ struct BenchArgs {
     /// Rays per pixel along each axis (as `render --supersample`).
     #[arg(long, default_value_t = 1, value_name = "N")]
     supersample: u32,
+    /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
+    #[arg(long, default_value_t = 0.05, value_name = "E")]
+    epsilon: f64,
+    /// Hierarchical: the minimum node area (as for `render --min-area`).
+    #[arg(long, value_name = "AREA")]
+    min_area: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -1210,9 +1216,8 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         tolerance: args.tolerance,
         max_shots: 1_000_000,
         form_factors: None,
-        // Hierarchical: the defaults of `render`.
-        epsilon: 0.05,
-        min_area: None,
+        epsilon: args.epsilon,
+        min_area: args.min_area,
     };
     let settings = RenderSettings {
         supersample: args.supersample,

@@ -159,6 +159,51 @@ impl Camera {
         cam
     }
 
+    /// In the room of the scene's most powerful emitter that faces down: 1.5 m (or 55 % of
+    /// the way) below it towards what is under it, looking level along the room's diagonal
+    /// with a 75 degree view. `None` without such an emitter.
+    fn under_brightest_light(scene: &Scene, width: u32, height: u32) -> Option<Camera> {
+        let light = scene
+            .surfaces
+            .iter()
+            .filter(|s| crate::geometry::polygon_normal(&s.vertices).is_some_and(|n| n.y < -0.7))
+            .max_by(|a, b| {
+                let power = |s: &crate::scene::Surface| {
+                    crate::geometry::polygon_area(&s.vertices) * s.emission.max_band()
+                };
+                power(a).total_cmp(&power(b))
+            })
+            .filter(|s| s.emission.max_band() > 0.0)?;
+        let centre = crate::geometry::polygon_centroid(&light.vertices);
+        let polygons: Vec<&[DVec3]> = scene
+            .surfaces
+            .iter()
+            .map(|s| s.vertices.as_slice())
+            .collect();
+        let ids: Vec<u32> = (0..polygons.len() as u32).collect();
+        let bvh = crate::visibility::PolygonBvh::new(&polygons, &ids);
+        let scale = bvh.scale();
+        let below = bvh
+            .closest_hit(centre, -DVec3::Y, 1e-6 * scale, scale)
+            .map_or(0.25 * scale, |h| h.t);
+        let drop = (below - 1.5).clamp(0.45 * below, 0.55 * below);
+        let eye = centre - DVec3::Y * drop;
+        // Step back from the light along the diagonal, to the room's far corner's opposite.
+        let diagonal = DVec3::new(1.0, 0.0, 1.0).normalize();
+        let back = bvh
+            .closest_hit(eye, -diagonal, 1e-6 * scale, scale)
+            .map_or(0.0, |h| 0.6 * h.t);
+        let eye = eye - diagonal * back;
+        Some(Camera {
+            eye,
+            look_at: eye + diagonal + DVec3::new(0.0, -0.15, 0.0),
+            up: DVec3::Y,
+            fov_y_degrees: 75.0,
+            width,
+            height,
+        })
+    }
+
     /// The camera to render `scene` with when the user gives none:
     ///
     /// * the scene's own [`Scene::camera`] when it has one;
@@ -167,10 +212,25 @@ impl Camera {
     /// * for a closed room (most surface area faces the inside eye): [`Camera::framing`]'s
     ///   eye moved to eye height (60 % up) just inside the front wall, looking down a little
     ///   across the room with a 75 degree view;
+    /// * for several rooms (more than one emitter facing down, like a generated building):
+    ///   in the room of the most powerful one (see `under_brightest_light`);
     /// * otherwise (objects): [`Camera::outside`].
     pub fn for_scene(scene: &Scene, width: u32, height: u32) -> Camera {
         if let Some(hint) = &scene.camera {
             return Camera::from_hint(hint, width, height);
+        }
+        // Several rooms (more than one light facing down): any eye chosen from the bounding
+        // box alone may stand inside a wall or outside every room, seeing only backs.
+        let ceiling_lights = scene
+            .surfaces
+            .iter()
+            .filter(|s| s.emission.max_band() > 0.0)
+            .filter(|s| crate::geometry::polygon_normal(&s.vertices).is_some_and(|n| n.y < -0.7))
+            .count();
+        if ceiling_lights > 1 {
+            if let Some(camera) = Camera::under_brightest_light(scene, width, height) {
+                return camera;
+            }
         }
         let bounds = scene.bounds();
         let (lo, hi) = bounds;
