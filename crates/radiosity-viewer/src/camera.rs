@@ -207,6 +207,19 @@ mod tests {
     }
 
     #[test]
+    fn starts_where_renders_default_camera_is() {
+        let scene = radiosity::scene::cornell_box();
+        let cam = Camera::for_scene(&scene, 640, 480);
+        let c = CameraController::new(&cam, 1000.0);
+        let back = c.camera(640, 480);
+        assert_eq!(back.eye, cam.eye);
+        assert_eq!(back.fov_y_degrees, cam.fov_y_degrees);
+        let (f0, r0, u0) = cam.basis();
+        let (f1, r1, u1) = back.basis();
+        assert!(close(f0, f1) && close(r0, r1) && close(u0, u1), "{f0} {f1}");
+    }
+
+    #[test]
     fn wheel_scales_speed_and_drag_turns() {
         let mut c = controller();
         c.scroll(2.0);
