@@ -18,6 +18,7 @@ macro_rules! outln {
 }
 
 mod progress_bar;
+mod view;
 
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -67,6 +68,8 @@ enum Command {
     /// factors, Gauss-Seidel) on the same mesh; print time, peak memory and the difference
     /// of element radiosity as a Markdown table row.
     Compare(CompareArgs),
+    /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
+    View(view::ViewArgs),
     /// Generate a scene file procedurally.
     Generate {
         #[command(subcommand)]
@@ -396,6 +399,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Check(args) => check_command(args),
         Command::Bench(args) => bench_command(args),
         Command::Compare(args) => compare_command(args),
+        Command::View(args) => view::view_command(args),
         Command::Generate {
             what: GenerateCommand::Building(args),
         } => generate_building(args),

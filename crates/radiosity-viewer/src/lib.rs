@@ -1,0 +1,148 @@
+//! # radiosity-viewer
+//!
+//! The walkthrough window and modeller of the `radiosity` renderer (paper sections 2.6,
+//! 3.3 and 3.5): a solved scene in perspective, walked through with the keyboard and
+//! mouse, its surfaces' reflectance and emission edited with colour pickers and re-solved
+//! from the cached form factors while the window stays live.
+//!
+//! * [`run`] opens the window ([`ViewerOptions`]: scene, screenshot, panel).
+//! * [`gpu`]: the wgpu pipeline, shared by the window and by [`gpu::render_offscreen`],
+//!   which returns pixels without any window (tests, screenshots, benchmarks).
+//! * [`camera::CameraController`]: the walking camera, a plain struct.
+//! * [`model`]: the edited scene with undo, and [`model::resolve`], the warm-started
+//!   Gauss-Seidel re-solve.
+//! * [`worker`]: the solve thread (dense with cached form factors, or progressive
+//!   refinement for large scenes), sending intermediate solutions to the window.
+//! * [`bench`]: frame time and edit-to-picture measurements.
+//!
+//! The core library (`radiosity`) has no window or GPU dependency; everything of that kind
+//! is here.
+//!
+//! ```no_run
+//! let scene = radiosity::scene::cornell_box();
+//! let mesh = radiosity::mesh::mesh_scene(&scene, 1000.0).unwrap();
+//! let (_, e) = radiosity::solve::element_properties(&mesh, &scene);
+//! let camera = radiosity::render::Camera::for_scene(&scene, 256, 256);
+//! let (image, adapter) = radiosity_viewer::gpu::render_offscreen(
+//!     &mesh, &e, &[], &camera, &Default::default()).unwrap();
+//! println!("{} x {} on {adapter}", image.width(), image.height());
+//! ```
+#![deny(missing_docs)]
+
+mod app;
+pub mod bench;
+pub mod camera;
+pub mod gpu;
+pub mod model;
+pub mod worker;
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+use radiosity::pipeline::Overrides;
+use radiosity::scene::Scene;
+
+/// What to show and how.
+#[derive(Clone, Debug)]
+pub struct ViewerOptions {
+    /// The scene.
+    pub scene: Scene,
+    /// Its file (where "save" writes; `None` for the built-in Cornell box, which is saved to
+    /// `cornell_box.scene`).
+    pub path: Option<PathBuf>,
+    /// `--max-area` and `--steps`.
+    pub overrides: Overrides,
+    /// Dense solve when it fits (auto) or always progressive refinement.
+    pub strategy: worker::Strategy,
+    /// Save a screenshot of the whole window here after `frames` frames of the solved
+    /// scene, then close.
+    pub screenshot: Option<PathBuf>,
+    /// Frames to draw before the screenshot.
+    pub frames: u32,
+    /// Show the modeller panel in the screenshot (it is always shown otherwise).
+    pub panel: bool,
+    /// Window size in points.
+    pub size: [f32; 2],
+    /// Select the first surface whose name starts with this once the mesh is ready (for
+    /// screenshots of the modeller).
+    pub select: Option<String>,
+    /// The shading the window starts with.
+    pub shading: radiosity::render::Shading,
+}
+
+impl ViewerOptions {
+    /// The defaults for `scene`: auto strategy, no screenshot, 1280 x 800.
+    pub fn new(scene: Scene, path: Option<PathBuf>) -> ViewerOptions {
+        ViewerOptions {
+            scene,
+            path,
+            overrides: Overrides::default(),
+            strategy: worker::Strategy::Auto,
+            screenshot: None,
+            frames: 30,
+            panel: false,
+            size: [1280.0, 800.0],
+            select: None,
+            shading: radiosity::render::Shading::Smooth,
+        }
+    }
+}
+
+/// Why the window could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    /// No display to open a window on.
+    #[error(
+        "no display: neither DISPLAY nor WAYLAND_DISPLAY is set, so no window can be opened. \
+         Run `radiosity view` in a desktop session, or headless under Xvfb: \
+         `apt-get install xvfb` then `xvfb-run -s \"-screen 0 1280x800x24\" radiosity view ...` \
+         (`radiosity render` makes images without any window)"
+    )]
+    NoDisplay,
+    /// No usable graphics adapter.
+    #[error(transparent)]
+    Gpu(#[from] gpu::GpuError),
+    /// The window system or renderer failed.
+    #[error("the window could not be opened: {0}. Tried winit (X11) with wgpu; without a GPU install a Vulkan software driver (`apt-get install mesa-vulkan-drivers`) or run with WGPU_BACKEND=gl")]
+    Window(String),
+    /// The solve or the screenshot failed while the window was open.
+    #[error("{0}")]
+    Failed(String),
+}
+
+/// Opens the window and runs until it is closed; returns notes to print (where the
+/// screenshot went).
+pub fn run(options: ViewerOptions) -> Result<Vec<String>, ViewerError> {
+    if cfg!(target_os = "linux")
+        && std::env::var_os("DISPLAY").is_none()
+        && std::env::var_os("WAYLAND_DISPLAY").is_none()
+    {
+        return Err(ViewerError::NoDisplay);
+    }
+    // Fail early, with the adapter search spelled out, when there is no adapter at all.
+    gpu::probe_adapter()?;
+    let native = eframe::NativeOptions {
+        viewport: eframe::egui::ViewportBuilder::default()
+            .with_inner_size(options.size)
+            .with_title(match &options.path {
+                Some(p) => format!("radiosity — {}", p.display()),
+                None => "radiosity — Cornell box".into(),
+            }),
+        // egui-wgpu's default present mode is AutoVsync: double-buffered with vsync.
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    let outcome = Arc::new(Mutex::new(app::Outcome::default()));
+    let for_app = outcome.clone();
+    eframe::run_native(
+        "radiosity",
+        native,
+        Box::new(move |cc| Ok(Box::new(app::ViewerApp::new(cc, options, for_app)))),
+    )
+    .map_err(|e| ViewerError::Window(e.to_string()))?;
+    let outcome = std::mem::take(&mut *outcome.lock().unwrap());
+    match outcome.error {
+        Some(e) => Err(ViewerError::Failed(e)),
+        None => Ok(outcome.notes),
+    }
+}
