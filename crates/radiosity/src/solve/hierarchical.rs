@@ -581,7 +581,9 @@ impl Solver<'_> {
     /// plane carries no energy); when no pair faces, all pairs count. Patch <- patch links
     /// use 16 pairs (4 x 4 stratified points on each, paired by a fixed permutation) and
     /// only the occluders whose boxes overlap the pair's box (none: visible, no ray);
-    /// cluster links use up to four pairs of their sample points and the whole BVH.
+    /// cluster links use up to eight facing pairs of sample points (a cluster keeps up to
+    /// eight quarter points of its roots, taken alternately from its two children) and the
+    /// whole BVH.
     /// With `any_open`, stops at the first open facing pair (the fraction is then only
     /// known to be positive).
     fn visibility(
