@@ -27,6 +27,17 @@ pub struct ViewArgs {
     /// progressive refinement shows light sooner.
     #[arg(long)]
     dense: bool,
+    /// The solver: auto (the two options above decide), hierarchical (hierarchical
+    /// radiosity with clustering, --epsilon, --min-area; the window shows its leaves and an
+    /// edit re-runs it).
+    #[arg(long, value_name = "SOLVER", default_value = "auto", conflicts_with_all = ["dense", "progressive"])]
+    solver: String,
+    /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
+    #[arg(long, default_value_t = 0.05, value_name = "E")]
+    epsilon: f64,
+    /// Hierarchical: the minimum node area (default: MAX_PATCH_AREA / 16).
+    #[arg(long, value_name = "AREA")]
+    min_area: Option<f64>,
     /// Open the window, draw `--frames` frames of the solved scene, save the window to this
     /// PNG and exit.
     #[arg(long, value_name = "FILE")]
@@ -96,6 +107,30 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
         options.strategy = Strategy::Progressive;
     } else if args.dense {
         options.strategy = Strategy::Dense;
+    }
+    match args.solver.as_str() {
+        "auto" => {}
+        "dense" => options.strategy = Strategy::Dense,
+        "progressive" => options.strategy = Strategy::Progressive,
+        "hierarchical" => {
+            let max_area = args
+                .max_area
+                .unwrap_or(options.scene.settings.max_patch_area);
+            let min_area = args.min_area.unwrap_or(max_area / 16.0);
+            if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
+                bail!("--epsilon must be a positive number, got {}", args.epsilon);
+            }
+            if !(min_area > 0.0 && min_area.is_finite()) {
+                bail!("--min-area must be a positive number, got {min_area}");
+            }
+            options.strategy = Strategy::Hierarchical(radiosity::solve::HierarchicalSettings {
+                epsilon: args.epsilon,
+                min_area,
+                tolerance: radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE,
+                max_memory_bytes: None,
+            });
+        }
+        other => bail!("--solver must be auto, dense, progressive or hierarchical, got {other}"),
     }
     options.screenshot = args.screenshot;
     options.frames = args.frames;

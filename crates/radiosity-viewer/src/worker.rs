@@ -122,6 +122,9 @@ pub enum Strategy {
     Dense,
     /// Always progressive refinement (no matrix; edits re-run it).
     Progressive,
+    /// Hierarchical radiosity with clustering: the window shows its leaves; edits re-run it
+    /// (its links are not kept between solves).
+    Hierarchical(radiosity::solve::HierarchicalSettings),
 }
 
 /// Starts the worker on `scene`; `wake` is called whenever there is news (the window asks
@@ -224,7 +227,7 @@ fn run(
             progress.message(&why);
             fits
         }
-        Strategy::Progressive => false,
+        Strategy::Progressive | Strategy::Hierarchical(_) => false,
     };
     let matrix: Option<FormFactorMatrix> = if dense {
         Some(
@@ -253,6 +256,36 @@ fn run(
         };
         let mut interrupted: Option<Recolour> = None;
         let mut last_sent = Instant::now() - SNAPSHOT_INTERVAL;
+        if let Strategy::Hierarchical(settings) = strategy {
+            // No intermediate pictures: the leaves are only known at the end. The window
+            // gets the leaves as its mesh (for drawing and picking), then their radiosity.
+            *progress.shared.stage.lock().unwrap() = "hierarchical";
+            progress.shared.total.store(0, Ordering::Relaxed);
+            let start = Instant::now();
+            let solution = prepared
+                .solve_hierarchical(&settings, progress)
+                .map_err(|e| e.to_string())?;
+            let leaves = Arc::new(solution.mesh(&prepared).clone());
+            let polygons: Vec<Vec<_>> = (0..leaves.len())
+                .map(|e| leaves.corner_positions(e).collect())
+                .collect();
+            let ids: Vec<u32> = (0..leaves.len() as u32).collect();
+            send(Update::Mesh(
+                leaves.clone(),
+                Arc::new(PolygonBvh::new(&polygons, &ids)),
+            ));
+            send(Update::Solution {
+                element_b: solution.element_rgb(),
+                done: true,
+                note: format!(
+                    "{} leaves, hierarchical radiosity in {:.1} s (edits re-run it)",
+                    leaves.len(),
+                    start.elapsed().as_secs_f64()
+                ),
+                edit,
+            });
+            continue;
+        }
         match &matrix {
             Some(f) => {
                 *progress.shared.stage.lock().unwrap() = "solve";
@@ -436,5 +469,67 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// With hierarchical radiosity the worker sends the leaves as the mesh, then their
+    /// radiosity; after an edit, the leaves and radiosity of a fresh hierarchical solve of
+    /// the edited scene (the solve is deterministic, so they are equal).
+    #[test]
+    fn worker_resolves_hierarchically_like_a_fresh_solve() {
+        let overrides = Overrides {
+            max_patch_area: Some(8000.0),
+            integral_steps: Some(2),
+        };
+        let settings = radiosity::solve::HierarchicalSettings {
+            epsilon: 0.2,
+            min_area: 2000.0,
+            tolerance: 1e-6,
+            max_memory_bytes: None,
+        };
+        let scene = cornell_box();
+        let (edits, updates, _) = spawn(
+            scene.clone(),
+            overrides,
+            Strategy::Hierarchical(settings),
+            Arc::new(|| {}),
+        );
+        converged(&updates, 0);
+        let mut edited = scene.clone();
+        for s in edited.surfaces.iter_mut().filter(|s| s.name == "Floor") {
+            s.reflectance = Rgb([0.7, 0.2, 0.2]);
+        }
+        edits
+            .send(Recolour {
+                colours: edited
+                    .surfaces
+                    .iter()
+                    .map(|s| (s.reflectance, s.emission))
+                    .collect(),
+                edit: 1,
+            })
+            .unwrap();
+        // The leaves come before the solution that answers the edit.
+        let mut leaves = None;
+        let b = loop {
+            match updates
+                .recv_timeout(Duration::from_secs(120))
+                .expect("worker answers")
+            {
+                Update::Mesh(mesh, _) => leaves = Some(mesh),
+                Update::Solution {
+                    element_b,
+                    done: true,
+                    edit: 1,
+                    ..
+                } => break element_b,
+                Update::Error(m) => panic!("worker failed: {m}"),
+                _ => {}
+            }
+        };
+        let fresh = Prepared::new(edited, overrides, &NoProgress).unwrap();
+        let solution = fresh.solve_hierarchical(&settings, &NoProgress).unwrap();
+        let leaves = leaves.expect("the leaves are sent");
+        assert_eq!(leaves.len(), solution.mesh(&fresh).len());
+        assert_eq!(b, solution.element_rgb());
     }
 }
