@@ -398,6 +398,16 @@ mod tests {
     use radiosity::scene::cornell_box;
     use radiosity::solve::Solver;
 
+    /// Asks the worker for the colours of `scene`, as edit number `edit`.
+    fn send_colours(edits: &Sender<Recolour>, scene: &Scene, edit: u64) {
+        let colours = scene
+            .surfaces
+            .iter()
+            .map(|s| (s.reflectance, s.emission))
+            .collect();
+        edits.send(Recolour { colours, edit }).unwrap();
+    }
+
     /// Waits for the converged solution answering `edit`.
     fn converged(updates: &Receiver<Update>, edit: u64) -> Vec<[f64; 3]> {
         loop {
@@ -438,16 +448,7 @@ mod tests {
         {
             s.reflectance = Rgb([0.2, 0.3, 0.75]);
         }
-        edits
-            .send(Recolour {
-                colours: edited
-                    .surfaces
-                    .iter()
-                    .map(|s| (s.reflectance, s.emission))
-                    .collect(),
-                edit: 1,
-            })
-            .unwrap();
+        send_colours(&edits, &edited, 1);
         let b = converged(&updates, 1);
 
         let fresh = Prepared::new(edited, overrides, &NoProgress).unwrap();
@@ -498,16 +499,7 @@ mod tests {
         for s in edited.surfaces.iter_mut().filter(|s| s.name == "Floor") {
             s.reflectance = Rgb([0.7, 0.2, 0.2]);
         }
-        edits
-            .send(Recolour {
-                colours: edited
-                    .surfaces
-                    .iter()
-                    .map(|s| (s.reflectance, s.emission))
-                    .collect(),
-                edit: 1,
-            })
-            .unwrap();
+        send_colours(&edits, &edited, 1);
         // The leaves come before the solution that answers the edit.
         let mut leaves = None;
         let b = loop {
