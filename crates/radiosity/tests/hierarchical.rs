@@ -183,16 +183,15 @@ fn cornell_box_agrees_with_the_dense_solve() {
         "cornell eps {EPS} min 500: {elapsed:?}, {} leaves, {} clusters, {} links, {} rounds, {} sweeps, {} rays; per-surface relative RMS {rms:.3e}; per element {c:?}",
         s.report.leaves, s.report.clusters, s.report.links, s.report.rounds, s.report.iterations, s.report.rays
     );
-    // Measured: per-surface relative RMS 2.5e-2; per dense element (the hierarchical
-    // solution averaged over each dense element) RMS 5.9e-2, largest 0.35, mean -0.8e-2
-    // (hierarchical darker), 6,500 leaves. What is left is mostly along shadow edges and
-    // block footprints, where the dense elements (2000 mm^2) are coarser than the leaves
-    // and the area rule's visibility differs from the hierarchy's; two dense solves on
-    // meshes 4x apart differ by 2.5e-2 RMS by a similar measure. The bounds leave 1.5x
-    // margin for the visibility sampling's variation between refinements.
-    assert!(rms < 0.035, "per-surface relative RMS {rms:e}");
-    assert!(c.rms < 0.09, "per-element relative RMS {:e}", c.rms);
-    assert!(c.bias.abs() < 0.015, "mean difference {:e}", c.bias);
+    // Measured: per-surface relative RMS 1.3e-2; per dense element (the hierarchical
+    // solution averaged over each dense element) RMS 5.2e-2, largest 0.32, mean -0.2e-2,
+    // 6,500 leaves. What is left is mostly along shadow edges and block footprints, where
+    // the dense elements (2000 mm^2) are coarser than the leaves and the area rule's
+    // visibility differs from the hierarchy's, and the BF tolerance itself. The bounds
+    // leave 1.5x margin for the visibility sampling's variation between refinements.
+    assert!(rms < 0.02, "per-surface relative RMS {rms:e}");
+    assert!(c.rms < 0.08, "per-element relative RMS {:e}", c.rms);
+    assert!(c.bias.abs() < 0.01, "mean difference {:e}", c.bias);
     // Energy: emitted = absorbed + escaped to the solve tolerance; the box is open at the
     // front, so much of the power escapes.
     let b = s.report.balance;

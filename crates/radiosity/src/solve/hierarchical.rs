@@ -106,6 +106,12 @@ pub const DEFAULT_HIERARCHICAL_TOLERANCE: f64 = 1e-6;
 const MAX_SWEEPS: usize = 100_000;
 /// Give up refining after this many rounds (each round is a solve and a refinement pass).
 const MAX_ROUNDS: usize = 64;
+/// The oracle takes a patch source's radiosity as the larger of its mean and this many
+/// times the spread (largest - smallest) of its leaves. Measured on the Cornell box at 2,046
+/// elements, epsilon 0.01: weight 0 / 1 / 2 / 4 gives 6.4 / 6.2 / 5.6 / 5.0 % RMS against
+/// the dense solve and -1.2 / -0.9 / -0.5 / -0.4 % mean difference; on the default building
+/// (217k leaves) 2 costs 14 % more time and 4 costs 29 %.
+const SPAN_WEIGHT: f64 = 2.0;
 /// No node index.
 const NONE: u32 = u32::MAX;
 /// Sample points kept per cluster for visibility.
@@ -383,6 +389,8 @@ struct Solver<'a> {
     /// Area-averaged radiosity of every node (apart from the nodes: the sweeps read it at
     /// random).
     b: Vec<[f64; 3]>,
+    /// Smallest and largest radiosity (largest band) of the leaves under every patch.
+    b_span: Vec<(f64, f64)>,
     /// Cluster index of every node, NONE for patches.
     cluster_of: Vec<u32>,
     clusters: Vec<Cluster>,
@@ -423,6 +431,7 @@ impl Solver<'_> {
             gathered: [0.0; 3],
         });
         self.b.push(b);
+        self.b_span.push((max3(b), max3(b)));
         self.cluster_of.push(NONE);
         self.nodes.len() as u32 - 1
     }
@@ -516,6 +525,7 @@ impl Solver<'_> {
             gathered: [0.0; 3],
         });
         self.b.push([0.0; 3]);
+        self.b_span.push((0.0, 0.0));
         self.cluster_of.push(self.clusters.len() as u32 - 1);
         self.nodes.len() as u32 - 1
     }
@@ -868,7 +878,11 @@ impl Solver<'_> {
         let q = link.source;
         let c = self.cluster_of[q as usize];
         let b_q = if c == NONE {
-            max3(self.b[q as usize])
+            // The mean, or the spread of the source's leaves where that is larger: a link
+            // multiplies the mean F by the mean B, and where both peak together (the floor
+            // under a light, seen from the light) the product misses their covariance.
+            let (lo, hi) = self.b_span[q as usize];
+            max3(self.b[q as usize]).max(SPAN_WEIGHT * (hi - lo))
         } else {
             self.clusters[c as usize].b_max
         };
@@ -1085,6 +1099,7 @@ impl Solver<'_> {
                 out.push((n, h));
             }
             self.b[n as usize] = new;
+            self.b_span[n as usize] = (max3(new), max3(new));
             return std::array::from_fn(|k| area * (new[k] - old[k]).abs());
         }
         let children = node.children;
@@ -1094,6 +1109,7 @@ impl Solver<'_> {
         }
         let mut change = [0.0; 3];
         let mut sum = [0.0; 3];
+        let mut span = (f64::INFINITY, f64::NEG_INFINITY);
         for child in children {
             let ch = self.push_pull(child, &pass, arriving);
             let (area, cb) = (self.nodes[child as usize].area, self.b[child as usize]);
@@ -1101,9 +1117,12 @@ impl Solver<'_> {
                 change[k] += ch[k];
                 sum[k] += area * cb[k];
             }
+            let (lo, hi) = self.b_span[child as usize];
+            span = (span.0.min(lo), span.1.max(hi));
         }
         let area = self.nodes[n as usize].area;
         self.b[n as usize] = sum.map(|s| s / area);
+        self.b_span[n as usize] = span;
         change
     }
 
@@ -1261,6 +1280,7 @@ pub fn solve_hierarchical(
     let mut solver = Solver {
         nodes: Vec::new(),
         b: Vec::new(),
+        b_span: Vec::new(),
         cluster_of: Vec::new(),
         clusters: Vec::new(),
         roots: Vec::new(),
