@@ -43,8 +43,9 @@
 //!
 //! A link p <- q is refined when rho_p B_q F_hat > epsilon B_ref, where rho_p is the
 //! largest reflectance of p (of any patch, for a cluster), B_q the largest band of q's
-//! radiosity (for a cluster: the largest of its patches, as its mean would hide a small
-//! light among dark walls), F_hat = max(F_pq, F_qp) (F_qp by reciprocity) for patch links
+//! radiosity (for a patch: the larger of its mean and twice the spread of its leaves, as a
+//! link misses the covariance of F and B where both peak together; for a cluster: the
+//! largest of its patches, as its mean would hide a small light among dark walls), F_hat = max(F_pq, F_qp) (F_qp by reciprocity) for patch links
 //! and the coupling of the two projected areas, Ap(p) Ap(q) / (pi r^2), over the smaller
 //! area otherwise (capped at 1). F_hat includes the visible fraction only when the pair is
 //! fully visible, or is two patches hidden by at least eight facing point pairs (a
@@ -70,11 +71,11 @@
 //!
 //! # Accuracy
 //!
-//! On the Cornell box at epsilon 0.01 the per-surface mean radiosity is within 2.5 % RMS of
-//! the dense solve and 1 % darker; averaged over each dense element the difference is 6-7 %
-//! RMS (3.7 % at epsilon 0.003), mostly along shadow edges and block footprints, where
+//! On the Cornell box at epsilon 0.01 the per-surface mean radiosity is within 1.3 % RMS of
+//! the dense solve; averaged over each dense element the difference is 5.7-6.6 % RMS (3.5 %
+//! at epsilon 0.003), 0.5-1 % darker, mostly along shadow edges and block footprints, where
 //! coarse links push one irradiance to children that an occluder hides from part of the
-//! source (see [`crate::compare`] and BENCHMARKS.md).
+//! source, and from the BF tolerance itself (see [`crate::compare`] and BENCHMARKS.md).
 //!
 //! # Energy account
 //!
