@@ -634,21 +634,27 @@ impl Solver<'_> {
             }
             count = 16;
         } else {
-            let samples_of = |n: &Node| -> Vec<(DVec3, DVec3)> {
+            // Sample points on the stack: this runs for every cluster link estimated.
+            let samples_of = |n: &Node| -> ([(DVec3, DVec3); CLUSTER_SAMPLES], usize) {
+                let mut out = [(DVec3::ZERO, DVec3::ZERO); CLUSTER_SAMPLES];
                 if n.is_cluster() {
-                    self.clusters[n.cluster as usize].samples.clone()
+                    let samples = &self.clusters[n.cluster as usize].samples;
+                    out[..samples.len()].copy_from_slice(samples);
+                    (out, samples.len())
                 } else {
                     let m = self.normal[n.surface as usize];
-                    quarter_points(n.polygon())
-                        .iter()
-                        .map(|&x| (x, m))
-                        .collect()
+                    for (o, x) in out.iter_mut().zip(quarter_points(n.polygon())) {
+                        *o = (x, m);
+                    }
+                    (out, 4)
                 }
             };
             // Up to eight pairs that face each other (from all pairs of sample points, in
-            // a fixed spread-out order); eight non-facing ones when none faces.
-            let (a, b) = (samples_of(np), samples_of(nq));
-            let (mut m, mut spare) = (0, Vec::new());
+            // a fixed spread-out order), kept in pairs[..8]; up to eight non-facing ones in
+            // pairs[8..], used when none faces.
+            let ((a, na), (b, nb)) = (samples_of(np), samples_of(nq));
+            let (a, b) = (&a[..na], &b[..nb]);
+            let (mut m, mut spare) = (0, 8);
             'outer: for shift in 0..b.len() {
                 for i in 0..a.len() {
                     let (x, y) = (a[i], b[(i + shift) % b.len()]);
@@ -659,14 +665,15 @@ impl Solver<'_> {
                         if m == 8 {
                             break 'outer;
                         }
-                    } else if spare.len() < 8 {
-                        spare.push((x.0, x.1, y.0, y.1));
+                    } else if spare < 16 {
+                        pairs[spare] = (x.0, x.1, y.0, y.1);
+                        spare += 1;
                     }
                 }
             }
             if m == 0 {
-                m = spare.len();
-                pairs[..m].copy_from_slice(&spare);
+                pairs.copy_within(8..spare, 0);
+                m = spare - 8;
             }
             count = m;
         }
