@@ -50,8 +50,8 @@ pub enum CompareError {
     Dark,
 }
 
-/// Compares `other` (on `other_mesh`) with `reference` (on `reference_mesh`) at the
-/// reference's element centroids; `emission` is E per reference element.
+/// Compares `other` (on `other_mesh`) with `reference` (on `reference_mesh`) over the
+/// reference's elements (see [`project`]); `emission` is E per reference element.
 pub fn compare(
     reference_mesh: &Mesh,
     reference: &Radiosity,
@@ -59,13 +59,47 @@ pub fn compare(
     other_mesh: &Mesh,
     other: &Radiosity,
 ) -> Result<Comparison, CompareError> {
+    let projected = project(reference_mesh, other_mesh, other)?;
+    let (mut num, mut den, mut sum, mut area, mut max) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
+    for (i, el) in reference_mesh.elements.iter().enumerate() {
+        for k in 0..3 {
+            let (r, o) = (reference.bands[k][i], projected.bands[k][i]);
+            num += el.area * (o - r).powi(2);
+            den += el.area * (r - emission[i][k]).powi(2);
+            sum += el.area * (o - r);
+            max = max.max((o - r).abs());
+        }
+        area += el.area;
+    }
+    if den <= 0.0 {
+        return Err(CompareError::Dark);
+    }
+    let scale = (den / (3.0 * area)).sqrt();
+    Ok(Comparison {
+        elements: reference_mesh.len(),
+        rms: (num / den).sqrt(),
+        max: max / scale,
+        bias: sum / (3.0 * area) / scale,
+    })
+}
+
+/// `other` (on `other_mesh`) averaged over each element of `reference_mesh`: the
+/// area-weighted mean at the element's 4 x 4 integration points of the other mesh's
+/// element under each point (found by a ray along the surface normal through a BVH of the
+/// other mesh).
+pub fn project(
+    reference_mesh: &Mesh,
+    other_mesh: &Mesh,
+    other: &Radiosity,
+) -> Result<Radiosity, CompareError> {
     let polygons: Vec<Vec<glam::DVec3>> = (0..other_mesh.len())
         .map(|e| other_mesh.corner_positions(e).collect())
         .collect();
     let ids: Vec<u32> = (0..other_mesh.len() as u32).collect();
     let bvh = PolygonBvh::new(&polygons, &ids);
     let delta = 1e-6 * bvh.scale();
-    let (mut num, mut den, mut sum, mut area, mut max) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
+    let mut bands: [Vec<f64>; 3] =
+        std::array::from_fn(|_| Vec::with_capacity(reference_mesh.len()));
     let mut points = Vec::new();
     for (i, el) in reference_mesh.elements.iter().enumerate() {
         points.clear();
@@ -90,24 +124,10 @@ pub fn compare(
             }
         }
         for k in 0..3 {
-            let (r, o) = (reference.bands[k][i], projected[k] / el.area);
-            num += el.area * (o - r).powi(2);
-            den += el.area * (r - emission[i][k]).powi(2);
-            sum += el.area * (o - r);
-            max = max.max((o - r).abs());
+            bands[k].push(projected[k] / el.area);
         }
-        area += el.area;
     }
-    if den <= 0.0 {
-        return Err(CompareError::Dark);
-    }
-    let scale = (den / (3.0 * area)).sqrt();
-    Ok(Comparison {
-        elements: reference_mesh.len(),
-        rms: (num / den).sqrt(),
-        max: max / scale,
-        bias: sum / (3.0 * area) / scale,
-    })
+    Ok(Radiosity { bands })
 }
 
 #[cfg(test)]
