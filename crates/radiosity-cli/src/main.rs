@@ -64,9 +64,10 @@ enum Command {
     /// Time the whole pipeline (parse, mesh, BVH, form factors, solve, shade, render) and
     /// print one Markdown table row per MAX_PATCH_AREA with the median time of each stage.
     Bench(BenchArgs),
-    /// Solve a scene with one solver and with the dense reference (area-method form
-    /// factors, Gauss-Seidel) on the same mesh; print time, peak memory and the difference
-    /// of element radiosity as a Markdown table row.
+    /// Solve a scene with one solver and with the dense reference (Gauss-Seidel on the
+    /// form factors of --method and --steps; for a reference more accurate than the default
+    /// area k = 2, use --method contour --steps 4) on the same mesh; print time, peak memory
+    /// and the difference of element radiosity as a Markdown table row.
     Compare(CompareArgs),
     /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
     View(view::ViewArgs),
@@ -973,13 +974,18 @@ fn compare_command(args: CompareArgs) -> Result<()> {
             }
         }
     }
-    outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense time (s) | dense peak (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
-    outln!("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense reference | dense time (s) | dense peak (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
+    outln!("| --- | ---: | --- | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: |");
     outln!(
-        "| {stem} | {} | {} | {elements} | {time:.2} | {} | {} | {} | {} | {} | {} |",
+        "| {stem} | {} | {} | {elements} | {time:.2} | {} | {} | {} | {} | {} | {} | {} |",
         prepared.mesh.len(),
         short_name(&solver),
         mib(peak, reset),
+        if args.no_reference {
+            "-".to_string()
+        } else {
+            prepared.method().to_string()
+        },
         reference.0,
         reference.1,
         difference.0,

@@ -489,3 +489,39 @@ fn hierarchical_solves_checks_and_renders_its_leaves() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn compare_prints_a_row_against_the_chosen_dense_reference() {
+    let dir = scratch_dir("compare");
+    let out = radiosity(
+        &[
+            "compare",
+            "--max-area",
+            "20000",
+            "--solver",
+            "hierarchical",
+            "--epsilon",
+            "0.01",
+            "--method",
+            "contour",
+            "--steps",
+            "2",
+            "--quiet",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("| cornell |"))
+        .unwrap_or_else(|| panic!("no row for the built-in box: {text}"));
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    // | scene | elements | solver | its elements | time | peak | reference | ... | RMS | max | mean |
+    assert_eq!(cells[7], "contour k=2", "{row}");
+    let rms: f64 = cells[10].parse().unwrap_or_else(|_| panic!("RMS in {row}"));
+    // The coarse box (about 130 elements) at epsilon 0.01: a few per cent; a broken
+    // projection or reference gives tens of per cent.
+    assert!(rms > 0.0 && rms < 15.0, "{row}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

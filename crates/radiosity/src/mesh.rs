@@ -155,6 +155,21 @@ fn plan(vertices: &[DVec3], max_area: f64) -> Result<Plan, f64> {
     }
 }
 
+/// How [`mesh_scene`] cuts a polygon at `max_area`: `Some([nu, nv])` for a quadrilateral
+/// cut into an nu x nv grid (u along corner 0 -> 1, v along 0 -> 3, as [`bilinear`]),
+/// `Some([m, 0])` for a triangle, or each fan triangle of a larger polygon, cut into m^2;
+/// `None` where meshing would refuse the surface. Hierarchical radiosity splits its patches
+/// along these grid lines, so that its elements nest with the mesh's.
+pub(crate) fn grid_of(vertices: &[DVec3], max_area: f64) -> Option<[u32; 2]> {
+    if !(max_area.is_finite() && max_area > 0.0) {
+        return None;
+    }
+    match plan(vertices, max_area).ok()? {
+        Plan::QuadGrid { nu, nv } => Some([nu, nv]),
+        Plan::TriangleFan { m, .. } => Some([m, 0]),
+    }
+}
+
 /// The triangles a polygon is cut into before subdivision: itself for a triangle, otherwise
 /// a fan from the area centroid (so the fan triangles are as fat as the polygon allows).
 fn fan_triangles(vertices: &[DVec3]) -> impl Iterator<Item = [DVec3; 3]> + '_ {

@@ -183,12 +183,12 @@ fn cornell_box_agrees_with_the_dense_solve() {
         "cornell eps {EPS} min 500: {elapsed:?}, {} leaves, {} clusters, {} links, {} rounds, {} sweeps, {} rays; per-surface relative RMS {rms:.3e}; per element {c:?}",
         s.report.leaves, s.report.clusters, s.report.links, s.report.rounds, s.report.iterations, s.report.rays
     );
-    // Measured: per-surface relative RMS 1.3e-2; per dense element (the hierarchical
-    // solution averaged over each dense element) RMS 5.2e-2, largest 0.32, mean -0.2e-2,
-    // 6,500 leaves. What is left is mostly along shadow edges and block footprints, where
-    // the dense elements (2000 mm^2) are coarser than the leaves and the area rule's
-    // visibility differs from the hierarchy's, and the BF tolerance itself. The bounds
-    // leave 1.5x margin for the visibility sampling's variation between refinements.
+    // Measured: per-surface relative RMS 1.4e-2; per dense element (the hierarchical
+    // solution averaged over each dense element) RMS 5.0e-2, largest 0.37, mean +0.4e-2,
+    // 7,928 leaves. At this epsilon it is mostly the BF tolerance itself (see the exact
+    // comparison below for small epsilon), and the dense area k = 2 reference's own error
+    // (1.2 % RMS at 2,046 elements). The bounds leave 1.5x margin for the visibility
+    // sampling's variation between refinements.
     assert!(rms < 0.02, "per-surface relative RMS {rms:e}");
     assert!(c.rms < 0.08, "per-element relative RMS {:e}", c.rms);
     assert!(c.bias.abs() < 0.01, "mean difference {:e}", c.bias);
@@ -311,4 +311,131 @@ fn refuses_to_outgrow_its_memory_limit() {
         ),
         "{err:?}"
     );
+}
+
+/// The Cornell box meshed at `max_area`, solved densely with exact (contour) form factors
+/// and 4 x 4 by 4 x 4 point pairs for visibility (on the 2,046-element mesh this is within
+/// 0.23 % RMS of the same solve with 8 x 8, BENCHMARKS.md), and by hierarchical radiosity
+/// on the same MAX_PATCH_AREA (so that its leaves nest with the dense elements): the
+/// per-element comparison.
+fn against_exact_dense(
+    max_area: f64,
+    epsilon: f64,
+    min_area: f64,
+) -> radiosity::compare::Comparison {
+    let mut prepared = Prepared::new(
+        cornell_box(),
+        Overrides {
+            max_patch_area: Some(max_area),
+            integral_steps: None,
+        },
+        &NoProgress,
+    )
+    .unwrap();
+    prepared.method = radiosity::form_factor::FormFactorMethod::Contour { steps: 4 };
+    let (f, _) = prepared.form_factors(&NoProgress).unwrap();
+    let dense = prepared
+        .solve(&f, Solver::DEFAULT_GAUSS_SEIDEL, &NoProgress)
+        .unwrap();
+    let (_, emission) = radiosity::solve::element_properties(&prepared.mesh, &prepared.scene);
+    let s = solve(&prepared.scene, epsilon, min_area);
+    let c = compare(
+        &prepared.mesh,
+        &dense.radiosity,
+        &emission,
+        &s.mesh,
+        &s.radiosity,
+    )
+    .unwrap();
+    eprintln!(
+        "cornell at {max_area} ({} elements), eps {epsilon}: {} leaves, {} links; {c:?}",
+        prepared.mesh.len(),
+        s.report.leaves,
+        s.report.links
+    );
+    c
+}
+
+#[test]
+fn cornell_box_element_by_element_against_an_exact_dense_solve() {
+    // 2,046 elements; leaves down to a quarter of an element. Measured: RMS 0.66 %, mean
+    // +0.13 %, largest 11.5 % (an element at a block's footprint, where the two solves'
+    // visibility samples differ). The bound is the target of issue #4 (1 % RMS; 1.5x the
+    // measured value, for the visibility samples' variation between refinements); the
+    // mean bound is 2x the measured one.
+    let c = against_exact_dense(1000.0, 3e-4, 250.0);
+    assert_eq!(c.elements, 2046);
+    assert!(c.rms < 0.01, "{c:?}");
+    assert!(c.bias.abs() < 0.003, "{c:?}");
+}
+
+/// True when `x` lies in the convex polygon `poly` (normal `n`), up to `tol` outside.
+fn inside(poly: &[glam::DVec3], n: glam::DVec3, x: glam::DVec3, tol: f64) -> bool {
+    (0..poly.len()).all(|i| {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        (b - a).cross(x - a).dot(n) >= -tol * (b - a).length()
+    })
+}
+
+#[test]
+fn leaves_nest_with_the_mesh_elements() {
+    // Every leaf on a quadrilateral surface lies within one element of the mesh made at the
+    // scene's MAX_PATCH_AREA, or is the union of whole elements: the hierarchy splits along
+    // the mesh's grid lines. (The Cornell box at 1000 mm^2: 18 x 18 and 17 x 18 grids and
+    // the like, none a power of two, so bisection alone would not nest.)
+    let mut scene = cornell_box();
+    scene.settings.max_patch_area = 1000.0;
+    let mesh = radiosity::mesh::mesh_scene(&scene, 1000.0).unwrap();
+    let s = solve(&scene, 0.03, 250.0);
+    let corners = |m: &radiosity::mesh::Mesh, e: usize| -> Vec<glam::DVec3> {
+        m.corner_positions(e).collect()
+    };
+    let tol = 1e-6;
+    let (mut within, mut unions) = (0, 0);
+    for (surface, x) in scene.surfaces.iter().enumerate() {
+        if x.vertices.len() != 4 {
+            continue;
+        }
+        let elements: Vec<usize> = mesh.surface_elements[surface]
+            .clone()
+            .map(|e| e as usize)
+            .collect();
+        let leaves: Vec<usize> = s.mesh.surface_elements[surface]
+            .clone()
+            .map(|e| e as usize)
+            .collect();
+        for &l in &leaves {
+            let leaf = &s.mesh.elements[l];
+            let lp = corners(&s.mesh, l);
+            // An element that holds the leaf's centroid and all its corners.
+            let host = elements.iter().copied().find(|&e| {
+                let ep = corners(&mesh, e);
+                inside(&ep, leaf.normal, leaf.centroid, tol)
+                    && lp.iter().all(|&c| inside(&ep, leaf.normal, c, tol))
+            });
+            if host.is_some() {
+                within += 1;
+            } else {
+                // The elements whose centroids it holds lie inside it and fill it.
+                let held: Vec<usize> = elements
+                    .iter()
+                    .copied()
+                    .filter(|&e| inside(&lp, leaf.normal, mesh.elements[e].centroid, -tol))
+                    .collect();
+                let area: f64 = held.iter().map(|&e| mesh.elements[e].area).sum();
+                for &e in &held {
+                    let ep = corners(&mesh, e);
+                    assert!(ep.iter().all(|&c| inside(&lp, leaf.normal, c, tol)));
+                }
+                assert!(
+                    (area - leaf.area).abs() < 1e-9 * leaf.area,
+                    "{}: leaf {l}",
+                    x.name
+                );
+                unions += 1;
+            }
+        }
+    }
+    eprintln!("{within} leaves within an element, {unions} unions of elements");
+    assert!(within > 0 && unions > 0);
 }
