@@ -83,11 +83,13 @@
 //! # Accuracy
 //!
 //! Element by element against a dense solve on the same mesh with exact (contour) form
-//! factors and 4 x 4 by 4 x 4 visibility pairs (the Cornell box at 2,046 elements, leaves
-//! down to a quarter of an element): 0.67 % RMS at epsilon 3e-4, 1.1-1.3 % at 1e-3, about
-//! 5 % at 1e-2 (tests/hierarchical.rs, BENCHMARKS.md). The dense solve with the default
-//! area k = 2 form factors is itself 1.2 % RMS from that reference on its own mesh, so it
-//! is not accurate enough to judge a 1 % agreement.
+//! factors and 4 x 4 by 4 x 4 visibility pairs, leaves down to a quarter of an element
+//! (the Cornell box; tests/hierarchical.rs, BENCHMARKS.md): at 2,046 elements 0.66 % RMS at
+//! epsilon 3e-4, 1.3 % at 1e-3, 5 % at 1e-2; at 19,591 elements 0.73 % at 1e-4 and 1.2 %
+//! at 3e-4 (a finer mesh has more links per element, each within the BF tolerance, so it
+//! needs a smaller epsilon for the same agreement). The dense solve with the default area
+//! k = 2 form factors is itself 1.2 % RMS from that reference on its own mesh, so it is not
+//! accurate enough to judge a 1 % agreement.
 //!
 //! # Energy account
 //!
