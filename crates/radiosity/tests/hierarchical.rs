@@ -363,9 +363,9 @@ fn cornell_box_element_by_element_against_an_exact_dense_solve() {
     // visibility samples differ). The bound is the target of issue #4 (1 % RMS; 1.5x the
     // measured value, for the visibility samples' variation between refinements); the
     // mean bound is 2x the measured one. The largest difference was 29 % (at 1,638
-    // elements, against contour k = 8) when pairs that
-    // sixteen sample pairs called hidden were dropped instead of refined (a footprint
-    // element lost the light its uncovered part sees); 0.2 keeps that out.
+    // elements, against contour k = 8) when pairs that sixteen sample pairs called hidden
+    // were dropped instead of refined (a footprint element lost the light its uncovered
+    // part sees); 0.2 keeps that out.
     let c = against_exact_dense(1000.0, 3e-4, 250.0);
     assert_eq!(c.elements, 2046);
     assert!(c.rms < 0.01, "{c:?}");
