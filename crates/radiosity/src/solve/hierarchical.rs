@@ -8,15 +8,15 @@
 //! five or more corners is first cut into the fan of triangles from its centroid (as
 //! [`crate::mesh`] does), each fan triangle a root of its own. Where a patch spans several
 //! elements of the mesh [`crate::mesh`] would make at the scene's `MAX_PATCH_AREA`, it
-//! splits along the grid line nearest its middle instead (four children, or two for a
-//! strip one element wide), so that the leaves nest with the mesh's elements: a leaf is a
-//! piece of one element or a union of whole ones, and a solution can be compared with a
-//! dense solve on that mesh element by element without mixing two grids (which alone
-//! differ by about 1.5 % RMS on the Cornell box at 2,000 elements). Triangles nest while
-//! their m is even. Above the roots sits a binary
-//! tree of *clusters* (median split of the roots' centres along the longest axis, down to
-//! single roots), so that the whole scene is one node. No matrix is stored: energy moves
-//! along *links*, each held by its receiver p and naming its source q.
+//! splits along the grid lines nearest its middle instead (four children, or two across a
+//! patch twice as long as wide), so that the leaves nest with the mesh's elements: a leaf
+//! is a piece of one element or a union of whole ones, and a solution can be compared with
+//! a dense solve on that mesh element by element without mixing two grids (two dense
+//! solutions on grids 4x apart differ by 1.7 % RMS on the Cornell box at 2,000 elements).
+//! Triangles nest while their m is even. Above the roots sits a binary tree of *clusters*
+//! (median split of the roots' centres along the longest axis, down to single roots), so
+//! that the whole scene is one node. No matrix is stored: energy moves along *links*, each
+//! held by its receiver p and naming its source q.
 //!
 //! # Clusters: light by direction
 //!
@@ -63,11 +63,10 @@
 //! oracle refines is refined whatever its visibility, even when all its sample pairs are
 //! blocked: a sliver that pokes out from under an object is easily missed by sixteen
 //! point pairs, and only the finished links (which the oracle accepts) are dropped when
-//! wholly hidden. B_ref is the
-//! area-weighted mean radiosity of the scene; before the first solve, the mean emission
-//! over one minus the mean reflectance (the ambient term of Cohen et al. 1988). The oracle
-//! is scale-free. Of the two nodes the larger (bounding radius) is split: a patch only
-//! while its area exceeds `min_area`, a cluster always.
+//! wholly hidden. B_ref is the area-weighted mean radiosity of the scene; before the first
+//! solve, the mean emission over one minus the mean reflectance (the ambient term of Cohen
+//! et al. 1988). The oracle is scale-free. Of the two nodes the larger (bounding radius) is
+//! split: a patch only while its area exceeds `min_area`, a cluster always.
 //!
 //! # Solving
 //!
@@ -339,9 +338,8 @@ fn mean_point_to_polygon(receiver: &[DVec3], normal: DVec3, source: &[DVec3]) ->
 /// The mean over the quarter points x of `receiver` (normal `n`) of the form factor to
 /// `source` (normal `m`, area `area`) by the point-to-point kernel from its four quarter
 /// points y, each standing for a quarter of its area: sum_y (A / 4) cos+ cos+ / (pi r^2)
-/// (the midpoint rule on both patches). For pairs more
-/// than three times the sum of their radii apart it is within a few parts in a thousand of
-/// the exact value, at a fraction of the cost of Lambert's formula (no arc tangents). One
+/// (the midpoint rule on both patches). For pairs more than three times the sum of their
+/// radii apart it is within a few parts in a thousand of the exact value, at a fraction of the cost of Lambert's formula (no arc tangents). One
 /// point for the source (the point-to-disc formula at its centre, used before) was biased
 /// low: where the source straddles the receiver's plane its centre may lie behind it, and
 /// the Cornell box's tilted block faces came out 8 % dark (0.5 % of all power lost).
@@ -560,9 +558,9 @@ impl Solver<'_> {
 
     /// The children of patch `n`, made on first use (they start with the parent's B).
     ///
-    /// A patch that spans several cells of the scene's mesh splits along the grid line
-    /// nearest its middle (in each direction that has more than one cell: four children,
-    /// or two for a strip), so that every element of the mesh is a node of the quadtree and
+    /// A patch that spans several cells of the scene's mesh splits along the grid lines
+    /// nearest its middle (four children; two, across its length, when it is twice as
+    /// many cells long as wide), so that every element of the mesh is a node of the quadtree and
     /// the leaves nest with the mesh's elements (a leaf is a union of elements or a piece of
     /// one); a triangle of m^2 cells with m even splits at its edge midpoints into four of
     /// (m/2)^2. Below one cell, or off the lattice (a triangle of odd m), a quadrilateral
