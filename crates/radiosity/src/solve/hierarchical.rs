@@ -54,7 +54,8 @@
 //! link misses the covariance of F and B where both peak together; for a cluster: the
 //! largest of its patches, as its mean would hide a small light among dark walls), F_hat = max(F_pq, F_qp) (F_qp by reciprocity) for patch links
 //! and the coupling of the two projected areas, Ap(p) Ap(q) / (pi r^2), over the smaller
-//! area otherwise (capped at 1). F_hat includes the visible fraction only when the pair is
+//! area otherwise (capped at 1; a cluster's projected area is raised by R / r times its
+//! area, for the directions its members see the other node from). F_hat includes the visible fraction only when the pair is
 //! fully visible, or is two patches hidden by at least eight facing point pairs (a
 //! cluster's few sample points were seen to call visible pairs hidden): a partly hidden
 //! link keeps its unoccluded F_hat, because the hidden part of a source is often its
@@ -805,9 +806,24 @@ impl Solver<'_> {
 
     /// F_hat of a link that involves a cluster: max(F_pq, F_qp) from the coupling
     /// A_p F_pq = Ap(p, -d) Ap(q, d) / (pi r^2) of the projected areas at the centres'
-    /// distance r (d: unit, from q to p), capped at 1.
+    /// distance r (d: unit, from q to p), capped at 1. A cluster's projected area is taken
+    /// in the direction from its centre, but its members see the other node from
+    /// directions up to R / r away: each cluster's is raised by (R / r) A, its area times
+    /// that angle. Without it a cluster of the Cornell box's light and the short block's
+    /// top, whose centre lies level with part of the red wall, sent the light no light
+    /// towards it by the oracle (the light faces down) and kept the coarse link: a
+    /// triangle of the red wall at 15 % of its radiosity at epsilon 0.1 (12.8 -> 8.8 %
+    /// RMS at epsilon 0.05, largest 177 -> 89 %; the building +12 % time).
     fn cluster_oracle(&self, np: &Node, nq: &Node, d: DVec3, r: f64) -> f64 {
-        let coupling = self.projected_area(np, -d) * self.projected_area(nq, d)
+        let spread = |n: &Node| {
+            if n.is_cluster() {
+                (n.radius / r).min(1.0) * n.area
+            } else {
+                0.0
+            }
+        };
+        let coupling = (self.projected_area(np, -d) + spread(np))
+            * (self.projected_area(nq, d) + spread(nq))
             / (std::f64::consts::PI * r * r);
         (coupling / np.area.min(nq.area)).min(1.0)
     }
