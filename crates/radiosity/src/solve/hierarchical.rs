@@ -52,11 +52,12 @@
 //! largest reflectance of p (of any patch, for a cluster), B_q the largest band of q's
 //! radiosity (for a patch: the larger of its mean and twice the spread of its leaves, as a
 //! link misses the covariance of F and B where both peak together; for a cluster: the
-//! largest of its patches, as its mean would hide a small light among dark walls), F_hat = max(F_pq, F_qp) (F_qp by reciprocity) for patch links
-//! and the coupling of the two projected areas, Ap(p) Ap(q) / (pi r^2), over the smaller
-//! area otherwise (capped at 1; a cluster's projected area is raised by R / r times its
-//! area, for the directions its members see the other node from). F_hat includes the visible fraction only when the pair is
-//! fully visible, or is two patches hidden by at least eight facing point pairs (a
+//! largest of its patches, as its mean would hide a small light among dark walls), F_hat =
+//! max(F_pq, F_qp) (F_qp by reciprocity) for patch links and the coupling of the two
+//! projected areas, Ap(p) Ap(q) / (pi r^2), over the smaller area otherwise (capped at 1; a
+//! cluster's projected area is raised by R / r times its area, for the directions its
+//! members see the other node from). F_hat includes the visible fraction only when the
+//! pair is fully visible, or is two patches hidden by at least eight facing point pairs (a
 //! cluster's few sample points were seen to call visible pairs hidden): a partly hidden
 //! link keeps its unoccluded F_hat, because the hidden part of a source is often its
 //! darkest (the floor behind a block is both unseen and in shadow), so the visible fraction
@@ -340,10 +341,11 @@ fn mean_point_to_polygon(receiver: &[DVec3], normal: DVec3, source: &[DVec3]) ->
 /// `source` (normal `m`, area `area`) by the point-to-point kernel from its four quarter
 /// points y, each standing for a quarter of its area: sum_y (A / 4) cos+ cos+ / (pi r^2)
 /// (the midpoint rule on both patches). For pairs more than three times the sum of their
-/// radii apart it is within a few parts in a thousand of the exact value, at a fraction of the cost of Lambert's formula (no arc tangents). One
-/// point for the source (the point-to-disc formula at its centre, used before) was biased
-/// low: where the source straddles the receiver's plane its centre may lie behind it, and
-/// the Cornell box's tilted block faces came out 8 % dark (0.5 % of all power lost).
+/// radii apart it is within a few parts in a thousand of the exact value, at a fraction of
+/// the cost of Lambert's formula (no arc tangents). One point for the source (the
+/// point-to-disc formula at its centre, used before) was biased low: where the source
+/// straddles the receiver's plane its centre may lie behind it, and the Cornell box's
+/// tilted block faces came out 8 % dark (0.5 % of all power lost).
 fn mean_point_pairs(receiver: &[DVec3], n: DVec3, source: &[DVec3], m: DVec3, area: f64) -> f64 {
     let ys = quarter_points(source);
     let weight = area / (4.0 * std::f64::consts::PI);
@@ -405,8 +407,8 @@ enum Estimate {
     Nothing,
     /// A link, and the rays cast for it.
     Link(Link, u64),
-    /// The pair must be refined (the rays cast to decide).
-    Refine(u64),
+    /// The pair must be refined (decided without rays).
+    Refine,
 }
 
 struct Solver<'a> {
@@ -561,11 +563,11 @@ impl Solver<'_> {
     ///
     /// A patch that spans several cells of the scene's mesh splits along the grid lines
     /// nearest its middle (four children; two, across its length, when it is twice as
-    /// many cells long as wide), so that every element of the mesh is a node of the quadtree and
-    /// the leaves nest with the mesh's elements (a leaf is a union of elements or a piece of
-    /// one); a triangle of m^2 cells with m even splits at its edge midpoints into four of
-    /// (m/2)^2. Below one cell, or off the lattice (a triangle of odd m), a quadrilateral
-    /// splits at its bilinear midpoints and a triangle at its edge midpoints.
+    /// many cells long as wide), so that every element of the mesh is a node of the
+    /// quadtree and the leaves nest with the mesh's elements (a leaf is a union of elements
+    /// or a piece of one); a triangle of m^2 cells with m even splits at its edge midpoints
+    /// into four of (m/2)^2. Below one cell, or off the lattice (a triangle of odd m), a
+    /// quadrilateral splits at its bilinear midpoints and a triangle at its edge midpoints.
     fn split_patch(&mut self, n: u32) -> Vec<u32> {
         let node = &self.nodes[n as usize];
         if node.child_count > 0 {
@@ -871,7 +873,7 @@ impl Solver<'_> {
                         dir: [0.0; 3],
                     };
                     if self.wants_refining(p, &probe, b_ref) {
-                        return Estimate::Refine(0);
+                        return Estimate::Refine;
                     }
                 }
                 let f_pq = if near {
@@ -924,7 +926,7 @@ impl Solver<'_> {
             // out from under an object (a floor patch partly under a block, whose uncovered
             // part sees the light, came out 80 % dark in the Cornell box when such pairs
             // were dropped). The children's links decide, with their own rays.
-            return Estimate::Refine(0);
+            return Estimate::Refine;
         }
         let (fraction, rays, facing) = self.visibility(p, q, scratch);
         if fraction == 0.0 && facing >= 8 && !cluster_link {
@@ -1039,10 +1041,7 @@ impl Solver<'_> {
                         self.rays += rays;
                         Some(link)
                     }
-                    Estimate::Refine(rays) => {
-                        self.rays += rays;
-                        None
-                    }
+                    Estimate::Refine => None,
                 };
                 let refine = match &link {
                     None => true,
