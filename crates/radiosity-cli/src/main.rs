@@ -30,12 +30,17 @@ use glam::DVec3;
 use image::RgbImage;
 use radiosity::form_factor::{FormFactorMatrix, FormFactorMethod};
 use radiosity::mesh::Mesh;
-use radiosity::pipeline::{FormFactorStats, Overrides, Prepared, Solution, SolutionReport};
+use radiosity::pipeline::{
+    self as pipeline, FormFactorStats, FormFactors, Overrides, Prepared, Solution, SolutionReport,
+    SolveRequest,
+};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
 use radiosity::scene::{self, Scene};
 use radiosity::shade::{self, Exposure};
-use radiosity::solve::{ProgressiveState, Solver};
+use radiosity::solve::{
+    keep_going, GaussSeidelSettings, Observer, ProgressiveSettings, Solver, SolverKind, Step,
+};
 
 use progress_bar::{format_duration, Reporter};
 
@@ -163,7 +168,7 @@ struct MethodArgs {
 #[derive(Args)]
 struct SolveOptions {
     /// Solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
+    #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
     solver: SolverArg,
     /// Where the solver stops. Gauss-Seidel: the relative residual (default 1e-9).
     /// Progressive: the unshot power as a fraction of the emitted power, in every band (the
@@ -206,21 +211,31 @@ enum MethodArg {
     Montecarlo,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum SolverArg {
-    /// Gauss-Seidel on the dense matrix when it fits comfortably and the scene is small,
-    /// hierarchical radiosity otherwise; says which and why.
-    Auto,
-    /// LU factorisation with partial pivoting (the paper's Gaussian elimination).
-    Lu,
-    /// Gauss-Seidel iteration to --tolerance.
-    GaussSeidel,
-    /// Progressive refinement (Cohen et al. 1988): shoot the brightest element's unshot
-    /// power, one row of form factors per shot, no matrix stored; to --tolerance unshot.
-    Progressive,
-    /// Hierarchical radiosity (Hanrahan et al. 1991): quadtrees and links, no matrix,
-    /// refined to --epsilon down to --min-area; the leaves are the elements shaded.
-    Hierarchical,
+/// `--solver`: the library's [`SolverKind`], its names and help as the library gives them.
+#[derive(Clone, Copy)]
+struct SolverArg(SolverKind);
+
+impl ValueEnum for SolverArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        const ALL: [SolverArg; 5] = [
+            SolverArg(SolverKind::ALL[0]),
+            SolverArg(SolverKind::ALL[1]),
+            SolverArg(SolverKind::ALL[2]),
+            SolverArg(SolverKind::ALL[3]),
+            SolverArg(SolverKind::ALL[4]),
+        ];
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()).help(self.0.help()))
+    }
+}
+
+impl std::fmt::Display for SolverArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -344,7 +359,7 @@ struct BenchArgs {
     #[arg(long, default_value_t = 5, value_name = "N")]
     repeat: usize,
     /// Solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
+    #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
     solver: SolverArg,
     /// Where the solver stops (as for `render --tolerance`: 1e-9 residual for Gauss-Seidel,
     /// 0.01 unshot for progressive).
@@ -385,11 +400,47 @@ fn describe(err: &anyhow::Error) -> String {
             text = format!("{text}: {cause}");
         }
     }
+    if let Some(hint) = hint(err) {
+        text = format!("{text}\nhint: {hint}");
+    }
     if err.downcast_ref::<scene::SceneError>().is_some() {
         text
     } else {
         format!("error: {text}")
     }
+}
+
+/// The flags that change what the library refused, for the errors where one does (the
+/// library's messages name no flags).
+fn hint(err: &anyhow::Error) -> Option<&'static str> {
+    use radiosity::pipeline::PipelineError;
+    use radiosity::solve::SolveError;
+    let solve_hint = |e: &SolveError| match e {
+        SolveError::HierarchicalTooBig { .. } => {
+            Some("raise --epsilon or --min-area (hierarchical radiosity refines less)")
+        }
+        SolveError::NotConverged { .. } => Some("loosen --tolerance or use --solver lu"),
+        SolveError::ProgressiveNotConverged { .. } => {
+            Some("raise --max-shots or loosen --tolerance")
+        }
+        _ => None,
+    };
+    err.chain().find_map(|cause| {
+        if let Some(e) = cause.downcast_ref::<PipelineError>() {
+            match e {
+                PipelineError::TooManyPoints { .. } => {
+                    Some("use fewer steps (--steps) or larger elements (--max-area)")
+                }
+                PipelineError::FormFactorsUnused { .. } => {
+                    Some("--form-factors applies to --solver gauss-seidel and lu only")
+                }
+                PipelineError::Solve(e) => solve_hint(e),
+                _ => None,
+            }
+        } else {
+            cause.downcast_ref::<SolveError>().and_then(solve_hint)
+        }
+    })
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -462,7 +513,7 @@ fn prepare(
         )?),
         None => None,
     };
-    prepared.check_memory(solver)?;
+    prepared.check_memory(solver.as_ref())?;
     reporter.note(&format!(
         "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
         stem,
@@ -508,6 +559,12 @@ fn form_factors(
         prepared.method().occlusion()
     ));
     let (f, stats) = prepared.form_factors(reporter)?;
+    note_form_factor_stats(prepared, &stats, reporter);
+    Ok((f, Some(stats)))
+}
+
+/// Notes what computing the form factors found.
+fn note_form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter: &Reporter) {
     reporter.note(&format!(
         "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
          reciprocity error {:.1e} largest, {:.1e} of exchanged power",
@@ -521,7 +578,6 @@ fn form_factors(
         stats.reciprocity.max_relative,
         stats.reciprocity.total_relative
     ));
-    Ok((f, Some(stats)))
 }
 
 /// The solver the options ask for; `auto` is decided from the element count `n` and the
@@ -537,44 +593,40 @@ fn solver(
             bail!("--tolerance must be a positive number, got {t}");
         }
     }
-    let choice = match options.solver {
-        SolverArg::Auto if options.form_factors.is_some() => SolverArg::GaussSeidel,
-        SolverArg::Auto => {
-            let (dense, reason) = radiosity::pipeline::choose_dense(
-                n,
-                radiosity::form_factor::available_memory_bytes(),
-            );
-            reporter.note(&format!("solver auto: {reason}"));
-            if dense {
-                SolverArg::GaussSeidel
-            } else {
-                SolverArg::Hierarchical
-            }
+    let choice = match options.solver.0 {
+        SolverKind::Auto if options.form_factors.is_some() => SolverKind::GaussSeidel,
+        SolverKind::Auto => {
+            let choice =
+                radiosity::solve::choose(n, radiosity::form_factor::available_memory_bytes());
+            reporter.note(&format!("solver auto: {choice}"));
+            choice.kind()
         }
         other => other,
     };
     Ok(match choice {
-        SolverArg::Auto => unreachable!("auto is resolved above"),
-        SolverArg::Lu => Solver::Lu,
-        SolverArg::GaussSeidel => Solver::GaussSeidel {
-            tolerance: options.tolerance.unwrap_or(1e-9),
-            max_iterations: 10_000,
-        },
-        SolverArg::Progressive => {
+        SolverKind::Auto => unreachable!("auto is resolved above"),
+        SolverKind::Lu => Solver::LU,
+        SolverKind::GaussSeidel => Solver::Dense(radiosity::solve::DenseSolver::GaussSeidel(
+            GaussSeidelSettings {
+                tolerance: options.tolerance.unwrap_or(1e-9),
+                ..GaussSeidelSettings::default()
+            },
+        )),
+        SolverKind::Progressive => {
             if options.form_factors.is_some() {
                 bail!("--form-factors cannot be used with --solver progressive, which computes its rows as it shoots");
             }
             if options.max_shots == 0 {
                 bail!("--max-shots must be at least 1");
             }
-            Solver::Progressive {
+            Solver::Progressive(ProgressiveSettings {
                 tolerance: options
                     .tolerance
                     .unwrap_or(radiosity::solve::DEFAULT_PROGRESSIVE_TOLERANCE),
                 max_shots: options.max_shots,
-            }
+            })
         }
-        SolverArg::Hierarchical => {
+        SolverKind::Hierarchical => {
             if options.form_factors.is_some() {
                 bail!("--form-factors cannot be used with --solver hierarchical, which uses links, not a matrix");
             }
@@ -604,12 +656,9 @@ fn solver(
     })
 }
 
-/// What a solve watches as it goes: a progressive solve calls it after every shot.
-type Observer<'a> = dyn FnMut(&ProgressiveState) -> ControlFlow<()> + 'a;
-
-/// Solves with `solver`: progressive refinement straight from the scene (no matrix), any
-/// other solver on the form factors (read from `file` or computed, then dropped). Returns
-/// the form-factor statistics when they were computed.
+/// Solves with `solver`: the dense solvers on the form factors (read from `file` or
+/// computed, then dropped), the others from the scene. Returns the form-factor statistics
+/// when they were computed.
 fn solve_scene(
     prepared: &Prepared,
     solver: Solver,
@@ -617,21 +666,31 @@ fn solve_scene(
     observer: &mut Observer,
     reporter: &Reporter,
 ) -> Result<(Solution, Option<FormFactorStats>)> {
-    if let Solver::Progressive {
-        tolerance,
-        max_shots,
-    } = solver
-    {
-        // The library reports the shots and the unshot fraction through the reporter.
-        let solution = prepared.solve_progressive(tolerance, max_shots, observer, reporter)?;
-        return Ok((solution, None));
+    let form_factors = match file {
+        Some(path) => FormFactors::File(path),
+        None => FormFactors::Compute,
+    };
+    if solver.needs_matrix() {
+        match form_factors {
+            FormFactors::File(path) => {
+                reporter.note(&format!("form factors read from {}", path.display()))
+            }
+            _ => reporter.note(&format!(
+                "form factors by {}; occlusion: {}",
+                prepared.method(),
+                prepared.method().occlusion()
+            )),
+        }
     }
-    if let Solver::Hierarchical(settings) = solver {
-        let solution = prepared.solve_hierarchical(&settings, reporter)?;
-        return Ok((solution, None));
+    let request = SolveRequest {
+        form_factors,
+        ..SolveRequest::new(solver)
+    };
+    let solution = pipeline::solve(prepared, &request, observer, reporter)?;
+    if let Some(stats) = &solution.form_factors {
+        note_form_factor_stats(prepared, stats, reporter);
     }
-    let (f, stats) = form_factors(prepared, file, reporter)?;
-    let solution = prepared.solve(&f, solver, reporter)?;
+    let stats = solution.form_factors;
     Ok((solution, stats))
 }
 
@@ -655,8 +714,8 @@ fn render_command(args: RenderArgs) -> Result<()> {
     // reporter, so that their shading and rendering do not count in the stage times.
     let mut snapshot_error = None;
     let mut written = 0usize;
-    let mut observer = |state: &ProgressiveState| {
-        let Some(dir) = &args.snapshots else {
+    let mut observer = |step: &Step| {
+        let (Some(dir), Step::Shot(state)) = (&args.snapshots, step) else {
             return ControlFlow::Continue(());
         };
         if state.shot % args.snapshot_every != 0 {
@@ -667,7 +726,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         let image = shade_and_render(
             &prepared,
             &prepared.mesh,
-            &display,
+            radiosity::light::Rgb::as_arrays(&display),
             &camera,
             settings,
             exposure,
@@ -701,8 +760,8 @@ fn render_command(args: RenderArgs) -> Result<()> {
     }
     let image = shade_and_render(
         &prepared,
-        solution.mesh(&prepared),
-        &solution.element_rgb(),
+        &solution.mesh,
+        solution.element_rgb(),
         &camera,
         settings,
         exposure,
@@ -875,15 +934,15 @@ fn solve_command(args: SolveArgs) -> Result<()> {
         radiosity::solution::write_solution(
             &output,
             &prepared.scene,
-            solution.mesh(&prepared),
-            &solution.element_rgb(),
+            &solution.mesh,
+            solution.element_rgb(),
         )
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
     reporter.note(&format!(
         "wrote {} ({} elements)",
         output.display(),
-        solution.mesh(&prepared).len()
+        solution.mesh.len()
     ));
     reporter.print_timings();
     Ok(())
@@ -911,19 +970,6 @@ fn mib(bytes: Option<u64>, reset: bool) -> String {
     }
 }
 
-/// A solver and its main settings, short enough for a table cell.
-fn short_name(solver: &Solver) -> String {
-    match solver {
-        Solver::Lu => "lu".into(),
-        Solver::GaussSeidel { tolerance, .. } => format!("gauss-seidel {tolerance:e}"),
-        Solver::Progressive { tolerance, .. } => format!("progressive {tolerance:e}"),
-        Solver::Hierarchical(h) => format!(
-            "hierarchical eps {} min {} tol {:e}",
-            h.epsilon, h.min_area, h.tolerance
-        ),
-    }
-}
-
 fn compare_command(args: CompareArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
@@ -939,31 +985,33 @@ fn compare_command(args: CompareArgs) -> Result<()> {
     )?;
     let time = start.elapsed().as_secs_f64();
     let peak = peak_memory_bytes();
-    let elements = solution.mesh(&prepared).len();
+    let elements = solution.mesh.len();
     let mut reference = ("-".to_string(), "-".to_string(), "-".to_string());
     let mut difference = ("-".to_string(), "-".to_string(), "-".to_string());
     if !args.no_reference {
         let dense = Solver::DEFAULT_GAUSS_SEIDEL;
-        match prepared.check_memory(Some(dense)) {
+        match prepared.check_memory(Some(&dense)) {
             Err(e) => reporter.note(&format!("no dense reference: {e}")),
             Ok(()) => {
                 let reset = reset_peak_memory();
                 let start = std::time::Instant::now();
-                let (f, _) = prepared.form_factors(&reporter)?;
-                let exact = prepared.solve(&f, dense, &reporter)?;
-                drop(f);
+                let exact = pipeline::solve(
+                    &prepared,
+                    &SolveRequest::new(dense),
+                    &mut keep_going,
+                    &reporter,
+                )?;
                 reference = (
                     format!("{:.2}", start.elapsed().as_secs_f64()),
                     mib(peak_memory_bytes(), reset),
                     String::new(),
                 );
-                let (_, emission) =
-                    radiosity::solve::element_properties(&prepared.mesh, &prepared.scene);
+                let emission = prepared.light.emission();
                 let c = radiosity::compare::compare(
                     &prepared.mesh,
                     &exact.radiosity,
                     &emission,
-                    solution.mesh(&prepared),
+                    &solution.mesh,
                     &solution.radiosity,
                 )?;
                 difference = (
@@ -979,7 +1027,7 @@ fn compare_command(args: CompareArgs) -> Result<()> {
     outln!(
         "| {stem} | {} | {} | {elements} | {time:.2} | {} | {} | {} | {} | {} | {} | {} |",
         prepared.mesh.len(),
-        short_name(&solver),
+        solver.short_label(),
         mib(peak, reset),
         if args.no_reference {
             "-".to_string()
@@ -1093,20 +1141,21 @@ fn check_command(args: CheckArgs) -> Result<()> {
             }
             None => prepared.form_factors(&reporter)?,
         };
-        (prepared.solve(&f, solver, &reporter)?, Some(stats))
+        let request = SolveRequest {
+            form_factors: FormFactors::Matrix(&f),
+            ..SolveRequest::new(solver)
+        };
+        let solution = pipeline::solve(&prepared, &request, &mut keep_going, &reporter)?;
+        (solution, Some(stats))
     } else {
         // Progressive refinement never holds the matrix: no row sums or reciprocity.
-        let observer = &mut |_: &ProgressiveState| ControlFlow::Continue(());
-        solve_scene(&prepared, solver, None, observer, &reporter)?
+        solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?
     };
     let scene = &prepared.scene;
     outln!("scene             {stem}");
     outln!("surfaces          {}", scene.surfaces.len());
-    outln!("elements          {}", solution.mesh(&prepared).len());
-    outln!(
-        "total area        {:.6}",
-        solution.mesh(&prepared).total_area()
-    );
+    outln!("elements          {}", solution.mesh.len());
+    outln!("total area        {:.6}", solution.mesh.total_area());
     outln!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
     outln!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
     outln!("method            {}", prepared.method());
@@ -1233,8 +1282,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let start = std::time::Instant::now();
     let (prepared, _, solver) = prepare(&scene_args, Some(&options), &reporter)?;
     let solver = solver.expect("prepare resolves the solver it is given options for");
-    let observer = &mut |_: &ProgressiveState| ControlFlow::Continue(());
-    let (solution, stats) = solve_scene(&prepared, solver, None, observer, &reporter)?;
+    let (solution, stats) = solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?;
     let rays = match (&stats, &solution.report) {
         (Some(s), _) => s.rays,
         (None, SolutionReport::Progressive(r)) => r.rays,
@@ -1244,8 +1292,8 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let camera = Camera::for_scene(&prepared.scene, args.size, args.size);
     let image = shade_and_render(
         &prepared,
-        solution.mesh(&prepared),
-        &solution.element_rgb(),
+        &solution.mesh,
+        solution.element_rgb(),
         &camera,
         settings,
         Exposure::Brightest,
@@ -1260,7 +1308,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         }
     }
     Ok(BenchRun {
-        elements: solution.mesh(&prepared).len(),
+        elements: solution.mesh.len(),
         steps: prepared.scene.settings.integral_steps,
         stages,
         total,
@@ -1315,14 +1363,14 @@ fn bench_command(args: BenchArgs) -> Result<()> {
     } else {
         args.max_area.iter().copied().map(Some).collect()
     };
-    let solver_name = match args.solver {
-        SolverArg::Auto => {
+    let solver_name = match args.solver.0 {
+        SolverKind::Auto => {
             "auto (dense Gauss-Seidel up to 20,000 elements when it fits, else progressive)"
         }
-        SolverArg::Lu => "LU",
-        SolverArg::GaussSeidel => "Gauss-Seidel",
-        SolverArg::Progressive => "progressive (form factors computed within the solve)",
-        SolverArg::Hierarchical => "hierarchical (links computed within the solve)",
+        SolverKind::Lu => "LU",
+        SolverKind::GaussSeidel => "Gauss-Seidel",
+        SolverKind::Progressive => "progressive (form factors computed within the solve)",
+        SolverKind::Hierarchical => "hierarchical (links computed within the solve)",
     };
     errln!(
         "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",

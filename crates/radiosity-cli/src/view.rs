@@ -27,7 +27,8 @@ pub struct ViewArgs {
     /// progressive refinement shows light sooner.
     #[arg(long)]
     dense: bool,
-    /// The solver: auto (the two options above decide), hierarchical (hierarchical
+    /// The solver: auto (the two options above decide), dense or gauss-seidel (Gauss-Seidel
+    /// on the cached matrix when it fits), lu, progressive, hierarchical (hierarchical
     /// radiosity with clustering, --epsilon, --min-area; the window shows its leaves and an
     /// edit re-runs it).
     #[arg(long, value_name = "SOLVER", default_value = "auto", conflicts_with_all = ["dense", "progressive"])]
@@ -78,7 +79,8 @@ pub struct ViewArgs {
 pub fn view_command(args: ViewArgs) -> Result<()> {
     use anyhow::bail;
     use radiosity::pipeline::Overrides;
-    use radiosity_viewer::{worker::Strategy, ViewerOptions};
+    use radiosity::solve::SolverKind;
+    use radiosity_viewer::{worker::ViewSolver, ViewerOptions};
 
     if args.steps == Some(0) {
         bail!("--steps must be at least 1");
@@ -103,35 +105,36 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
         max_patch_area: args.max_area,
         integral_steps: args.steps,
     };
+    // `dense` is the window's name for Gauss-Seidel on the cached matrix; every other name
+    // is the library's.
+    let mut kind = match args.solver.as_str() {
+        "dense" => SolverKind::GaussSeidel,
+        name => name.parse::<SolverKind>()?,
+    };
     if args.progressive {
-        options.strategy = Strategy::Progressive;
+        kind = SolverKind::Progressive;
     } else if args.dense {
-        options.strategy = Strategy::Dense;
+        kind = SolverKind::GaussSeidel;
     }
-    match args.solver.as_str() {
-        "auto" => {}
-        "dense" => options.strategy = Strategy::Dense,
-        "progressive" => options.strategy = Strategy::Progressive,
-        "hierarchical" => {
-            let max_area = args
-                .max_area
-                .unwrap_or(options.scene.settings.max_patch_area);
-            let min_area = args.min_area.unwrap_or(max_area / 16.0);
-            if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
-                bail!("--epsilon must be a positive number, got {}", args.epsilon);
-            }
-            if !(min_area > 0.0 && min_area.is_finite()) {
-                bail!("--min-area must be a positive number, got {min_area}");
-            }
-            options.strategy = Strategy::Hierarchical(radiosity::solve::HierarchicalSettings {
-                epsilon: args.epsilon,
-                min_area,
-                tolerance: radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE,
-                max_memory_bytes: None,
-            });
+    let mut hierarchical = None;
+    if kind == SolverKind::Hierarchical {
+        let max_area = args
+            .max_area
+            .unwrap_or(options.scene.settings.max_patch_area);
+        let min_area = args.min_area.unwrap_or(max_area / 16.0);
+        if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
+            bail!("--epsilon must be a positive number, got {}", args.epsilon);
         }
-        other => bail!("--solver must be auto, dense, progressive or hierarchical, got {other}"),
+        if !(min_area > 0.0 && min_area.is_finite()) {
+            bail!("--min-area must be a positive number, got {min_area}");
+        }
+        hierarchical = Some(radiosity::solve::HierarchicalSettings {
+            epsilon: args.epsilon,
+            min_area,
+            ..radiosity::solve::HierarchicalSettings::defaults_for(max_area)
+        });
     }
+    options.solver = ViewSolver { kind, hierarchical };
     options.screenshot = args.screenshot;
     options.frames = args.frames;
     options.panel = args.panel;

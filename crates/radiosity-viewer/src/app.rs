@@ -129,7 +129,7 @@ impl ViewerApp {
         let (edits, updates, progress) = worker::spawn(
             options.scene.clone(),
             options.overrides,
-            options.strategy,
+            options.solver,
             wake,
         );
         let gpu = cc.wgpu_render_state.as_ref().map(|rs| {
@@ -198,8 +198,12 @@ impl ViewerApp {
             match update {
                 Update::Mesh(mesh, bvh) => {
                     // Unlit until the first solution: show the emission.
-                    let (_, e) = radiosity::solve::element_properties(&mesh, &self.modeller.scene);
-                    self.element_b = e;
+                    let surfaces = &self.modeller.scene.surfaces;
+                    self.element_b = mesh
+                        .elements
+                        .iter()
+                        .map(|e| surfaces[e.surface as usize].emission.0)
+                        .collect();
                     self.colours_dirty = true;
                     self.mesh = Some(mesh);
                     self.bvh = Some(bvh);

@@ -6,17 +6,16 @@ use std::time::Instant;
 
 use glam::DVec3;
 use radiosity::mesh::{mesh_scene, Mesh};
-use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::pipeline::{self, FormFactors, Overrides, Prepared, SolutionReport, SolveRequest};
 use radiosity::progress::NoProgress;
 use radiosity::render::Camera;
 use radiosity::scene::{cornell_box, Rgb, Scene};
 use radiosity::shade::{self, Exposure};
-use radiosity::solve::{self, element_properties, Solver};
+use radiosity::solve::{keep_going, DenseSolver, GaussSeidelSettings, Solver, Step};
 
 use crate::gpu::{
     colour_vertices, geometry_vertices, mesh_bounds, Headless, MeshRenderer, Style, Target,
 };
-use crate::model::resolve;
 use crate::worker::VIEW_TOLERANCE;
 
 /// Frame-time figures of one scene.
@@ -91,15 +90,16 @@ pub fn solved_cornell(max_area: f64) -> Result<Solved, String> {
         &NoProgress,
     )
     .map_err(|e| e.to_string())?;
-    let (f, _) = prepared
-        .form_factors(&NoProgress)
-        .map_err(|e| e.to_string())?;
-    let solution = prepared
-        .solve(&f, Solver::DEFAULT_GAUSS_SEIDEL, &NoProgress)
-        .map_err(|e| e.to_string())?;
-    let b = solution.element_rgb();
+    let solution = pipeline::solve(
+        &prepared,
+        &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
+        &mut keep_going,
+        &NoProgress,
+    )
+    .map_err(|e| e.to_string())?;
+    let b = solution.element_rgb().to_vec();
     let scale = Exposure::Brightest.scale(&prepared.scene, &prepared.mesh, &b);
-    Ok((prepared.scene, prepared.mesh, b, scale))
+    Ok((prepared.scene, (*prepared.mesh).clone(), b, scale))
 }
 
 /// `copies` copies of `mesh`'s triangles on a square grid in x and z (1.25 scene widths
@@ -188,11 +188,20 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
         .form_factors(&NoProgress)
         .map_err(|e| e.to_string())?;
     let form_factor_s = t.elapsed().as_secs_f64();
-    let mesh = &prepared.mesh;
-    let (rho, e) = element_properties(mesh, &prepared.scene);
-    let mut b = e.clone();
-    resolve(&f, &rho, &e, &mut b, VIEW_TOLERANCE, 10_000, |_, _| true);
-    let scale = Exposure::Brightest.scale(&prepared.scene, mesh, &b);
+    let mesh = &prepared.mesh.clone();
+    let solver = Solver::Dense(DenseSolver::GaussSeidel(GaussSeidelSettings {
+        tolerance: VIEW_TOLERANCE,
+        max_iterations: 10_000,
+    }));
+    let request = |start| SolveRequest {
+        solver,
+        form_factors: FormFactors::Matrix(&f),
+        start,
+    };
+    let b = pipeline::solve(&prepared, &request(None), &mut keep_going, &NoProgress)
+        .map_err(|e| e.to_string())?
+        .radiosity;
+    let scale = Exposure::Brightest.scale(&prepared.scene, mesh, b.as_arrays());
     let camera = Camera::for_scene(&prepared.scene, 1280, 800);
     let mut renderer = MeshRenderer::new(&gpu.device);
     renderer.set_mesh(&gpu.device, mesh);
@@ -209,9 +218,10 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
         gpu.queue.submit([encoder.finish()]);
         let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
     };
-    picture(&b);
+    picture(b.as_arrays());
 
     // The edit
+    let mut prepared = prepared;
     let mut scene = prepared.scene.clone();
     for s in scene
         .surfaces
@@ -220,21 +230,40 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
     {
         s.reflectance = Rgb([0.2, 0.3, 0.75]);
     }
+    let colours: Vec<_> = scene
+        .surfaces
+        .iter()
+        .map(|s| (s.reflectance, s.emission))
+        .collect();
     let start = Instant::now();
-    let (rho2, e2) = element_properties(mesh, &scene);
+    prepared.recolour(&colours).map_err(|e| e.to_string())?;
     let mut first: Option<f64> = None;
-    let report = resolve(&f, &rho2, &e2, &mut b, VIEW_TOLERANCE, 10_000, |b, _| {
-        if first.is_none() {
-            picture(b);
+    let mut observer = |step: &Step| {
+        if let (None, Step::Sweep { radiosity, .. }) = (first, step) {
+            picture(Rgb::as_arrays(radiosity));
             first = Some(start.elapsed().as_secs_f64() * 1e3);
         }
-        true
-    });
-    picture(&b);
+        std::ops::ControlFlow::Continue(())
+    };
+    let solution = pipeline::solve(
+        &prepared,
+        &request(Some(b.as_slice())),
+        &mut observer,
+        &NoProgress,
+    )
+    .map_err(|e| e.to_string())?;
+    let SolutionReport::Matrix(report) = solution.report else {
+        return Err("a dense solve reports as one".into());
+    };
+    picture(solution.element_rgb());
     let converged_picture_ms = start.elapsed().as_secs_f64() * 1e3;
     let lu_ms = (mesh.len() <= 5_000).then(|| {
         let t = Instant::now();
-        let _ = solve::solve(&f, &rho2, &e2, Solver::Lu, &NoProgress);
+        let lu = SolveRequest {
+            form_factors: FormFactors::Matrix(&f),
+            ..SolveRequest::new(Solver::LU)
+        };
+        let _ = pipeline::solve(&prepared, &lu, &mut keep_going, &NoProgress);
         t.elapsed().as_secs_f64() * 1e3
     });
     Ok(EditTiming {
@@ -243,7 +272,7 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
         form_factor_s,
         first_picture_ms: first.unwrap_or(converged_picture_ms),
         converged_picture_ms,
-        sweeps: report.sweeps,
+        sweeps: report.iterations.unwrap_or(0),
         lu_ms,
     })
 }

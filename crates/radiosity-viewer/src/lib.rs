@@ -9,9 +9,9 @@
 //! * [`gpu`]: the wgpu pipeline, shared by the window and by [`gpu::render_offscreen`],
 //!   which returns pixels without any window (tests, screenshots, benchmarks).
 //! * [`camera::CameraController`]: the walking camera, a plain struct.
-//! * [`model`]: the edited scene with undo, and [`model::resolve`], the warm-started
-//!   Gauss-Seidel re-solve.
-//! * [`worker`]: the solve thread (dense with cached form factors, or progressive
+//! * [`model`]: the edited scene with undo.
+//! * [`worker`]: the solve thread, on the library's solvers (dense with cached form
+//!   factors and warm-started Gauss-Seidel re-solves, or progressive
 //!   refinement for large scenes), sending intermediate solutions to the window.
 //! * [`bench`]: frame time and edit-to-picture measurements.
 //!
@@ -21,7 +21,11 @@
 //! ```no_run
 //! let scene = radiosity::scene::cornell_box();
 //! let mesh = radiosity::mesh::mesh_scene(&scene, 1000.0).unwrap();
-//! let (_, e) = radiosity::solve::element_properties(&mesh, &scene);
+//! let e: Vec<[f64; 3]> = mesh
+//!     .elements
+//!     .iter()
+//!     .map(|el| scene.surfaces[el.surface as usize].emission.0)
+//!     .collect();
 //! let camera = radiosity::render::Camera::for_scene(&scene, 256, 256);
 //! let (image, adapter) = radiosity_viewer::gpu::render_offscreen(
 //!     &mesh, &e, &[], &camera, &Default::default()).unwrap();
@@ -52,8 +56,8 @@ pub struct ViewerOptions {
     pub path: Option<PathBuf>,
     /// `--max-area` and `--steps`.
     pub overrides: Overrides,
-    /// Dense solve when it fits (auto) or always progressive refinement.
-    pub strategy: worker::Strategy,
+    /// The solver (see [`worker::ViewSolver`] for the window's `auto`).
+    pub solver: worker::ViewSolver,
     /// Save a screenshot of the whole window here after `frames` frames of the solved
     /// scene, then close.
     pub screenshot: Option<PathBuf>,
@@ -71,13 +75,13 @@ pub struct ViewerOptions {
 }
 
 impl ViewerOptions {
-    /// The defaults for `scene`: auto strategy, no screenshot, 1280 x 800.
+    /// The defaults for `scene`: the window's auto solver, no screenshot, 1280 x 800.
     pub fn new(scene: Scene, path: Option<PathBuf>) -> ViewerOptions {
         ViewerOptions {
             scene,
             path,
             overrides: Overrides::default(),
-            strategy: worker::Strategy::Auto,
+            solver: worker::ViewSolver::auto(),
             screenshot: None,
             frames: 30,
             panel: false,

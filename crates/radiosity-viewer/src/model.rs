@@ -1,15 +1,11 @@
-//! The modeller's data: surface colours, their undo history, and the re-solve that turns a
-//! colour change into new radiosities from the cached form factors.
+//! The modeller's data: surface colours and their undo history.
 //!
 //! Form factors depend only on geometry (paper 1.2), so a reflectance or emission edit
-//! needs only a new solve of (I - rho F) B = E. [`resolve`] runs Gauss-Seidel sweeps
-//! starting from the previous solution (a warm start): after a small edit the old B is
-//! already close, so far fewer sweeps are needed than from B = E. BENCHMARKS.md compares
-//! it with refactoring the LU.
+//! needs only a new solve of (I - rho F) B = E: the worker re-solves with the library's
+//! Gauss-Seidel on the cached matrix, starting from the previous solution (a warm start:
+//! after a small edit the old B is already close, so far fewer sweeps are needed than from
+//! B = E). BENCHMARKS.md compares it with refactoring the LU.
 
-use std::time::{Duration, Instant};
-
-use radiosity::form_factor::FormFactorMatrix;
 use radiosity::scene::{Rgb, Scene};
 
 /// The colours of one surface: what the modeller edits.
@@ -105,119 +101,38 @@ impl Modeller {
     }
 }
 
-/// How a re-solve went.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ResolveReport {
-    /// Gauss-Seidel sweeps made.
-    pub sweeps: usize,
-    /// The last sweep's largest change relative to max |E| (an upper bound on the relative
-    /// residual after it; see radiosity's `solve::gauss_seidel`).
-    pub change: f64,
-    /// Wall-clock time.
-    pub elapsed: Duration,
-    /// False when it was stopped by `observer` or ran out of sweeps.
-    pub converged: bool,
-}
-
-/// Gauss-Seidel sweeps B_i <- E_i + rho_i sum_j F_ij B_j over all three bands, in place,
-/// starting from the `b` given (the previous solution: a warm start), until the largest
-/// change in a sweep relative to max |E| is below `tolerance` or `max_sweeps` sweeps are
-/// done. After each sweep `observer` gets the current B and the sweep's change and may stop
-/// the solve by returning false (the window shows intermediate solutions this way).
-///
-/// The change in a sweep bounds the residual after it (radiosity's Gauss-Seidel uses the
-/// same test), and the error of B is at most residual / (1 - max rho * max row sum).
-///
-/// # Panics
-/// If the lengths of `reflectance`, `emission` and `b` differ from `f.n()`.
-pub fn resolve(
-    f: &FormFactorMatrix,
-    reflectance: &[[f64; 3]],
-    emission: &[[f64; 3]],
-    b: &mut [[f64; 3]],
-    tolerance: f64,
-    max_sweeps: usize,
-    mut observer: impl FnMut(&[[f64; 3]], f64) -> bool,
-) -> ResolveReport {
-    let n = f.n();
-    assert!(reflectance.len() == n && emission.len() == n && b.len() == n);
-    let start = Instant::now();
-    let scale = emission
-        .iter()
-        .flat_map(|e| e.iter())
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    if scale == 0.0 {
-        // Nothing emits: B = 0 exactly.
-        b.iter_mut().for_each(|x| *x = [0.0; 3]);
-        observer(b, 0.0);
-        return ResolveReport {
-            sweeps: 0,
-            change: 0.0,
-            elapsed: start.elapsed(),
-            converged: true,
-        };
-    }
-    let mut change = f64::INFINITY;
-    for sweep in 1..=max_sweeps {
-        let mut largest = 0.0f64;
-        for i in 0..n {
-            let h = row_dot3(f.row(i), b);
-            for k in 0..3 {
-                let new = emission[i][k] + reflectance[i][k] * h[k];
-                largest = largest.max((new - b[i][k]).abs());
-                b[i][k] = new;
-            }
-        }
-        change = largest / scale;
-        let done = change < tolerance;
-        let go_on = observer(b, change);
-        if done || !go_on {
-            return ResolveReport {
-                sweeps: sweep,
-                change,
-                elapsed: start.elapsed(),
-                converged: done,
-            };
-        }
-    }
-    ResolveReport {
-        sweeps: max_sweeps,
-        change,
-        elapsed: start.elapsed(),
-        converged: false,
-    }
-}
-
-/// sum_j F_ij B_j for the three bands, with four independent partial sums per band so that
-/// the additions do not wait on each other (about twice as fast as one running sum; the
-/// rounding differs from it by a few ulps).
-fn row_dot3(row: &[f32], b: &[[f64; 3]]) -> [f64; 3] {
-    let mut acc = [[0.0f64; 3]; 4];
-    let (rows, row_rest) = row.as_chunks::<4>();
-    let (bs, b_rest) = b[..row.len()].as_chunks::<4>();
-    for (f4, b4) in rows.iter().zip(bs) {
-        for l in 0..4 {
-            let fij = f4[l] as f64;
-            for k in 0..3 {
-                acc[l][k] += fij * b4[l][k];
-            }
-        }
-    }
-    for (&fij, bj) in row_rest.iter().zip(b_rest) {
-        for k in 0..3 {
-            acc[0][k] += fij as f64 * bj[k];
-        }
-    }
-    std::array::from_fn(|k| (acc[0][k] + acc[1][k]) + (acc[2][k] + acc[3][k]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity::pipeline::{Overrides, Prepared};
+    use radiosity::form_factor::FormFactorMatrix;
+    use radiosity::pipeline::{
+        self, FormFactors, Overrides, Prepared, SolutionReport, SolveRequest,
+    };
     use radiosity::progress::NoProgress;
     use radiosity::scene::cornell_box;
-    use radiosity::solve::{self, element_properties, Solver};
+    use radiosity::solve::{keep_going, DenseSolver, GaussSeidelSettings, Solver};
+
+    /// Gauss-Seidel to a relative residual of 1e-10 on `f`, from `start` or B = E: B and
+    /// the sweeps made.
+    fn gauss_seidel(
+        prepared: &Prepared,
+        f: &FormFactorMatrix,
+        start: Option<&[Rgb]>,
+    ) -> (Vec<Rgb>, usize) {
+        let request = SolveRequest {
+            solver: Solver::Dense(DenseSolver::GaussSeidel(GaussSeidelSettings {
+                tolerance: 1e-10,
+                max_iterations: 10_000,
+            })),
+            form_factors: FormFactors::Matrix(f),
+            start,
+        };
+        let solution = pipeline::solve(prepared, &request, &mut keep_going, &NoProgress).unwrap();
+        let SolutionReport::Matrix(report) = solution.report else {
+            panic!("a dense solve reports as one")
+        };
+        (solution.radiosity.0, report.iterations.unwrap())
+    }
 
     #[test]
     fn edits_undo_in_order_and_a_drag_is_one_step() {
@@ -278,20 +193,13 @@ mod tests {
     #[test]
     fn resolve_after_a_reflectance_edit_equals_a_fresh_solve() {
         let mut scene = cornell_box();
-        let prepared = Prepared::new(
-            scene.clone(),
-            Overrides {
-                max_patch_area: Some(8000.0),
-                integral_steps: Some(2),
-            },
-            &NoProgress,
-        )
-        .unwrap();
+        let overrides = Overrides {
+            max_patch_area: Some(8000.0),
+            integral_steps: Some(2),
+        };
+        let mut prepared = Prepared::new(scene.clone(), overrides, &NoProgress).unwrap();
         let (f, _) = prepared.form_factors(&NoProgress).unwrap();
-        let (rho, e) = element_properties(&prepared.mesh, &prepared.scene);
-        let mut b = e.clone();
-        let first = resolve(&f, &rho, &e, &mut b, 1e-10, 10_000, |_, _| true);
-        assert!(first.converged);
+        let (first, _) = gauss_seidel(&prepared, &f, None);
 
         // Paint the tall block blue-ish and the floor darker.
         let mut modeller = Modeller::new(prepared.scene.clone());
@@ -315,40 +223,33 @@ mod tests {
             modeller.set(s, c, false);
         }
         scene.surfaces = modeller.scene.surfaces.clone();
-        let (rho2, e2) = element_properties(&prepared.mesh, &modeller.scene);
-        let warm = resolve(&f, &rho2, &e2, &mut b, 1e-10, 10_000, |_, _| true);
-        assert!(warm.converged);
+        let colours: Vec<_> = scene
+            .surfaces
+            .iter()
+            .map(|s| (s.reflectance, s.emission))
+            .collect();
+        prepared.recolour(&colours).unwrap();
+        let (b, warm_sweeps) = gauss_seidel(&prepared, &f, Some(&first));
 
-        // A fresh full solve of the edited scene, by the library.
-        let fresh_prepared = Prepared::new(
-            scene,
-            Overrides {
-                max_patch_area: Some(8000.0),
-                integral_steps: Some(2),
-            },
-            &NoProgress,
-        )
-        .unwrap();
+        // A fresh full solve of the edited scene, form factors computed anew.
+        let fresh_prepared = Prepared::new(scene, overrides, &NoProgress).unwrap();
         let (f2, _) = fresh_prepared.form_factors(&NoProgress).unwrap();
         assert_eq!(
             f2.as_slice(),
             f.as_slice(),
             "form factors do not depend on colours"
         );
-        let fresh = fresh_prepared
-            .solve(
-                &f2,
-                Solver::GaussSeidel {
-                    tolerance: 1e-10,
-                    max_iterations: 10_000,
-                },
-                &NoProgress,
-            )
-            .unwrap();
-        let max_e = e2.iter().flatten().fold(0.0f64, |m, x| m.max(*x));
+        let (fresh, cold_sweeps) = gauss_seidel(&fresh_prepared, &f2, None);
+        let max_e = fresh_prepared
+            .light
+            .emission()
+            .iter()
+            .fold(0.0f64, |m, e| m.max(e.max_band()));
+        // Both stop at a relative residual of 1e-10; with rho <= 0.8 and row sums <= 1 the
+        // error of each is at most 1e-10 / (1 - 0.8) = 5e-10 of max |E|, so they agree
+        // within 1e-9 of max |E| (checked at 2e-9).
         let mut worst = 0.0f64;
-        for (i, bi) in b.iter().enumerate() {
-            let fi = fresh.radiosity.element(i);
+        for (bi, fi) in b.iter().zip(&fresh) {
             for k in 0..3 {
                 worst = worst.max((bi[k] - fi[k]).abs() / max_e);
             }
@@ -356,16 +257,19 @@ mod tests {
         assert!(
             worst < 2e-9,
             "re-solve vs fresh solve: largest difference {worst:e} of max E \
-             ({} elements, {} sweeps warm)",
+             ({} elements, {warm_sweeps} sweeps warm)",
             b.len(),
-            warm.sweeps
         );
         // And the LU solve agrees too (exact up to rounding).
-        let lu = solve::solve(&f2, &rho2, &e2, Solver::Lu, &NoProgress)
+        let request = SolveRequest {
+            form_factors: FormFactors::Matrix(&f2),
+            ..SolveRequest::new(Solver::LU)
+        };
+        let lu = pipeline::solve(&fresh_prepared, &request, &mut keep_going, &NoProgress)
             .unwrap()
-            .0;
+            .radiosity;
         for (i, bi) in b.iter().enumerate() {
-            for (x, y) in bi.iter().zip(lu.element(i)) {
+            for (x, y) in bi.0.iter().zip(lu.element(i).0) {
                 assert!(
                     (x - y).abs() / max_e < 2e-9,
                     "element {i}: re-solve {x}, LU {y}"
@@ -373,13 +277,9 @@ mod tests {
             }
         }
         // The warm start saves sweeps.
-        let mut cold = e2.clone();
-        let from_e = resolve(&f, &rho2, &e2, &mut cold, 1e-10, 10_000, |_, _| true);
         assert!(
-            warm.sweeps <= from_e.sweeps,
-            "warm {} vs cold {}",
-            warm.sweeps,
-            from_e.sweeps
+            warm_sweeps <= cold_sweeps,
+            "warm {warm_sweeps} vs cold {cold_sweeps}"
         );
     }
 }

@@ -16,13 +16,14 @@ use std::time::{Duration, Instant};
 
 use radiosity::form_factor::FormFactorMatrix;
 use radiosity::mesh::Mesh;
-use radiosity::pipeline::{choose_dense, Overrides, Prepared};
+use radiosity::pipeline::{self, FormFactors, Overrides, Prepared, SolutionReport, SolveRequest};
 use radiosity::progress::{Progress, Stage};
 use radiosity::scene::{Rgb, Scene};
-use radiosity::solve::{element_properties, DEFAULT_PROGRESSIVE_TOLERANCE};
+use radiosity::solve::{
+    choose, DenseSolver, GaussSeidelSettings, HierarchicalSettings, ProgressiveSettings, Solver,
+    SolverKind, Step, DEFAULT_PROGRESSIVE_TOLERANCE,
+};
 use radiosity::visibility::PolygonBvh;
-
-use crate::model::resolve;
 
 /// The tolerance of the viewer's Gauss-Seidel solves: the largest change in a sweep below
 /// 1e-6 of max |E| (far below an 8-bit display level; the CLI's 1e-9 would add sweeps
@@ -105,26 +106,37 @@ impl Progress for Reporter {
     }
 }
 
-/// The most elements [`Strategy::Auto`] computes the dense matrix for: about 5 s of form
+/// The most elements the window's `auto` computes the dense matrix for: about 5 s of form
 /// factors on two cores for the Cornell box (BENCHMARKS.md), more in cluttered scenes, with
 /// nothing lit on screen meanwhile. Beyond it progressive refinement shows light at once.
 pub const VIEW_DENSE_MAX_ELEMENTS: usize = 6_000;
 
-/// How the worker solves.
+/// How the window solves: a solver of the library's by kind, and hierarchical radiosity's
+/// settings for when that is the kind.
+///
+/// The window's `auto` differs from the command line's: the dense matrix (cached, so edits
+/// are quick re-solves) when [`radiosity::solve::choose`] allows it and there are at most
+/// [`VIEW_DENSE_MAX_ELEMENTS`] elements, progressive refinement otherwise (it shows light
+/// from the first shot). `gauss-seidel` and `lu` take the dense matrix whenever `choose`
+/// allows it, however long the form factors take, and fall back to progressive refinement
+/// when it would not fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Strategy {
-    /// The dense matrix (cached, so edits are re-solves) when `choose_dense` allows it and
-    /// there are at most [`VIEW_DENSE_MAX_ELEMENTS`] elements; progressive refinement
-    /// otherwise.
-    Auto,
-    /// The dense matrix whenever `choose_dense` allows it (up to 20,000 elements and half
-    /// the memory), however long the form factors take.
-    Dense,
-    /// Always progressive refinement (no matrix; edits re-run it).
-    Progressive,
-    /// Hierarchical radiosity with clustering: the window shows its leaves; edits re-run it
-    /// (its links are not kept between solves).
-    Hierarchical(radiosity::solve::HierarchicalSettings),
+pub struct ViewSolver {
+    /// The solver's kind.
+    pub kind: SolverKind,
+    /// Used when `kind` is hierarchical; `None`: the defaults for the scene's
+    /// `MAX_PATCH_AREA` ([`HierarchicalSettings::defaults_for`]).
+    pub hierarchical: Option<HierarchicalSettings>,
+}
+
+impl ViewSolver {
+    /// The window's automatic choice.
+    pub fn auto() -> ViewSolver {
+        ViewSolver {
+            kind: SolverKind::Auto,
+            hierarchical: None,
+        }
+    }
 }
 
 /// Starts the worker on `scene`; `wake` is called whenever there is news (the window asks
@@ -132,7 +144,7 @@ pub enum Strategy {
 pub fn spawn(
     scene: Scene,
     overrides: Overrides,
-    strategy: Strategy,
+    solver: ViewSolver,
     wake: Arc<dyn Fn() + Send + Sync>,
 ) -> (Sender<Recolour>, Receiver<Update>, Arc<StageProgress>) {
     let (edit_tx, edit_rx) = std::sync::mpsc::channel::<Recolour>();
@@ -150,7 +162,7 @@ pub fn spawn(
                 let _ = tx.send(u);
                 wake();
             };
-            if let Err(message) = run(scene, overrides, strategy, &reporter, &edit_rx, &send) {
+            if let Err(message) = run(scene, overrides, solver, &reporter, &edit_rx, &send) {
                 send(Update::Error(message));
             }
         })
@@ -170,66 +182,74 @@ fn newest(edits: &Receiver<Recolour>) -> Result<Option<Recolour>, ()> {
     }
 }
 
+/// The solver the window uses for `n` elements: see [`ViewSolver`]; the reason goes to the
+/// status line.
+fn decide(prepared: &Prepared, choice: ViewSolver, progress: &Reporter) -> Solver {
+    let n = prepared.mesh.len();
+    let progressive = Solver::Progressive(ProgressiveSettings {
+        tolerance: DEFAULT_PROGRESSIVE_TOLERANCE,
+        max_shots: usize::MAX,
+    });
+    let gauss_seidel = Solver::Dense(DenseSolver::GaussSeidel(GaussSeidelSettings {
+        tolerance: VIEW_TOLERANCE,
+        max_iterations: 10_000,
+    }));
+    let dense = match choice.kind {
+        SolverKind::Hierarchical => {
+            return Solver::Hierarchical(choice.hierarchical.unwrap_or_else(|| {
+                HierarchicalSettings::defaults_for(prepared.scene.settings.max_patch_area)
+            }))
+        }
+        SolverKind::Progressive => return progressive,
+        SolverKind::Lu => Solver::LU,
+        SolverKind::Auto | SolverKind::GaussSeidel => gauss_seidel,
+    };
+    let auto = choose(n, radiosity::form_factor::available_memory_bytes());
+    if !(auto.dense() && prepared.check_memory(Some(&dense)).is_ok()) {
+        progress.message(&format!(
+            "{}: no dense matrix; progressive refinement",
+            auto.estimate()
+        ));
+        progressive
+    } else if choice.kind == SolverKind::Auto && n > VIEW_DENSE_MAX_ELEMENTS {
+        progress.message(&format!(
+            "{n} elements: more than {VIEW_DENSE_MAX_ELEMENTS}, so progressive refinement \
+             shows light at once instead of waiting for every form factor (--dense \
+             computes the matrix, for live edits)"
+        ));
+        progressive
+    } else {
+        progress.message(&auto.to_string());
+        dense
+    }
+}
+
+/// A BVH over the elements of `mesh` (ids are element indices), for picking.
+fn element_bvh(mesh: &Mesh) -> Arc<PolygonBvh> {
+    let polygons: Vec<Vec<_>> = (0..mesh.len())
+        .map(|e| mesh.corner_positions(e).collect())
+        .collect();
+    let ids: Vec<u32> = (0..mesh.len() as u32).collect();
+    Arc::new(PolygonBvh::new(&polygons, &ids))
+}
+
 fn run(
     scene: Scene,
     overrides: Overrides,
-    strategy: Strategy,
+    choice: ViewSolver,
     progress: &Reporter,
     edits: &Receiver<Recolour>,
     send: &dyn Fn(Update),
 ) -> Result<(), String> {
     let mut prepared = Prepared::new(scene, overrides, progress).map_err(|e| e.to_string())?;
-    let mesh = Arc::new(prepared.mesh.clone());
-    let polygons: Vec<Vec<_>> = (0..mesh.len())
-        .map(|e| mesh.corner_positions(e).collect())
-        .collect();
-    let ids: Vec<u32> = (0..mesh.len() as u32).collect();
     send(Update::Mesh(
-        mesh.clone(),
-        Arc::new(PolygonBvh::new(&polygons, &ids)),
+        prepared.mesh.clone(),
+        element_bvh(&prepared.mesh),
     ));
-    let n = mesh.len();
-    let fits = || {
-        let (dense, why) = choose_dense(n, radiosity::form_factor::available_memory_bytes());
-        if dense && prepared.check_memory(None).is_ok() {
-            (true, why)
-        } else {
-            // choose_dense names the CLI's fallback; the window's is progressive refinement
-            // (it shows light from the first shot).
-            let estimate = why
-                .split([';', ',', ':'])
-                .next()
-                .unwrap_or_default()
-                .to_string();
-            (
-                false,
-                format!("{estimate}: no dense matrix; progressive refinement"),
-            )
-        }
-    };
-    let dense = match strategy {
-        Strategy::Auto => {
-            let (fits, why) = fits();
-            if fits && n > VIEW_DENSE_MAX_ELEMENTS {
-                progress.message(&format!(
-                    "{n} elements: more than {VIEW_DENSE_MAX_ELEMENTS}, so progressive refinement \
-                     shows light at once instead of waiting for every form factor (--dense \
-                     computes the matrix, for live edits)"
-                ));
-                false
-            } else {
-                progress.message(&why);
-                fits
-            }
-        }
-        Strategy::Dense => {
-            let (fits, why) = fits();
-            progress.message(&why);
-            fits
-        }
-        Strategy::Progressive | Strategy::Hierarchical(_) => false,
-    };
-    let matrix: Option<FormFactorMatrix> = if dense {
+    let n = prepared.mesh.len();
+    let solver = decide(&prepared, choice, progress);
+    // The dense matrix is computed once: edits change colours, not form factors.
+    let matrix: Option<FormFactorMatrix> = if solver.needs_matrix() {
         Some(
             prepared
                 .form_factors(progress)
@@ -239,16 +259,16 @@ fn run(
     } else {
         None
     };
-    let (reflectance, emission) = element_properties(&prepared.mesh, &prepared.scene);
-    let mut b = emission.clone();
-    let mut pending = Some((reflectance, emission, 0u64));
+    // Gauss-Seidel's warm start: the last solution, converged or not.
+    let mut last: Option<Vec<Rgb>> = None;
+    let mut pending = Some(0u64);
     loop {
-        let Some((rho, e, edit)) = pending.take() else {
+        let Some(edit) = pending.take() else {
             // Idle: wait for the next edit (or the window closing).
             match edits.recv() {
                 Ok(r) => {
                     let r = newest(edits).ok().flatten().unwrap_or(r);
-                    pending = Some(recoloured(&mut prepared, r));
+                    pending = Some(recoloured(&mut prepared, r, send));
                     continue;
                 }
                 Err(_) => return Ok(()),
@@ -256,139 +276,108 @@ fn run(
         };
         let mut interrupted: Option<Recolour> = None;
         let mut last_sent = Instant::now() - SNAPSHOT_INTERVAL;
-        if let Strategy::Hierarchical(settings) = strategy {
-            // No intermediate pictures: the leaves are only known at the end. The window
-            // gets the leaves as its mesh (for drawing and picking), then their radiosity.
-            *progress.shared.stage.lock().unwrap() = "hierarchical";
-            progress.shared.total.store(0, Ordering::Relaxed);
-            let start = Instant::now();
-            let solution = prepared
-                .solve_hierarchical(&settings, progress)
-                .map_err(|e| e.to_string())?;
-            let leaves = Arc::new(solution.mesh(&prepared).clone());
-            let polygons: Vec<Vec<_>> = (0..leaves.len())
-                .map(|e| leaves.corner_positions(e).collect())
-                .collect();
-            let ids: Vec<u32> = (0..leaves.len() as u32).collect();
-            send(Update::Mesh(
-                leaves.clone(),
-                Arc::new(PolygonBvh::new(&polygons, &ids)),
-            ));
-            send(Update::Solution {
-                element_b: solution.element_rgb(),
-                done: true,
-                note: format!(
-                    "{} leaves, hierarchical radiosity in {:.1} s (edits re-run it)",
-                    leaves.len(),
-                    start.elapsed().as_secs_f64()
-                ),
-                edit,
-            });
+        *progress.shared.stage.lock().unwrap() = match solver {
+            Solver::Dense(_) => "solve",
+            Solver::Progressive(_) => "progressive",
+            Solver::Hierarchical(_) => "hierarchical",
+        };
+        progress.shared.total.store(0, Ordering::Relaxed);
+        let start = Instant::now();
+        let mut observer = |step: &Step| {
+            if let Ok(Some(r)) = newest(edits) {
+                interrupted = Some(r);
+                return ControlFlow::Break(());
+            }
+            if last_sent.elapsed() >= SNAPSHOT_INTERVAL {
+                last_sent = Instant::now();
+                let (element_b, note) = match step {
+                    Step::Sweep {
+                        change, radiosity, ..
+                    } => (
+                        radiosity.to_vec(),
+                        format!("Gauss-Seidel: change {change:.1e}"),
+                    ),
+                    Step::Shot(state) => (
+                        state.display_radiosity(),
+                        format!(
+                            "progressive: shot {}, unshot {:.2} %",
+                            state.shot,
+                            100.0 * state.unshot_fraction
+                        ),
+                    ),
+                };
+                send(Update::Solution {
+                    element_b: Rgb::as_arrays(&element_b).to_vec(),
+                    done: false,
+                    note,
+                    edit,
+                });
+            }
+            ControlFlow::Continue(())
+        };
+        let request = SolveRequest {
+            solver,
+            form_factors: matrix
+                .as_ref()
+                .map_or(FormFactors::Compute, FormFactors::Matrix),
+            start: last.as_deref(),
+        };
+        let result = pipeline::solve(&prepared, &request, &mut observer, progress);
+        if let Some(r) = interrupted {
+            if let Ok(solution) = result {
+                if solver.needs_matrix() {
+                    last = Some(solution.radiosity.0);
+                }
+            }
+            pending = Some(recoloured(&mut prepared, r, send));
             continue;
         }
-        match &matrix {
-            Some(f) => {
-                *progress.shared.stage.lock().unwrap() = "solve";
-                progress.shared.total.store(0, Ordering::Relaxed);
-                let report = resolve(f, &rho, &e, &mut b, VIEW_TOLERANCE, 10_000, |b, change| {
-                    if let Ok(Some(r)) = newest(edits) {
-                        interrupted = Some(r);
-                        return false;
-                    }
-                    if last_sent.elapsed() >= SNAPSHOT_INTERVAL && change >= VIEW_TOLERANCE {
-                        last_sent = Instant::now();
-                        send(Update::Solution {
-                            element_b: b.to_vec(),
-                            done: false,
-                            note: format!("Gauss-Seidel: change {change:.1e}"),
-                            edit,
-                        });
-                    }
-                    true
-                });
-                if interrupted.is_none() {
-                    send(Update::Solution {
-                        element_b: b.clone(),
-                        done: true,
-                        note: format!(
-                            "{n} elements, Gauss-Seidel {} sweeps in {:.0} ms (dense form factors cached)",
-                            report.sweeps,
-                            report.elapsed.as_secs_f64() * 1e3
-                        ),
-                        edit,
-                    });
-                }
+        let solution = result.map_err(|e| e.to_string())?;
+        let seconds = start.elapsed().as_secs_f64();
+        let note = match solution.report {
+            SolutionReport::Matrix(r) => format!(
+                "{n} elements, {} {} sweeps in {:.0} ms (dense form factors cached)",
+                if solver == Solver::LU { "LU" } else { "Gauss-Seidel" },
+                r.iterations.unwrap_or(0),
+                r.elapsed.as_secs_f64() * 1e3
+            ),
+            SolutionReport::Progressive(r) => format!(
+                "{n} elements, progressive refinement: {} shots in {seconds:.1} s (no matrix: edits re-run it)",
+                r.shots
+            ),
+            SolutionReport::Hierarchical(r) => {
+                // The window gets the leaves as its mesh (for drawing and picking), then
+                // their radiosity.
+                send(Update::Mesh(
+                    solution.mesh.clone(),
+                    element_bvh(&solution.mesh),
+                ));
+                format!(
+                    "{} leaves, hierarchical radiosity in {seconds:.1} s (edits re-run it)",
+                    r.leaves
+                )
             }
-            None => {
-                *progress.shared.stage.lock().unwrap() = "progressive";
-                progress.shared.total.store(0, Ordering::Relaxed);
-                let start = Instant::now();
-                let mut observer = |state: &radiosity::solve::ProgressiveState| {
-                    if let Ok(Some(r)) = newest(edits) {
-                        interrupted = Some(r);
-                        return ControlFlow::Break(());
-                    }
-                    if last_sent.elapsed() >= SNAPSHOT_INTERVAL {
-                        last_sent = Instant::now();
-                        send(Update::Solution {
-                            element_b: state.display_radiosity(),
-                            done: false,
-                            note: format!(
-                                "progressive: shot {}, unshot {:.2} %",
-                                state.shot,
-                                100.0 * state.unshot_fraction
-                            ),
-                            edit,
-                        });
-                    }
-                    ControlFlow::Continue(())
-                };
-                let solution = prepared.solve_progressive(
-                    DEFAULT_PROGRESSIVE_TOLERANCE,
-                    usize::MAX,
-                    &mut observer,
-                    progress,
-                );
-                if interrupted.is_none() {
-                    let solution = solution.map_err(|e| e.to_string())?;
-                    let shots = match solution.report {
-                        radiosity::pipeline::SolutionReport::Progressive(r) => r.shots,
-                        _ => 0,
-                    };
-                    let mut display = solution.element_rgb();
-                    if let radiosity::pipeline::SolutionReport::Progressive(r) = solution.report {
-                        for (d, rho) in display.iter_mut().zip(&rho) {
-                            for k in 0..3 {
-                                d[k] += rho[k] * r.ambient[k];
-                            }
-                        }
-                    }
-                    send(Update::Solution {
-                        element_b: display,
-                        done: true,
-                        note: format!(
-                            "{n} elements, progressive refinement: {shots} shots in {:.1} s (no matrix: edits re-run it)",
-                            start.elapsed().as_secs_f64()
-                        ),
-                        edit,
-                    });
-                }
-            }
-        }
-        if let Some(r) = interrupted {
-            pending = Some(recoloured(&mut prepared, r));
+        };
+        let display = solution.display_radiosity(prepared.light.reflectance());
+        send(Update::Solution {
+            element_b: Rgb::as_arrays(&display).to_vec(),
+            done: true,
+            note,
+            edit,
+        });
+        if solver.needs_matrix() {
+            last = Some(solution.radiosity.0);
         }
     }
 }
 
-/// Applies new surface colours to the prepared scene; returns the element properties.
-fn recoloured(prepared: &mut Prepared, r: Recolour) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, u64) {
-    for (s, (rho, e)) in prepared.scene.surfaces.iter_mut().zip(r.colours) {
-        s.reflectance = rho;
-        s.emission = e;
+/// Applies new surface colours to the prepared scene (a refusal goes to the window, and
+/// the colours stay as they were); returns the edit's number.
+fn recoloured(prepared: &mut Prepared, r: Recolour, send: &dyn Fn(Update)) -> u64 {
+    if let Err(e) = prepared.recolour(&r.colours) {
+        send(Update::Error(e.to_string()));
     }
-    let (rho, e) = element_properties(&prepared.mesh, &prepared.scene);
-    (rho, e, r.edit)
+    r.edit
 }
 
 #[cfg(test)]
@@ -396,7 +385,7 @@ mod tests {
     use super::*;
     use radiosity::progress::NoProgress;
     use radiosity::scene::cornell_box;
-    use radiosity::solve::Solver;
+    use radiosity::solve::keep_going;
 
     /// Asks the worker for the colours of `scene`, as edit number `edit`.
     fn send_colours(edits: &Sender<Recolour>, scene: &Scene, edit: u64) {
@@ -438,7 +427,12 @@ mod tests {
             integral_steps: Some(2),
         };
         let scene = cornell_box();
-        let (edits, updates, _) = spawn(scene.clone(), overrides, Strategy::Auto, Arc::new(|| {}));
+        let (edits, updates, _) = spawn(
+            scene.clone(),
+            overrides,
+            ViewSolver::auto(),
+            Arc::new(|| {}),
+        );
         converged(&updates, 0);
         let mut edited = scene.clone();
         for s in edited
@@ -452,10 +446,13 @@ mod tests {
         let b = converged(&updates, 1);
 
         let fresh = Prepared::new(edited, overrides, &NoProgress).unwrap();
-        let (f, _) = fresh.form_factors(&NoProgress).unwrap();
-        let solution = fresh
-            .solve(&f, Solver::DEFAULT_GAUSS_SEIDEL, &NoProgress)
-            .unwrap();
+        let solution = pipeline::solve(
+            &fresh,
+            &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
+            &mut keep_going,
+            &NoProgress,
+        )
+        .unwrap();
         let max_e = fresh
             .scene
             .surfaces
@@ -463,7 +460,7 @@ mod tests {
             .map(|s| s.emission.max_band())
             .fold(0.0, f64::max);
         for (i, bi) in b.iter().enumerate() {
-            for (x, y) in bi.iter().zip(solution.radiosity.element(i)) {
+            for (x, y) in bi.iter().zip(solution.radiosity.element(i).0) {
                 assert!(
                     (x - y).abs() < 1e-5 * max_e,
                     "element {i}: worker {x}, fresh solve {y} (max E {max_e})"
@@ -491,7 +488,10 @@ mod tests {
         let (edits, updates, _) = spawn(
             scene.clone(),
             overrides,
-            Strategy::Hierarchical(settings),
+            ViewSolver {
+                kind: SolverKind::Hierarchical,
+                hierarchical: Some(settings),
+            },
             Arc::new(|| {}),
         );
         converged(&updates, 0);
@@ -519,9 +519,15 @@ mod tests {
             }
         };
         let fresh = Prepared::new(edited, overrides, &NoProgress).unwrap();
-        let solution = fresh.solve_hierarchical(&settings, &NoProgress).unwrap();
+        let solution = pipeline::solve(
+            &fresh,
+            &SolveRequest::new(Solver::Hierarchical(settings)),
+            &mut keep_going,
+            &NoProgress,
+        )
+        .unwrap();
         let leaves = leaves.expect("the leaves are sent");
-        assert_eq!(leaves.len(), solution.mesh(&fresh).len());
+        assert_eq!(leaves.len(), solution.mesh.len());
         assert_eq!(b, solution.element_rgb());
     }
 }

@@ -5,12 +5,13 @@
 //! Where no adapter exists the test says it was skipped and why; with the environment
 //! variable `CI` set it fails instead (CI installs lavapipe, so an adapter must be there).
 
+use radiosity::pipeline::{self, SolveRequest};
 use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::NoProgress;
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
 use radiosity::scene::cornell_box;
 use radiosity::shade::{self, Exposure};
-use radiosity::solve::Solver;
+use radiosity::solve::{keep_going, Solver};
 use radiosity_viewer::gpu::{Headless, Style};
 
 /// Mean absolute difference per channel (0-255) allowed between the two images.
@@ -54,12 +55,15 @@ fn offscreen_cornell_box_matches_the_cpu_render() {
     };
     eprintln!("adapter: {}", gpu.adapter);
     let prepared = Prepared::new(cornell_box(), Overrides::default(), &NoProgress).unwrap();
-    let (f, _) = prepared.form_factors(&NoProgress).unwrap();
-    let solution = prepared
-        .solve(&f, Solver::DEFAULT_GAUSS_SEIDEL, &NoProgress)
-        .unwrap();
+    let solution = pipeline::solve(
+        &prepared,
+        &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
+        &mut keep_going,
+        &NoProgress,
+    )
+    .unwrap();
     let mesh = &prepared.mesh;
-    let b = solution.element_rgb();
+    let b = solution.element_rgb().to_vec();
     let vb = shade::vertex_radiosity(mesh, &b);
     let scale = Exposure::Brightest.scale(&prepared.scene, mesh, &b);
     let camera = Camera::for_scene(&prepared.scene, 256, 256);

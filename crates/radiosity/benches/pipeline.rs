@@ -9,12 +9,13 @@ use std::time::Duration;
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
+use radiosity::pipeline::{self as run, FormFactors, SolveRequest};
 use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::NoProgress;
 use radiosity::render::{self, Camera, RenderSettings, Renderer};
 use radiosity::scene::cornell_box;
 use radiosity::shade::{self, Exposure};
-use radiosity::solve::{self, Solver};
+use radiosity::solve::{self, keep_going, DenseSolver, GaussSeidelSettings, Solver};
 
 /// MAX_PATCH_AREA (mm^2) that cuts the Cornell box into about 500 elements (535 with the red wall as two triangles).
 const MAX_AREA: f64 = 4000.0;
@@ -49,16 +50,17 @@ fn form_factors(c: &mut Criterion) {
 fn solvers(c: &mut Criterion) {
     let p = prepared();
     let (f, _) = p.form_factors(&NoProgress).expect("fits in memory");
-    let (rho, e) = solve::element_properties(&p.mesh, &p.scene);
     let mut group = configure(c, "solve");
     let n = p.mesh.len();
-    let gauss_seidel = Solver::GaussSeidel {
-        tolerance: 1e-9,
-        max_iterations: 10_000,
-    };
-    for (name, solver) in [("lu", Solver::Lu), ("gauss_seidel", gauss_seidel)] {
+    let gauss_seidel = DenseSolver::GaussSeidel(GaussSeidelSettings::default());
+    for (name, solver) in [("lu", DenseSolver::Lu), ("gauss_seidel", gauss_seidel)] {
         group.bench_function(format!("{name}_{n}_elements"), |b| {
-            b.iter(|| black_box(solve::solve(&f, &rho, &e, solver, &NoProgress).unwrap()))
+            b.iter(|| {
+                black_box(
+                    solve::solve(&f, &p.light, &solver, None, &mut keep_going, &NoProgress)
+                        .unwrap(),
+                )
+            })
         });
     }
     group.finish();
@@ -67,7 +69,11 @@ fn solvers(c: &mut Criterion) {
 fn rendering(c: &mut Criterion) {
     let p = prepared();
     let (f, _) = p.form_factors(&NoProgress).expect("fits in memory");
-    let solution = p.solve(&f, Solver::Lu, &NoProgress).unwrap();
+    let request = SolveRequest {
+        form_factors: FormFactors::Matrix(&f),
+        ..SolveRequest::new(Solver::LU)
+    };
+    let solution = run::solve(&p, &request, &mut keep_going, &NoProgress).unwrap();
     let element_b = solution.element_rgb();
     let vertex_b = shade::vertex_radiosity(&p.mesh, &element_b);
     let settings = RenderSettings {

@@ -14,6 +14,7 @@
 
 use thiserror::Error;
 
+use crate::light::Rgb;
 use crate::mesh::Mesh;
 use crate::solve::Radiosity;
 use crate::visibility::PolygonBvh;
@@ -55,7 +56,7 @@ pub enum CompareError {
 pub fn compare(
     reference_mesh: &Mesh,
     reference: &Radiosity,
-    emission: &[[f64; 3]],
+    emission: &[Rgb],
     other_mesh: &Mesh,
     other: &Radiosity,
 ) -> Result<Comparison, CompareError> {
@@ -63,7 +64,7 @@ pub fn compare(
     let (mut num, mut den, mut sum, mut area, mut max) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
     for (i, el) in reference_mesh.elements.iter().enumerate() {
         for k in 0..3 {
-            let (r, o) = (reference.bands[k][i], projected.bands[k][i]);
+            let (r, o) = (reference.0[i][k], projected.0[i][k]);
             num += el.area * (o - r).powi(2);
             den += el.area * (r - emission[i][k]).powi(2);
             sum += el.area * (o - r);
@@ -98,8 +99,7 @@ pub fn project(
     let ids: Vec<u32> = (0..other_mesh.len() as u32).collect();
     let bvh = PolygonBvh::new(&polygons, &ids);
     let delta = 1e-6 * bvh.scale();
-    let mut bands: [Vec<f64>; 3] =
-        std::array::from_fn(|_| Vec::with_capacity(reference_mesh.len()));
+    let mut out = Vec::with_capacity(reference_mesh.len());
     let mut points = Vec::new();
     for (i, el) in reference_mesh.elements.iter().enumerate() {
         points.clear();
@@ -120,14 +120,12 @@ pub fn project(
                 });
             };
             for k in 0..3 {
-                projected[k] += w * other.bands[k][hit.id as usize];
+                projected[k] += w * other.0[hit.id as usize][k];
             }
         }
-        for k in 0..3 {
-            bands[k].push(projected[k] / el.area);
-        }
+        out.push(Rgb(projected.map(|p| p / el.area)));
     }
-    Ok(Radiosity { bands })
+    Ok(Radiosity(out))
 }
 
 #[cfg(test)]
@@ -137,9 +135,7 @@ mod tests {
     use crate::scene::cornell_box;
 
     fn uniform(mesh: &Mesh, f: impl Fn(usize) -> [f64; 3]) -> Radiosity {
-        Radiosity {
-            bands: std::array::from_fn(|k| (0..mesh.len()).map(|e| f(e)[k]).collect()),
-        }
+        Radiosity((0..mesh.len()).map(|e| Rgb(f(e))).collect())
     }
 
     #[test]
@@ -154,7 +150,7 @@ mod tests {
         let field = |m: &Mesh, scale: f64| {
             uniform(m, |e| [scale * (1.0 + m.elements[e].surface as f64); 3])
         };
-        let e = vec![[0.0; 3]; coarse.len()];
+        let e = vec![Rgb::BLACK; coarse.len()];
         let same = compare(&coarse, &field(&coarse, 1.0), &e, &fine, &field(&fine, 1.0)).unwrap();
         // Zero up to the rounding of the 16-point weighted means.
         assert!(same.rms < 1e-12 && same.max < 1e-12, "{same:?}");
@@ -172,7 +168,7 @@ mod tests {
             mesh_scene(&a, 20_000.0).unwrap(),
             mesh_scene(&b, 20_000.0).unwrap(),
         );
-        let e = vec![[0.0; 3]; ma.len()];
+        let e = vec![Rgb::BLACK; ma.len()];
         let one = |m: &Mesh| uniform(m, |_| [1.0; 3]);
         assert!(matches!(
             compare(&ma, &one(&ma), &e, &mb, &one(&mb)),

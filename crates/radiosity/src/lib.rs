@@ -14,6 +14,7 @@
 //! * [`mesh`]: area-based subdivision of surfaces into elements (paper 2.4).
 //! * [`visibility`]: BVH ray queries over triangles (occlusion and closest hit).
 //! * [`form_factor`]: form factors F_ij (paper 1.2, 2.3) and their file format (paper 2.8).
+//! * [`light`]: the RGB type of radiosity, emission and reflectance, checked per element.
 //! * [`solve`]: (I - rho F) B = E per band, by LU or Gauss-Seidel (paper figure 6).
 //! * [`shade`]: vertex radiosities, exposure and gamma (paper 2.5, 2.7).
 //! * [`render`]: a CPU ray-cast camera that writes PNG images (paper 2.6).
@@ -29,6 +30,7 @@ mod atomic_write;
 pub mod compare;
 pub mod form_factor;
 pub mod geometry;
+pub mod light;
 pub mod mesh;
 pub mod pipeline;
 pub mod progress;

@@ -4,8 +4,8 @@
 //! Each stage reports through [`Progress`], so its time and progress reach whoever
 //! listens (a progress bar, a window, a distributed runner).
 
-use std::ops::ControlFlow;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 use crate::form_factor::{
@@ -13,12 +13,13 @@ use crate::form_factor::{
     FormFactorFileError, FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter, Reciprocity,
     RowSums,
 };
+use crate::light::{check_surface, ElementLight, LightError, Rgb};
 use crate::mesh::{mesh_scene, Mesh, MeshError};
 use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::Scene;
 use crate::solve::{
-    self, energy_balance, EnergyBalance, HierarchicalReport, ProgressiveReport, ProgressiveState,
-    Radiosity, SolveError, SolveReport, Solver,
+    self, energy_balance, EnergyBalance, HierarchicalReport, Observer, ProgressiveReport,
+    Radiosity, SolveError, SolveReport, Solver, SolverKind,
 };
 use crate::visibility::PolygonBvh;
 
@@ -37,9 +38,30 @@ pub enum PipelineError {
     /// The solve failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
-    /// A setting cannot be honoured (for example an integration that would not fit).
-    #[error("{0}")]
-    Settings(String),
+    /// A surface's reflectance or emission is out of range.
+    #[error(transparent)]
+    Light(#[from] LightError),
+    /// The integration points of every element would not fit.
+    #[error(
+        "{steps} integral steps on {elements} elements means {points:.2e} integration points \
+         (more than {limit:.0e}): fewer steps or larger elements would fit"
+    )]
+    TooManyPoints {
+        /// k, the points along each axis of each element.
+        steps: u32,
+        /// Elements.
+        elements: usize,
+        /// elements x k^2.
+        points: f64,
+        /// The most allowed.
+        limit: f64,
+    },
+    /// Form factors were given to a solver that computes its own.
+    #[error("{solver} computes its own form factors: it cannot use a form-factor matrix")]
+    FormFactorsUnused {
+        /// The solver.
+        solver: SolverKind,
+    },
     /// Writing an output failed.
     #[error("cannot write {path}")]
     Write {
@@ -48,39 +70,6 @@ pub enum PipelineError {
         /// Why.
         source: std::io::Error,
     },
-}
-
-/// The most elements `choose_dense` will give the dense solve: its form factors cost
-/// O(n^2) (about 5 s at 10,000 elements on two cores, BENCHMARKS.md), so beyond this the
-/// hierarchical solver (no matrix) is chosen even when the matrix would fit.
-pub const AUTO_DENSE_MAX_ELEMENTS: usize = 20_000;
-
-/// The `auto` solver's decision for `n` elements and `available` bytes of memory: true for
-/// the dense solve (Gauss-Seidel on the stored matrix), false for hierarchical radiosity;
-/// with the reason, including the memory estimate, to tell the user.
-pub fn choose_dense(n: usize, available: u64) -> (bool, String) {
-    let matrix = 4.0 * (n as f64).powi(2) * 1.1;
-    let mib = |b: f64| b / (1u64 << 20) as f64;
-    let estimate = format!(
-        "{n} elements; the dense form-factor matrix needs {:.0} MiB of the {:.0} MiB available",
-        mib(matrix),
-        mib(available as f64)
-    );
-    if n > AUTO_DENSE_MAX_ELEMENTS {
-        (false, format!("{estimate}; more than {AUTO_DENSE_MAX_ELEMENTS} elements: hierarchical radiosity with clustering (no matrix; links, memory about linear in the elements)"))
-    } else if matrix > 0.5 * available as f64 {
-        (
-            false,
-            format!(
-                "{estimate}, more than half of it: hierarchical radiosity with clustering (no matrix; links, memory about linear in the elements)"
-            ),
-        )
-    } else {
-        (
-            true,
-            format!("{estimate}: Gauss-Seidel on the dense matrix"),
-        )
-    }
 }
 
 /// Settings from the command line that override the scene file's.
@@ -97,7 +86,9 @@ pub struct Prepared {
     /// The scene, with overrides applied to its settings.
     pub scene: Scene,
     /// Its elements.
-    pub mesh: Mesh,
+    pub mesh: Arc<Mesh>,
+    /// Reflectance and emission of every element, checked.
+    pub light: ElementLight,
     /// The input surfaces in a BVH, for occlusion.
     pub occluders: PolygonBvh,
     /// How form factors are computed (by default the area integral with the scene's
@@ -118,8 +109,11 @@ pub struct FormFactorStats {
     pub reciprocity: Reciprocity,
 }
 
-/// A solved scene.
+/// A solved scene: the radiosity of every element of the mesh it lives on.
 pub struct Solution {
+    /// The elements the radiosities belong to: the prepared mesh, or the leaves of
+    /// hierarchical radiosity.
+    pub mesh: Arc<Mesh>,
     /// Element radiosities.
     pub radiosity: Radiosity,
     /// How the solve went.
@@ -129,9 +123,8 @@ pub struct Solution {
     /// the power still unshot is neither absorbed nor escaped (so the relative error is the
     /// unshot fraction).
     pub balance: EnergyBalance,
-    /// The elements the radiosities belong to when they are not the prepared mesh's: the
-    /// leaves of hierarchical radiosity. `None` for every other solver.
-    pub mesh: Option<Mesh>,
+    /// What computing the form factors found, when they were computed for this solve.
+    pub form_factors: Option<FormFactorStats>,
 }
 
 /// How a solve went, by kind of solver.
@@ -145,8 +138,45 @@ pub enum SolutionReport {
     Hierarchical(HierarchicalReport),
 }
 
+/// Where a dense solve gets its form factors.
+#[derive(Clone, Copy, Debug, Default)]
+pub enum FormFactors<'a> {
+    /// Computed now with the prepared method.
+    #[default]
+    Compute,
+    /// Read from a file written by [`Prepared::save_form_factors`] (refused if it was made
+    /// for another mesh or method).
+    File(&'a Path),
+    /// A matrix already at hand (the window keeps one for re-solves after edits).
+    Matrix(&'a FormFactorMatrix),
+}
+
+/// What to solve with: the solver, where its form factors come from, and where it starts.
+#[derive(Clone, Copy, Debug)]
+pub struct SolveRequest<'a> {
+    /// The solver and its settings.
+    pub solver: Solver,
+    /// For the dense solvers; any other source than `Compute` is refused by the others.
+    pub form_factors: FormFactors<'a>,
+    /// A starting solution on the prepared mesh (Gauss-Seidel's warm start); the other
+    /// solvers start from B = E.
+    pub start: Option<&'a [Rgb]>,
+}
+
+impl<'a> SolveRequest<'a> {
+    /// `solver` on computed form factors, from B = E.
+    pub fn new(solver: Solver) -> SolveRequest<'a> {
+        SolveRequest {
+            solver,
+            form_factors: FormFactors::Compute,
+            start: None,
+        }
+    }
+}
+
 impl Prepared {
-    /// Applies `overrides`, meshes the scene and builds the occluder BVH.
+    /// Applies `overrides`, checks every surface's reflectance and emission, meshes the
+    /// scene and builds the occluder BVH.
     pub fn new(
         mut scene: Scene,
         overrides: Overrides,
@@ -158,9 +188,13 @@ impl Prepared {
         if let Some(k) = overrides.integral_steps {
             scene.settings.integral_steps = k;
         }
+        for (i, s) in scene.surfaces.iter().enumerate() {
+            check_surface(i, s.reflectance, s.emission).map_err(LightError::from)?;
+        }
         let mesh = run_stage(progress, Stage::Mesh, 0, || {
             mesh_scene(&scene, scene.settings.max_patch_area)
         })?;
+        let light = ElementLight::of_mesh(&mesh, &scene)?;
         let occluders = run_stage(progress, Stage::Bvh, 0, || {
             form_factor::occluder_bvh(&scene)
         });
@@ -169,10 +203,25 @@ impl Prepared {
         };
         Ok(Prepared {
             scene,
-            mesh,
+            mesh: Arc::new(mesh),
+            light,
             occluders,
             method,
         })
+    }
+
+    /// Gives every surface new colours, (reflectance, emission) in surface order, checked;
+    /// the mesh and the form factors stay valid (they depend on the geometry only).
+    pub fn recolour(&mut self, colours: &[(Rgb, Rgb)]) -> Result<(), LightError> {
+        for (i, &(rho, e)) in colours.iter().enumerate() {
+            check_surface(i, rho, e)?;
+        }
+        for (s, &(rho, e)) in self.scene.surfaces.iter_mut().zip(colours) {
+            s.reflectance = rho;
+            s.emission = e;
+        }
+        self.light = ElementLight::of_mesh(&self.mesh, &self.scene)?;
+        Ok(())
     }
 
     /// How form factors are computed.
@@ -191,28 +240,32 @@ impl Prepared {
     }
 
     /// Refuses, before any work, settings whose form factors and solve would not fit in
-    /// memory: the f32 matrix (4 n^2 bytes), plus the f64 LU matrix (8 n^2) for `Solver::Lu`,
-    /// plus the integration points (32 k^2 bytes per element). Progressive refinement stores
-    /// no matrix, so only the integration points are checked for it.
-    pub fn check_memory(&self, solver: Option<Solver>) -> Result<(), PipelineError> {
+    /// memory: the f32 matrix (4 n^2 bytes), plus the f64 LU matrix (8 n^2) for LU, plus the
+    /// integration points (32 k^2 bytes per element). Progressive refinement and
+    /// hierarchical radiosity store no matrix, so only the integration points are checked
+    /// for them. `None`: the form factors alone.
+    pub fn check_memory(&self, solver: Option<&Solver>) -> Result<(), PipelineError> {
+        const MAX_POINTS: f64 = 5e7;
         let n = self.mesh.len();
         let steps = match self.method {
             FormFactorMethod::AreaIntegral { steps }
             | FormFactorMethod::Contour { steps }
-            | FormFactorMethod::Analytic { steps } => steps as f64,
-            _ => 1.0,
+            | FormFactorMethod::Analytic { steps } => steps,
+            _ => 1,
         };
-        let points = n as f64 * steps * steps;
-        if points > 5e7 {
-            return Err(PipelineError::Settings(format!(
-                "INTEGRAL_STEPS {steps} on {n} elements means {points:.2e} integration points (more than 5e7); \
-                 use fewer steps (--steps) or larger elements (--max-area)"
-            )));
+        let points = n as f64 * steps as f64 * steps as f64;
+        if points > MAX_POINTS {
+            return Err(PipelineError::TooManyPoints {
+                steps,
+                elements: n,
+                points,
+                limit: MAX_POINTS,
+            });
         }
         let per_entry = match solver {
             // No matrix: O(n) vectors and one row.
-            Some(Solver::Progressive { .. } | Solver::Hierarchical(_)) => return Ok(()),
-            Some(Solver::Lu) => 12.0,
+            Some(Solver::Progressive(_) | Solver::Hierarchical(_)) => return Ok(()),
+            Some(&Solver::LU) => 12.0,
             _ => 4.0,
         };
         let what = if per_entry > 4.0 {
@@ -229,10 +282,7 @@ impl Prepared {
         &self,
         progress: &dyn Progress,
     ) -> Result<(FormFactorMatrix, FormFactorStats), PipelineError> {
-        let ctx = FormFactorContext {
-            mesh: &self.mesh,
-            occluders: &self.occluders,
-        };
+        let ctx = self.context();
         let rays = RayCounter::default();
         let start = Instant::now();
         let matrix = form_factor::compute_matrix(&ctx, self.method(), &rays, progress)?;
@@ -244,6 +294,14 @@ impl Prepared {
             reciprocity: matrix.reciprocity(&self.areas()),
         };
         Ok((matrix, stats))
+    }
+
+    /// What the form-factor methods need: the mesh and the occluders.
+    pub fn context(&self) -> FormFactorContext<'_> {
+        FormFactorContext {
+            mesh: &self.mesh,
+            occluders: &self.occluders,
+        }
     }
 
     /// Reads form factors from `path`, refusing a file made for another mesh or method.
@@ -273,105 +331,107 @@ impl Prepared {
             source,
         })
     }
+}
 
-    /// Solves for element radiosities with `solver`.
-    pub fn solve(
-        &self,
-        f: &FormFactorMatrix,
-        solver: Solver,
-        progress: &dyn Progress,
-    ) -> Result<Solution, PipelineError> {
-        let (reflectance, emission) = solve::element_properties(&self.mesh, &self.scene);
-        let (radiosity, report) = solve::solve(f, &reflectance, &emission, solver, progress)?;
-        let balance = energy_balance(f, &self.areas(), &reflectance, &emission, &radiosity);
-        Ok(Solution {
-            radiosity,
-            report: SolutionReport::Matrix(report),
-            balance,
-            mesh: None,
-        })
+/// Solves the prepared scene as `request` says: the one place that matches [`Solver`].
+///
+/// The dense solvers take their matrix from `request.form_factors` (computing it reports
+/// its statistics in [`Solution::form_factors`]); progressive refinement computes its rows
+/// as it shoots and hierarchical radiosity its links, so they refuse any matrix given.
+/// `observer` sees every Gauss-Seidel sweep and progressive shot and may stop the solve
+/// (the report then says so); `progress` gets the stages for progress bars.
+pub fn solve(
+    prepared: &Prepared,
+    request: &SolveRequest,
+    observer: &mut Observer,
+    progress: &dyn Progress,
+) -> Result<Solution, PipelineError> {
+    let light = &prepared.light;
+    if !request.solver.needs_matrix() && !matches!(request.form_factors, FormFactors::Compute) {
+        return Err(PipelineError::FormFactorsUnused {
+            solver: request.solver.kind(),
+        });
     }
-
-    /// Solves by progressive refinement (see [`solve::solve_progressive`]) with this
-    /// scene's method, without any form-factor matrix. `observer` is called after every
-    /// shot (for snapshots or a viewer) and may stop the solve.
-    pub fn solve_progressive(
-        &self,
-        tolerance: f64,
-        max_shots: usize,
-        observer: &mut dyn FnMut(&ProgressiveState) -> ControlFlow<()>,
-        progress: &dyn Progress,
-    ) -> Result<Solution, PipelineError> {
-        let (reflectance, emission) = solve::element_properties(&self.mesh, &self.scene);
-        let ctx = FormFactorContext {
-            mesh: &self.mesh,
-            occluders: &self.occluders,
-        };
-        let (radiosity, report) = solve::solve_progressive(
-            &ctx,
-            self.method(),
-            &reflectance,
-            &emission,
-            tolerance,
-            max_shots,
-            observer,
-            progress,
-        )?;
-        Ok(Solution {
-            radiosity,
-            balance: report.balance,
-            report: SolutionReport::Progressive(report),
-            mesh: None,
-        })
-    }
-
-    /// Solves by hierarchical radiosity (see [`solve::solve_hierarchical`]): no matrix; the
-    /// solution carries its own elements (the leaves) in [`Solution::mesh`].
-    pub fn solve_hierarchical(
-        &self,
-        settings: &solve::HierarchicalSettings,
-        progress: &dyn Progress,
-    ) -> Result<Solution, PipelineError> {
-        let h = solve::solve_hierarchical(&self.scene, &self.occluders, settings, progress)?;
-        Ok(Solution {
-            radiosity: h.radiosity,
-            balance: h.report.balance,
-            report: SolutionReport::Hierarchical(h.report),
-            mesh: Some(h.mesh),
-        })
+    match &request.solver {
+        Solver::Dense(dense) => {
+            let computed;
+            let (f, stats) = match request.form_factors {
+                FormFactors::Matrix(f) => (f, None),
+                FormFactors::File(path) => {
+                    computed = prepared.load_form_factors(path, progress)?;
+                    (&computed, None)
+                }
+                FormFactors::Compute => {
+                    let (f, stats) = prepared.form_factors(progress)?;
+                    computed = f;
+                    (&computed, Some(stats))
+                }
+            };
+            let (radiosity, report) =
+                solve::solve(f, light, dense, request.start, observer, progress)?;
+            let balance = energy_balance(f, &prepared.areas(), light, radiosity.as_slice());
+            Ok(Solution {
+                mesh: prepared.mesh.clone(),
+                radiosity,
+                report: SolutionReport::Matrix(report),
+                balance,
+                form_factors: stats,
+            })
+        }
+        Solver::Progressive(settings) => {
+            let (radiosity, report) = solve::solve_progressive(
+                &prepared.context(),
+                prepared.method(),
+                light,
+                settings,
+                observer,
+                progress,
+            )?;
+            Ok(Solution {
+                mesh: prepared.mesh.clone(),
+                radiosity,
+                balance: report.balance,
+                report: SolutionReport::Progressive(report),
+                form_factors: None,
+            })
+        }
+        Solver::Hierarchical(settings) => {
+            let h = solve::solve_hierarchical(
+                &prepared.scene,
+                &prepared.occluders,
+                settings,
+                progress,
+            )?;
+            Ok(Solution {
+                mesh: Arc::new(h.mesh),
+                radiosity: h.radiosity,
+                balance: h.report.balance,
+                report: SolutionReport::Hierarchical(h.report),
+                form_factors: None,
+            })
+        }
     }
 }
 
 impl Solution {
-    /// The elements the radiosities belong to: [`Solution::mesh`] when set, else `prepared`'s.
-    pub fn mesh<'a>(&'a self, prepared: &'a Prepared) -> &'a Mesh {
-        self.mesh.as_ref().unwrap_or(&prepared.mesh)
+    /// B per element as plain triples.
+    pub fn element_rgb(&self) -> &[[f64; 3]] {
+        self.radiosity.as_arrays()
     }
 
-    /// B per element as RGB triples.
-    pub fn element_rgb(&self) -> Vec<[f64; 3]> {
-        (0..self.radiosity.len())
-            .map(|i| self.radiosity.element(i))
-            .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn auto_picks_dense_only_when_small_and_comfortable() {
-        let gib = 1u64 << 30;
-        assert!(choose_dense(2_000, 16 * gib).0);
-        // 20,000 elements need 1.64 GiB with headroom: dense with 16 GiB, not with 2 GiB
-        // (more than half of it).
-        assert!(choose_dense(20_000, 16 * gib).0);
-        assert!(!choose_dense(20_000, 2 * gib).0);
-        assert!(!choose_dense(20_001, 1 << 50).0);
-        assert!(
-            choose_dense(9_805, 16 * gib).1.contains("MiB"),
-            "the reason states the estimate"
-        );
+    /// The radiosity to show: progressive refinement's ambient term added (its estimate of
+    /// the light still unshot, paper section 4), the solution itself for every other
+    /// solver. `reflectance` is rho per element of [`Solution::mesh`].
+    pub fn display_radiosity(&self, reflectance: &[Rgb]) -> Vec<Rgb> {
+        match self.report {
+            SolutionReport::Progressive(r) => self
+                .radiosity
+                .as_slice()
+                .iter()
+                .zip(reflectance)
+                .map(|(&b, &rho)| b + rho * Rgb(r.ambient))
+                .collect(),
+            _ => self.radiosity.0.clone(),
+        }
     }
 }

@@ -3,11 +3,12 @@
 
 use radiosity::compare::compare;
 use radiosity::form_factor::occluder_bvh;
-use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::light::Rgb as Light;
+use radiosity::pipeline::{self, Overrides, Prepared, SolveRequest};
 use radiosity::progress::NoProgress;
 use radiosity::scene::{cornell_box, Rgb, Scene};
 use radiosity::solve::{
-    solve_hierarchical, HierarchicalSettings, HierarchicalSolution, Solver,
+    keep_going, solve_hierarchical, HierarchicalSettings, HierarchicalSolution, Solver,
     DEFAULT_HIERARCHICAL_TOLERANCE,
 };
 
@@ -42,8 +43,8 @@ fn per_surface(mesh: &radiosity::mesh::Mesh, b: &radiosity::solve::Radiosity) ->
             for e in range.clone() {
                 let a = mesh.elements[e as usize].area;
                 area += a;
-                for (s, band) in sum.iter_mut().zip(&b.bands) {
-                    *s += a * band[e as usize];
+                for (k, s) in sum.iter_mut().enumerate() {
+                    *s += a * b.0[e as usize][k];
                 }
             }
             sum.map(|s| s / area)
@@ -54,9 +55,9 @@ fn per_surface(mesh: &radiosity::mesh::Mesh, b: &radiosity::solve::Radiosity) ->
 /// The dense reference: Gauss-Seidel on the area-integral form factors (k = 2) of the
 /// Cornell box meshed at MAX_PATCH_AREA 2000 mm^2 (about 1000 elements).
 struct Dense {
-    mesh: radiosity::mesh::Mesh,
+    mesh: std::sync::Arc<radiosity::mesh::Mesh>,
     radiosity: radiosity::solve::Radiosity,
-    emission: Vec<[f64; 3]>,
+    emission: Vec<Light>,
     per_surface: Vec<[f64; 3]>,
 }
 
@@ -70,14 +71,17 @@ fn dense_cornell() -> Dense {
         &NoProgress,
     )
     .unwrap();
-    let (f, _) = prepared.form_factors(&NoProgress).unwrap();
-    let dense = prepared
-        .solve(&f, Solver::DEFAULT_GAUSS_SEIDEL, &NoProgress)
-        .unwrap();
-    let (_, emission) = radiosity::solve::element_properties(&prepared.mesh, &prepared.scene);
+    let dense = pipeline::solve(
+        &prepared,
+        &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
+        &mut keep_going,
+        &NoProgress,
+    )
+    .unwrap();
+    let emission = prepared.light.emission().to_vec();
     Dense {
         per_surface: per_surface(&prepared.mesh, &dense.radiosity),
-        mesh: prepared.mesh,
+        mesh: prepared.mesh.clone(),
         radiosity: dense.radiosity,
         emission,
     }
@@ -108,7 +112,7 @@ fn cube_errors(s: &HierarchicalSolution) -> (f64, f64) {
     for (i, el) in s.mesh.elements.iter().enumerate() {
         for k in 0..3 {
             let exact = CUBE_E[k] / (1.0 - CUBE_RHO[k]);
-            let rel = (s.radiosity.bands[k][i] - exact).abs() / exact;
+            let rel = (s.radiosity.0[i][k] - exact).abs() / exact;
             worst = worst.max(rel);
             mean += el.area * rel / 3.0;
         }
@@ -303,7 +307,7 @@ fn refuses_to_outgrow_its_memory_limit() {
     };
     let err = solve_hierarchical(&scene, &bvh, &settings, &NoProgress).unwrap_err();
     let text = err.to_string();
-    assert!(text.contains("--epsilon"), "{text}");
+    assert!(text.contains("larger epsilon or minimum area"), "{text}");
     assert!(
         matches!(
             err,
@@ -332,11 +336,14 @@ fn against_exact_dense(
     )
     .unwrap();
     prepared.method = radiosity::form_factor::FormFactorMethod::Contour { steps: 4 };
-    let (f, _) = prepared.form_factors(&NoProgress).unwrap();
-    let dense = prepared
-        .solve(&f, Solver::DEFAULT_GAUSS_SEIDEL, &NoProgress)
-        .unwrap();
-    let (_, emission) = radiosity::solve::element_properties(&prepared.mesh, &prepared.scene);
+    let dense = pipeline::solve(
+        &prepared,
+        &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
+        &mut keep_going,
+        &NoProgress,
+    )
+    .unwrap();
+    let emission = prepared.light.emission();
     settings
         .iter()
         .map(|&(epsilon, min_area)| {
@@ -344,7 +351,7 @@ fn against_exact_dense(
             let c = compare(
                 &prepared.mesh,
                 &dense.radiosity,
-                &emission,
+                emission,
                 &s.mesh,
                 &s.radiosity,
             )

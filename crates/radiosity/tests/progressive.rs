@@ -6,12 +6,13 @@ use radiosity::form_factor::{
     compute_matrix, compute_rows, occluder_bvh, FormFactorContext, FormFactorMatrix,
     FormFactorMethod, RayCounter, RowComputer,
 };
+use radiosity::light::ElementLight;
 use radiosity::mesh::{mesh_scene, Mesh};
 use radiosity::progress::NoProgress;
 use radiosity::scene::{cornell_box, Rgb, Scene};
 use radiosity::solve::{
-    element_properties, energy_balance, solve, solve_progressive, ProgressiveReport, Radiosity,
-    SolveError, Solver,
+    energy_balance, keep_going, solve, solve_progressive, DenseSolver, GaussSeidelSettings,
+    ProgressiveReport, ProgressiveSettings, Radiosity, SolveError, Step,
 };
 use radiosity::visibility::PolygonBvh;
 
@@ -29,19 +30,22 @@ fn unit_cube(max_area: f64, emit: impl Fn(usize) -> [f64; 3]) -> Scene {
 struct Setup {
     mesh: Mesh,
     bvh: PolygonBvh,
-    rho: Vec<[f64; 3]>,
-    e: Vec<[f64; 3]>,
+    light: ElementLight,
+    rho: Vec<Rgb>,
+    e: Vec<Rgb>,
     areas: Vec<f64>,
 }
 
 fn setup(scene: &Scene, max_area: f64) -> Setup {
     let mesh = mesh_scene(scene, max_area).unwrap();
     let bvh = occluder_bvh(scene);
-    let (rho, e) = element_properties(&mesh, scene);
+    let light = ElementLight::of_mesh(&mesh, scene).unwrap();
+    let (rho, e) = (light.reflectance().to_vec(), light.emission().to_vec());
     let areas = mesh.elements.iter().map(|e| e.area).collect();
     Setup {
         mesh,
         bvh,
+        light,
         rho,
         e,
         areas,
@@ -65,12 +69,15 @@ impl Setup {
         let (b, report) = solve_progressive(
             &self.ctx(),
             method,
-            &self.rho,
-            &self.e,
-            tolerance,
-            1_000_000,
-            &mut |s| {
-                fractions.push(s.unshot_fraction);
+            &self.light,
+            &ProgressiveSettings {
+                tolerance,
+                max_shots: 1_000_000,
+            },
+            &mut |step| {
+                if let Step::Shot(s) = step {
+                    fractions.push(s.unshot_fraction);
+                }
                 ControlFlow::Continue(())
             },
             &NoProgress,
@@ -84,21 +91,27 @@ impl Setup {
     }
 
     fn gauss_seidel(&self, f: &FormFactorMatrix) -> Radiosity {
-        let solver = Solver::GaussSeidel {
+        let solver = DenseSolver::GaussSeidel(GaussSeidelSettings {
             tolerance: 1e-13,
             max_iterations: 100_000,
-        };
-        solve(f, &self.rho, &self.e, solver, &NoProgress).unwrap().0
+        });
+        solve(f, &self.light, &solver, None, &mut keep_going, &NoProgress)
+            .unwrap()
+            .0
     }
 }
 
 /// max_i |a_i - b_i| / max_i |b_i| over all bands.
 fn max_relative_difference(a: &Radiosity, b: &Radiosity) -> f64 {
-    let scale = b.bands.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    a.bands
+    let scale = b
+        .as_arrays()
         .iter()
         .flatten()
-        .zip(b.bands.iter().flatten())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    a.as_arrays()
+        .iter()
+        .flatten()
+        .zip(b.as_arrays().iter().flatten())
         .map(|(x, y)| (x - y).abs() / scale)
         .fold(0.0, f64::max)
 }
@@ -163,7 +176,7 @@ fn furnace_in_closed_cube() {
         for i in 0..s.mesh.len() {
             for k in 0..3 {
                 let expected = s.e[i][k] / (1.0 - s.rho[i][k]);
-                let got = b.bands[k][i];
+                let got = b.0[i][k];
                 worst = worst.max(((got - expected) / expected).abs());
             }
         }
@@ -209,7 +222,7 @@ fn agrees_with_dense_gauss_seidel() {
         assert!(d < 1e-5, "{n} elements, {method}: {d:e}");
         // Energy balance of the progressive B through the dense matrix: what is unaccounted
         // for is the unshot power (1e-6) plus the f32 reciprocity rounding of F.
-        let bal = energy_balance(&f, &s.areas, &s.rho, &s.e, &b);
+        let bal = energy_balance(&f, &s.areas, &s.light, b.as_slice());
         assert!(bal.relative_error() < 1e-5, "{bal:?}");
     }
 }
@@ -314,11 +327,15 @@ fn ambient_is_for_display_only_and_observer_can_stop() {
     let (b, report) = solve_progressive(
         &s.ctx(),
         FormFactorMethod::AreaIntegral { steps: 2 },
-        &s.rho,
-        &s.e,
-        1e-6,
-        1_000_000,
-        &mut |state| {
+        &s.light,
+        &ProgressiveSettings {
+            tolerance: 1e-6,
+            max_shots: 1_000_000,
+        },
+        &mut |step| {
+            let Step::Shot(state) = step else {
+                panic!("progressive refinement shows shots, not {step:?}")
+            };
             let display = state.display_radiosity();
             for (i, d) in display.iter().enumerate() {
                 for k in 0..3 {
@@ -362,15 +379,19 @@ fn refusals() {
         solve_progressive(
             &s.ctx(),
             method,
-            &s.rho,
-            &s.e,
-            tolerance,
-            max_shots,
-            &mut |_| ControlFlow::Continue(()),
+            &s.light,
+            &ProgressiveSettings {
+                tolerance,
+                max_shots,
+            },
+            &mut keep_going,
             &NoProgress,
         )
     };
-    assert!(matches!(run(0.0, 10), Err(SolveError::BadSettings(_))));
+    assert!(matches!(
+        run(0.0, 10),
+        Err(SolveError::BadSettings { value: 0.0, .. })
+    ));
     let err = run(1e-6, 3).unwrap_err();
     let SolveError::ProgressiveNotConverged {
         shots,
@@ -382,32 +403,22 @@ fn refusals() {
     };
     assert_eq!(shots, 3);
     assert!(unshot_fraction > 1e-6);
-    // The matrix solver entry point refuses the progressive solver.
-    let f = FormFactorMatrix::from_rows(1, vec![0.0]);
-    assert_eq!(
-        solve(
-            &f,
-            &[[0.5; 3]],
-            &[[1.0; 3]],
-            Solver::DEFAULT_PROGRESSIVE,
-            &NoProgress
-        )
-        .unwrap_err(),
-        SolveError::NeedsScene
-    );
+    // (The matrix solver entry point takes a `DenseSolver`: it cannot be handed progressive
+    // refinement at all.)
     // Nothing emitted: B = 0 after no shots.
-    let dark = vec![[0.0; 3]; s.mesh.len()];
+    let dark = ElementLight::new(s.rho.clone(), vec![Rgb::BLACK; s.mesh.len()]).unwrap();
     let (b, report) = solve_progressive(
         &s.ctx(),
         method,
-        &s.rho,
         &dark,
-        0.01,
-        10,
-        &mut |_| ControlFlow::Continue(()),
+        &ProgressiveSettings {
+            tolerance: 0.01,
+            max_shots: 10,
+        },
+        &mut keep_going,
         &NoProgress,
     )
     .unwrap();
     assert_eq!(report.shots, 0);
-    assert!(b.bands.iter().flatten().all(|&x| x == 0.0));
+    assert!(b.0.iter().all(|&x| x == Rgb::BLACK));
 }

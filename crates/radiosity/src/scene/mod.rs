@@ -88,26 +88,8 @@ pub use parse::{parse_scene, read_scene, ParseError, SceneError};
 pub use shape::PLANARITY_TOLERANCE;
 pub use write::{write_scene, write_scene_file};
 
-/// A colour triple in linear red, green, blue bands.
-///
-/// Used both for emission (exitance per band, scene units) and reflectance (fraction in [0, 1)).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Rgb(pub [f64; 3]);
-
-impl Rgb {
-    /// All three bands zero.
-    pub const BLACK: Rgb = Rgb([0.0; 3]);
-
-    /// The value of band `b` (0 red, 1 green, 2 blue).
-    pub fn band(self, b: usize) -> f64 {
-        self.0[b]
-    }
-
-    /// The largest of the three bands.
-    pub fn max_band(self) -> f64 {
-        self.0[0].max(self.0[1]).max(self.0[2])
-    }
-}
+/// Colours of surfaces: see [`crate::light`].
+pub use crate::light::Rgb;
 
 /// The meshing and integration settings at the top of a scene file.
 #[derive(Clone, Copy, Debug, PartialEq)]

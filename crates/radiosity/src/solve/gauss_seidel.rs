@@ -1,6 +1,7 @@
 //! The iterative solver: Gauss-Seidel sweeps over (I - rho F) B = E.
 //!
-//! Each sweep visits the elements in order and sets B_i <- E_i + rho_i sum_j F_ij B_j using
+//! Starts from B = E, or from an earlier solution (a warm start, as the window uses after
+//! a colour edit). Each sweep visits the elements in order and sets B_i <- E_i + rho_i sum_j F_ij B_j using
 //! the values already updated in this sweep, for all three bands at once, so that every row
 //! of F (f32, widened to f64) is read once per sweep. Since rho_i < 1 and each row of F sums
 //! to at most 1, the iteration matrix has norm below 1 and the sweeps converge.
@@ -11,26 +12,40 @@
 //! the tolerance the true residual is computed (one more pass over F) and the solve ends
 //! when that too is below the tolerance.
 
-use super::{max_abs_emission, relative, relative_residual, row_dot3, Radiosity, SolveError};
+use std::ops::ControlFlow;
+
+use super::residual::{max_abs_emission, relative, relative_residual, row_dot3};
+use super::{GaussSeidelSettings, Observer, Radiosity, SolveError, Step};
 use crate::form_factor::FormFactorMatrix;
+use crate::light::{ElementLight, Rgb};
 use crate::progress::Progress;
 
-/// Iterates from B = E until the relative residual is below `tolerance` in every band;
-/// returns B and the number of sweeps.
+/// What a Gauss-Seidel run returns.
+pub(super) struct Run {
+    pub radiosity: Radiosity,
+    pub sweeps: usize,
+    /// The observer stopped it before it converged.
+    pub stopped: bool,
+}
+
+/// Iterates from `start` (or B = E) until the relative residual is below the tolerance in
+/// every band, or until `observer`, shown every sweep, says stop.
 pub(super) fn solve(
     f: &FormFactorMatrix,
-    reflectance: &[[f64; 3]],
-    emission: &[[f64; 3]],
-    tolerance: f64,
-    max_iterations: usize,
+    light: &ElementLight,
+    settings: &GaussSeidelSettings,
+    start: Option<&[Rgb]>,
+    observer: &mut Observer,
     progress: &dyn Progress,
-) -> Result<(Radiosity, usize), SolveError> {
+) -> Result<Run, SolveError> {
+    let GaussSeidelSettings {
+        tolerance,
+        max_iterations,
+    } = *settings;
+    let (reflectance, emission) = (light.reflectance(), light.emission());
     let n = f.n();
     let scale = max_abs_emission(emission);
-    let mut b: Vec<[f64; 3]> = emission.to_vec();
-    let to_radiosity = |b: &[[f64; 3]]| Radiosity {
-        bands: std::array::from_fn(|k| b.iter().map(|x| x[k]).collect()),
-    };
+    let mut b: Vec<Rgb> = start.unwrap_or(emission).to_vec();
     let mut residual = f64::INFINITY;
     for sweep in 1..=max_iterations {
         let mut change = [0.0f64; 3];
@@ -54,14 +69,29 @@ pub(super) fn solve(
         }
         residual = estimate;
         if estimate < tolerance {
-            let radiosity = to_radiosity(&b);
-            let true_residual = relative_residual(f, reflectance, emission, &radiosity)
+            let true_residual = relative_residual(f, light, &b)
                 .into_iter()
                 .fold(0.0, f64::max);
             residual = true_residual;
             if true_residual < tolerance {
-                return Ok((radiosity, sweep));
+                return Ok(Run {
+                    radiosity: Radiosity(b),
+                    sweeps: sweep,
+                    stopped: false,
+                });
             }
+        }
+        let step = Step::Sweep {
+            sweep,
+            change: estimate,
+            radiosity: &b,
+        };
+        if let ControlFlow::Break(()) = observer(&step) {
+            return Ok(Run {
+                radiosity: Radiosity(b),
+                sweeps: sweep,
+                stopped: true,
+            });
         }
     }
     Err(SolveError::NotConverged {

@@ -1294,9 +1294,7 @@ impl Solver<'_> {
                 return Ok((sweep, residual));
             }
         }
-        Err(SolveError::BadSettings(format!(
-            "hierarchical radiosity did not converge in {MAX_SWEEPS} sweeps"
-        )))
+        Err(SolveError::HierarchicalNotConverged { sweeps: MAX_SWEEPS })
     }
 
     fn leaves_of(&self, n: u32, out: &mut Vec<u32>) {
@@ -1327,45 +1325,32 @@ pub fn solve_hierarchical(
         ..
     } = *settings;
     if !(epsilon.is_finite() && epsilon > 0.0) {
-        return Err(SolveError::BadSettings(format!(
-            "epsilon must be a positive number, got {epsilon}"
-        )));
+        return Err(SolveError::BadSettings {
+            setting: "epsilon",
+            expected: "a positive number",
+            value: epsilon,
+        });
     }
     if !(min_area.is_finite() && min_area > 0.0) {
-        return Err(SolveError::BadSettings(format!(
-            "the minimum element area must be a positive number, got {min_area}"
-        )));
+        return Err(SolveError::BadSettings {
+            setting: "the minimum element area",
+            expected: "a positive number",
+            value: min_area,
+        });
     }
     if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
-        return Err(SolveError::BadSettings(format!(
-            "the tolerance must be a number in (0, 1), got {tolerance}"
-        )));
+        return Err(SolveError::BadSettings {
+            setting: "the tolerance",
+            expected: "a number in (0, 1)",
+            value: tolerance,
+        });
     }
     for (s, surface) in scene.surfaces.iter().enumerate() {
-        for b in 0..3 {
-            let (r, e) = (surface.reflectance.0[b], surface.emission.0[b]);
-            if !(0.0..1.0).contains(&r) {
-                return Err(SolveError::BadValue {
-                    element: s,
-                    what: "reflectance",
-                    band: b,
-                    value: r,
-                    why: "outside [0, 1)",
-                });
-            }
-            if !(e.is_finite() && e >= 0.0) {
-                return Err(SolveError::BadValue {
-                    element: s,
-                    what: "emission",
-                    band: b,
-                    value: e,
-                    why: "not a finite non-negative number",
-                });
-            }
-        }
+        crate::light::check_surface(s, surface.reflectance, surface.emission)
+            .map_err(crate::light::LightError::from)?;
     }
     if scene.surfaces.is_empty() {
-        return Err(SolveError::BadSettings("the scene has no surfaces".into()));
+        return Err(SolveError::NoSurfaces);
     }
     let start = Instant::now();
     let mut solver = Solver {
@@ -1518,9 +1503,12 @@ pub fn solve_hierarchical(
         leaf_ids.extend(leaves);
     }
     let mesh = Mesh::from_surfaces(parts);
-    let radiosity = Radiosity {
-        bands: std::array::from_fn(|k| leaf_ids.iter().map(|&l| solver.b[l as usize][k]).collect()),
-    };
+    let radiosity = Radiosity(
+        leaf_ids
+            .iter()
+            .map(|&l| crate::light::Rgb(solver.b[l as usize]))
+            .collect(),
+    );
 
     // Energy account from the leaves.
     let (mut emitted_leaves, mut leaving, mut carried, mut absorbed) =

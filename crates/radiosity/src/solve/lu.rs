@@ -14,6 +14,7 @@ use faer::{get_global_parallelism, Mat};
 
 use super::Radiosity;
 use crate::form_factor::{check_dense_fits, FormFactorMatrix, OutOfMemory};
+use crate::light::{ElementLight, Rgb};
 use crate::progress::{run_stage, Progress, Stage};
 
 /// Bytes per matrix entry the LU solver needs: the f64 matrix, factored in place. faer's
@@ -32,11 +33,11 @@ pub(super) fn check_memory(n: usize, available: u64) -> Result<(), OutOfMemory> 
 /// The caller has checked the inputs and the memory ([`check_memory`]).
 pub(super) fn solve(
     f: &FormFactorMatrix,
-    reflectance: &[[f64; 3]],
-    emission: &[[f64; 3]],
+    light: &ElementLight,
     share: bool,
     progress: &dyn Progress,
 ) -> Radiosity {
+    let (reflectance, emission) = (light.reflectance(), light.emission());
     let n = f.n();
     // Group the bands by reflectance vector: groups[g] lists the bands factored together.
     let mut groups: Vec<Vec<usize>> = Vec::new();
@@ -52,7 +53,7 @@ pub(super) fn solve(
             None => groups.push(vec![band]),
         }
     }
-    let mut out = Radiosity::default();
+    let mut out = Radiosity(vec![Rgb::BLACK; n]);
     run_stage(progress, Stage::Solve, groups.len() as u64, || {
         let par = get_global_parallelism();
         for bands in &groups {
@@ -89,7 +90,9 @@ pub(super) fn solve(
             lu_solve::solve_transpose_in_place(a.as_ref(), a.as_ref(), p, rhs.as_mut(), par, stack);
 
             for (k, &band) in bands.iter().enumerate() {
-                out.bands[band] = rhs.col_as_slice(k).to_vec();
+                for (b, &x) in out.0.iter_mut().zip(rhs.col_as_slice(k)) {
+                    b[band] = x;
+                }
             }
             progress.advance(1);
         }

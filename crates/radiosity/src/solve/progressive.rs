@@ -28,11 +28,11 @@
 //!
 //! Memory: O(n) vectors plus one row of F.
 
-use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
-use super::{EnergyBalance, Radiosity, SolveError};
+use super::{EnergyBalance, Observer, ProgressiveSettings, Radiosity, SolveError, Step};
 use crate::form_factor::{FormFactorContext, FormFactorMethod, RayCounter, RowComputer};
+use crate::light::{ElementLight, Rgb};
 use crate::progress::{run_stage, Progress, Stage};
 
 /// The unshot-power fraction progressive refinement stops at unless told otherwise: 1 %.
@@ -45,10 +45,10 @@ pub struct ProgressiveState<'a> {
     pub shot: usize,
     /// The element shot last.
     pub shooter: usize,
-    /// B per element (three bands), without the ambient term.
-    pub radiosity: &'a [[f64; 3]],
+    /// B per element, without the ambient term.
+    pub radiosity: &'a [Rgb],
     /// rho per element, for [`ProgressiveState::display_radiosity`].
-    pub reflectance: &'a [[f64; 3]],
+    pub reflectance: &'a [Rgb],
     /// The ambient radiosity per band (see the module documentation).
     pub ambient: [f64; 3],
     /// The largest, over the bands that emit, unshot power / emitted power.
@@ -57,11 +57,11 @@ pub struct ProgressiveState<'a> {
 
 impl ProgressiveState<'_> {
     /// B_i + rho_i ambient for every element: the radiosity to show while the solve runs.
-    pub fn display_radiosity(&self) -> Vec<[f64; 3]> {
+    pub fn display_radiosity(&self) -> Vec<Rgb> {
         self.radiosity
             .iter()
             .zip(self.reflectance)
-            .map(|(b, rho)| std::array::from_fn(|k| b[k] + rho[k] * self.ambient[k]))
+            .map(|(b, rho)| Rgb(std::array::from_fn(|k| b[k] + rho[k] * self.ambient[k])))
             .collect()
     }
 }
@@ -92,8 +92,7 @@ pub struct ProgressiveReport {
 
 /// Solves by progressive refinement, computing one row of F per shot with `method`.
 ///
-/// `reflectance[i]` and `emission[i]` are rho and E of element i of `ctx.mesh` (rho in
-/// [0, 1), E finite). Stops when the unshot power is below `tolerance` times the emitted
+/// `light` holds rho and E of every element of `ctx.mesh`. Stops when the unshot power is below `tolerance` times the emitted
 /// power in every band that emits (see the module documentation), or when `observer`,
 /// called after every shot, returns `ControlFlow::Break` (the report says `stopped`).
 /// Fails with [`SolveError::ProgressiveNotConverged`] after `max_shots` shots. Reports to
@@ -101,23 +100,33 @@ pub struct ProgressiveReport {
 ///
 /// Deterministic: ties for the brightest element go to the lowest index, and each row is
 /// computed by the method's deterministic code.
-#[allow(clippy::too_many_arguments)]
 pub fn solve_progressive(
     ctx: &FormFactorContext,
     method: FormFactorMethod,
-    reflectance: &[[f64; 3]],
-    emission: &[[f64; 3]],
-    tolerance: f64,
-    max_shots: usize,
-    observer: &mut dyn FnMut(&ProgressiveState) -> ControlFlow<()>,
+    light: &ElementLight,
+    settings: &ProgressiveSettings,
+    observer: &mut Observer,
     progress: &dyn Progress,
 ) -> Result<(Radiosity, ProgressiveReport), SolveError> {
+    let ProgressiveSettings {
+        tolerance,
+        max_shots,
+    } = *settings;
+    let (reflectance, emission) = (light.reflectance(), light.emission());
     let n = ctx.mesh.len();
-    super::check_properties(n, reflectance, emission)?;
+    if light.len() != n {
+        return Err(SolveError::LengthMismatch {
+            what: "the element light",
+            len: light.len(),
+            n,
+        });
+    }
     if !(tolerance > 0.0 && tolerance.is_finite()) {
-        return Err(SolveError::BadSettings(format!(
-            "the progressive tolerance (unshot fraction) must be a positive number, got {tolerance}"
-        )));
+        return Err(SolveError::BadSettings {
+            setting: "the progressive tolerance (unshot fraction)",
+            expected: "a positive number",
+            value: tolerance,
+        });
     }
     let start = Instant::now();
     let areas: Vec<f64> = ctx.mesh.elements.iter().map(|e| e.area).collect();
@@ -136,13 +145,13 @@ pub fn solve_progressive(
     });
     let emitted: [f64; 3] =
         std::array::from_fn(|k| areas.iter().zip(emission).map(|(a, e)| a * e[k]).sum());
-    let mut b: Vec<[f64; 3]> = emission.to_vec();
-    let mut unshot: Vec<[f64; 3]> = emission.to_vec();
+    let mut b: Vec<Rgb> = emission.to_vec();
+    let mut unshot: Vec<Rgb> = emission.to_vec();
     let mut absorbed = [0.0f64; 3];
     let mut escaped = [0.0f64; 3];
     // Running total of unshot power per band, recomputed exactly every 64 shots so that
     // rounding in the running sum cannot drift.
-    let total_unshot = |u: &[[f64; 3]]| -> [f64; 3] {
+    let total_unshot = |u: &[Rgb]| -> [f64; 3] {
         std::array::from_fn(|k| areas.iter().zip(u).map(|(a, d)| a * d[k]).sum())
     };
     let fraction = |u: [f64; 3]| -> f64 {
@@ -198,7 +207,7 @@ pub fn solve_progressive(
             }
             let shot = unshot[shooter];
             let a_i = areas[shooter];
-            unshot[shooter] = [0.0; 3];
+            unshot[shooter] = Rgb::BLACK;
             let row = rows.row(shooter, &rays);
             let mut row_sum = 0.0;
             let mut reflected_power = [0.0f64; 3];
@@ -236,7 +245,7 @@ pub fn solve_progressive(
                 ambient: ambient_of(power),
                 unshot_fraction: fraction(power),
             };
-            if observer(&state).is_break() {
+            if observer(&Step::Shot(&state)).is_break() {
                 stopped = true;
                 return Ok(());
             }
@@ -265,8 +274,5 @@ pub fn solve_progressive(
         report.elapsed.as_secs_f64(),
         if stopped { " (stopped early)" } else { "" }
     ));
-    let radiosity = Radiosity {
-        bands: std::array::from_fn(|k| b.iter().map(|x| x[k]).collect()),
-    };
-    Ok((radiosity, report))
+    Ok((Radiosity(b), report))
 }

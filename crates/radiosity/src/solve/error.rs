@@ -1,0 +1,88 @@
+//! Why a solve failed.
+
+use crate::form_factor::OutOfMemory;
+use crate::light::LightError;
+
+/// The radiosity system cannot be solved.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SolveError {
+    /// The dense LU matrix would not fit in memory (nothing was allocated).
+    #[error(transparent)]
+    OutOfMemory(#[from] OutOfMemory),
+    /// Hierarchical radiosity's nodes and links would outgrow the memory.
+    #[error(
+        "hierarchical radiosity stopped refining at {nodes} nodes and {links} links: they \
+         take about {used_mib} MiB, past the limit of {limit_mib} MiB (80 % of the memory \
+         available unless set); a larger epsilon or minimum area refines less"
+    )]
+    HierarchicalTooBig {
+        /// Estimated bytes held, in MiB.
+        used_mib: u64,
+        /// The limit, in MiB.
+        limit_mib: u64,
+        /// Nodes made.
+        nodes: usize,
+        /// Links held.
+        links: usize,
+    },
+    /// Gauss-Seidel did not reach the tolerance within the allowed sweeps.
+    #[error(
+        "Gauss-Seidel did not converge: after {iterations} sweeps the relative residual is \
+         {residual:e}, above the tolerance {tolerance:e} (raise the iteration limit, loosen \
+         the tolerance, or use the LU solver)"
+    )]
+    NotConverged {
+        /// Sweeps made.
+        iterations: usize,
+        /// The largest relative residual over the bands after the last sweep.
+        residual: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+    /// Progressive refinement did not reach the tolerance within the allowed shots.
+    #[error(
+        "progressive refinement did not converge: after {shots} shots the unshot power is \
+         {unshot_fraction:e} of the emitted power, above the tolerance {tolerance:e} (raise \
+         the shot limit or loosen the tolerance)"
+    )]
+    ProgressiveNotConverged {
+        /// Shots made.
+        shots: usize,
+        /// Unshot power / emitted power, the largest over the bands.
+        unshot_fraction: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+    /// Hierarchical radiosity's sweeps did not settle.
+    #[error("hierarchical radiosity did not converge in {sweeps} sweeps")]
+    HierarchicalNotConverged {
+        /// Sweeps made.
+        sweeps: usize,
+    },
+    /// There is nothing to solve.
+    #[error("the scene has no surfaces")]
+    NoSurfaces,
+    /// An input vector does not have one entry per row of the form-factor matrix.
+    #[error("{what} has {len} entries but the form-factor matrix has {n} rows")]
+    LengthMismatch {
+        /// Which input.
+        what: &'static str,
+        /// Its length.
+        len: usize,
+        /// The matrix size.
+        n: usize,
+    },
+    /// A reflectance is outside [0, 1) or an emission is not a finite number.
+    #[error(transparent)]
+    Light(#[from] LightError),
+    /// The solver settings are unusable (for example a tolerance that is not positive).
+    #[error("bad solver settings: {setting} must be {expected}, got {value}")]
+    BadSettings {
+        /// Which setting ("the Gauss-Seidel tolerance").
+        setting: &'static str,
+        /// What it must be ("a positive number").
+        expected: &'static str,
+        /// The value given.
+        value: f64,
+    },
+}
