@@ -57,13 +57,7 @@ pub struct Camera {
 /// True when most of a 5 x 5 grid of rays from the bounding box's centre towards its front
 /// (-z) face leave the scene without hitting a surface: the box is open there.
 fn front_side_is_open(scene: &Scene, lo: DVec3, hi: DVec3) -> bool {
-    let polygons: Vec<&[DVec3]> = scene
-        .surfaces
-        .iter()
-        .map(|s| s.vertices.as_slice())
-        .collect();
-    let ids: Vec<u32> = (0..polygons.len() as u32).collect();
-    let bvh = PolygonBvh::new(&polygons, &ids);
+    let bvh = PolygonBvh::over_surfaces(scene);
     let centre = 0.5 * (lo + hi);
     let mut escaped = 0;
     for i in 0..5 {
@@ -175,13 +169,7 @@ impl Camera {
             })
             .filter(|s| s.emission.max_band() > 0.0)?;
         let centre = crate::geometry::polygon_centroid(&light.vertices);
-        let polygons: Vec<&[DVec3]> = scene
-            .surfaces
-            .iter()
-            .map(|s| s.vertices.as_slice())
-            .collect();
-        let ids: Vec<u32> = (0..polygons.len() as u32).collect();
-        let bvh = crate::visibility::PolygonBvh::new(&polygons, &ids);
+        let bvh = PolygonBvh::over_surfaces(scene);
         let scale = bvh.scale();
         let below = bvh
             .closest_hit(centre, -DVec3::Y, 1e-6 * scale, scale)
@@ -405,10 +393,6 @@ pub struct Renderer<'m> {
 impl<'m> Renderer<'m> {
     /// Builds the element BVH of `mesh`.
     pub fn new(mesh: &'m Mesh) -> Renderer<'m> {
-        let polygons: Vec<Vec<DVec3>> = (0..mesh.len())
-            .map(|e| mesh.corner_positions(e).collect())
-            .collect();
-        let ids: Vec<u32> = (0..mesh.len() as u32).collect();
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
         for v in &mesh.vertices {
@@ -437,7 +421,7 @@ impl<'m> Renderer<'m> {
             .collect();
         Renderer {
             mesh,
-            bvh: PolygonBvh::new(&polygons, &ids),
+            bvh: PolygonBvh::over_elements(mesh),
             bounds: (lo, hi),
             boundary_edges,
         }
