@@ -9,10 +9,10 @@
 //! * `camera`: the pinhole [`Camera`] and its automatic placement ([`Camera::for_scene`]).
 //! * `renderer`: the element BVH, what a ray sees ([`Shading`]), and the interpolation
 //!   weights of smooth shading ([`inverse_bilinear`], [`barycentric`]).
+//! * [`tonemap`]: exposure, the paper's gamma correction (section 2.7) and 8-bit encoding.
 //! * [`render`] (here): the ray loop over the image, and [`write_png`].
 //!
-//! Colours go through [`crate::shade::expose`] and the paper's gamma correction (section
-//! 2.7, [`crate::shade::encode`]). Rows are rendered in parallel with rayon; each finished
+//! Colours go through [`tonemap::expose`] and [`tonemap::encode`]. Rows are rendered in parallel with rayon; each finished
 //! row is reported to the [`Progress`] sink as one unit of [`Stage::Render`].
 
 use std::io;
@@ -22,12 +22,13 @@ use image::RgbImage;
 use rayon::prelude::*;
 
 use crate::progress::{run_stage, Progress, Stage};
-use crate::shade::GammaEncoder;
+use tonemap::GammaEncoder;
 
 mod camera;
 mod renderer;
 #[cfg(test)]
 mod test_support;
+pub mod tonemap;
 
 pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
 pub use renderer::{barycentric, inverse_bilinear, Renderer, Shading};
@@ -38,7 +39,7 @@ pub struct RenderSettings {
     /// The display mode.
     pub shading: Shading,
     /// Radiosities are multiplied by this before clamping to [0, 1] (see
-    /// [`crate::shade::Exposure::scale`]).
+    /// [`tonemap::Exposure::scale`]).
     pub exposure_scale: f64,
     /// Gamma factor of paper 2.7: display = value^(1 / gamma). 1 means no correction.
     pub gamma: f64,

@@ -17,9 +17,9 @@ use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
 
+use super::tonemap::expose;
 use super::RenderSettings;
 use crate::mesh::Mesh;
-use crate::shade::expose;
 use crate::visibility::PolygonBvh;
 
 /// How the hit element is coloured.
@@ -266,8 +266,9 @@ mod tests {
     use crate::mesh::{bilinear, mesh_scene};
     use crate::progress::NoProgress;
     use crate::render::test_support::{cornell_camera, facing_minus_z, px, scene, surface};
+    use crate::render::tonemap::tone_map;
     use crate::render::{render, Camera};
-    use crate::shade::{tone_map, vertex_radiosity};
+    use crate::shade::vertex_radiosity;
     use glam::dvec3;
     use image::RgbImage;
 
