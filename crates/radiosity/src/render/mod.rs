@@ -7,30 +7,34 @@
 //! the element it hits first, in one of the paper's three display modes ([`Shading`]).
 //!
 //! * `camera`: the pinhole [`Camera`] and its automatic placement ([`Camera::for_scene`]).
-//! * `renderer`: the element BVH, what a ray sees ([`Shading`]), and the interpolation
-//!   weights of smooth shading ([`inverse_bilinear`], [`barycentric`]).
-//! * [`tonemap`]: exposure, the paper's gamma correction (section 2.7) and 8-bit encoding.
-//! * [`render`] (here): the ray loop over the image, and [`write_png`].
+//! * `renderer`: the element BVH, what a ray sees ([`Shading`]), the interpolation weights
+//!   of smooth shading ([`inverse_bilinear`], [`barycentric`]), and the ray loop that
+//!   writes a view into a [`Film`] ([`Renderer::film`]).
+//! * `film`: the linear film: f64 values per ray sample, no exposure or gamma yet.
+//! * [`tonemap`]: exposure, the paper's gamma correction (section 2.7) and 8-bit encoding,
+//!   from a film to an image.
+//! * [`render`] (here): film then tone map, the one call the CLI makes; and [`write_png`].
 //!
-//! Colours go through [`tonemap::expose`] and [`tonemap::encode`]. Rows are rendered in parallel with rayon; each finished
-//! row is reported to the [`Progress`] sink as one unit of [`Stage::Render`].
+//! Rows are rendered in parallel with rayon; each finished row is reported to the
+//! [`Progress`] sink as one unit of [`Stage::Render`].
 
 use std::io;
 use std::path::Path;
 
 use image::RgbImage;
-use rayon::prelude::*;
 
 use crate::progress::{run_stage, Progress, Stage};
-use tonemap::GammaEncoder;
+use tonemap::ToneMap;
 
 mod camera;
+mod film;
 mod renderer;
 #[cfg(test)]
 mod test_support;
 pub mod tonemap;
 
 pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
+pub use film::{sample_offset, Film, FilmContent};
 pub use renderer::{barycentric, inverse_bilinear, Renderer, Shading};
 
 /// Everything about how to render except the camera and the radiosities.
@@ -61,6 +65,10 @@ impl Default for RenderSettings {
     }
 }
 
+/// At most this many film samples (48 MiB of them) are held at once by [`render`], which
+/// traces and tone-maps a large or heavily supersampled image in strips of rows.
+const STRIP_SAMPLES: usize = 1 << 21;
+
 /// Renders the view of `camera` into a `camera.width` x `camera.height` image.
 ///
 /// `element_b` holds one radiosity per element of the renderer's mesh; `vertex_b` one per
@@ -68,6 +76,9 @@ impl Default for RenderSettings {
 /// [`Shading::Smooth`] (it may be empty otherwise). Rows are rendered in parallel; the work
 /// is reported as [`Stage::Render`] with one `advance(1)` per finished row. An image with
 /// no pixels is returned at once.
+///
+/// The rays write a linear [`Film`] ([`Renderer::film`]), which [`tonemap::ToneMap`] turns
+/// into 8-bit colour: per pixel, each sample exposed and clamped, the mean, then gamma.
 ///
 /// # Panics
 /// If `element_b` (or, for smooth shading, `vertex_b`) has the wrong length.
@@ -79,46 +90,29 @@ pub fn render(
     settings: &RenderSettings,
     progress: &dyn Progress,
 ) -> RgbImage {
-    let mesh = renderer.mesh;
-    assert_eq!(element_b.len(), mesh.len(), "one radiosity per element");
-    if settings.shading == Shading::Smooth {
-        assert_eq!(
-            vertex_b.len(),
-            mesh.vertices.len(),
-            "one radiosity per vertex"
-        );
-    }
+    renderer.check_inputs(element_b, vertex_b, settings.shading);
     let (w, h) = (camera.width as usize, camera.height as usize);
     if w == 0 || h == 0 {
         return RgbImage::new(camera.width, camera.height);
     }
-    let screen = camera.screen();
-    let footprint = camera.pixel_angle();
-    let n = settings.supersample.max(1);
+    let n = settings.supersample.max(1) as usize;
+    let tone = ToneMap::new(settings.exposure_scale, settings.gamma);
+    let strip = (STRIP_SAMPLES / (w * n * n)).max(1);
     let mut buf = vec![0u8; w * h * 3];
-    let encoder = GammaEncoder::new(settings.gamma);
     run_stage(progress, Stage::Render, h as u64, || {
-        buf.par_chunks_mut(w * 3).enumerate().for_each(|(y, row)| {
-            for x in 0..w {
-                let mut sum = [0.0; 3];
-                for j in 0..n {
-                    for i in 0..n {
-                        let sx = x as f64 + (i as f64 + 0.5) / n as f64;
-                        let sy = y as f64 + (j as f64 + 0.5) / n as f64;
-                        let dir = camera.direction_in(screen, sx, sy);
-                        let c = renderer
-                            .trace(camera.eye, dir, footprint, element_b, vertex_b, settings);
-                        for k in 0..3 {
-                            sum[k] += c[k];
-                        }
-                    }
-                }
-                let samples = (n * n) as f64;
-                let rgb = encoder.encode(sum.map(|s| s / samples));
-                row[3 * x..3 * x + 3].copy_from_slice(&rgb);
-            }
-            progress.advance(1);
-        });
+        for (k, out) in buf.chunks_mut(strip * w * 3).enumerate() {
+            let rows = k * strip..k * strip + out.len() / (w * 3);
+            let film = renderer.film_rows(
+                camera,
+                rows,
+                element_b,
+                vertex_b,
+                settings.shading,
+                n,
+                progress,
+            );
+            tone.encode_film(&film, out);
+        }
     });
     RgbImage::from_raw(camera.width, camera.height, buf).expect("buffer has the image's size")
 }
@@ -206,5 +200,45 @@ mod tests {
             &NoProgress,
         );
         assert_eq!(empty.dimensions(), (0, 7));
+    }
+
+    #[test]
+    fn render_is_the_tone_mapped_film_in_strips() {
+        // A light above a floor, 200 x 200 pixels of 8 x 8 samples: 2.56 M samples, which
+        // render() traces in two strips; the image must be the whole film's tone map.
+        let s = scene(vec![
+            surface("floor", 0.0, facing_minus_z(-1., 1., -1., 1., 0.)),
+            surface("light", 5.0, facing_minus_z(-0.3, 0.3, -0.3, 0.3, -0.5)),
+        ]);
+        let mesh = mesh_scene(&s, 0.1).unwrap();
+        let eb: Vec<[f64; 3]> = (0..mesh.len())
+            .map(|e| [0.1 + 0.01 * e as f64, 0.5, 5.0 * (e % 3) as f64])
+            .collect();
+        let vb = crate::shade::vertex_radiosity(&mesh, &eb);
+        let r = Renderer::new(&mesh);
+        let cam = Camera {
+            eye: dvec3(0.1, 0.2, -3.),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 45.0,
+            width: 200,
+            height: 200,
+        };
+        assert!(200 * 200 * 64 > STRIP_SAMPLES && 200 * 64 < STRIP_SAMPLES);
+        for shading in [Shading::Smooth, Shading::Flat, Shading::Wireframe] {
+            let settings = RenderSettings {
+                shading,
+                exposure_scale: 0.7,
+                gamma: 1.8,
+                supersample: 8,
+            };
+            let img = render(&r, &cam, &eb, &vb, &settings, &NoProgress);
+            let film = r.film(&cam, &eb, &vb, shading, 8, &NoProgress);
+            assert_eq!(
+                film.content() == FilmContent::Coverage,
+                shading == Shading::Wireframe
+            );
+            assert_eq!(img, tonemap::to_image(&film, 0.7, 1.8), "{shading:?}");
+        }
     }
 }

@@ -12,14 +12,22 @@
 //!
 //! Surfaces are one-sided: a ray that reaches the back of an element sees black (the back
 //! reflects and emits nothing). A ray that hits nothing sees black.
+//!
+//! [`Renderer::film`] casts the rays of a view, n x n per pixel, in parallel by rows, and
+//! writes what each sees into a linear [`Film`]: radiosity for flat and smooth shading,
+//! line coverage for wireframe. Exposure and gamma come after, in
+//! [`crate::render::tonemap`].
 
 use std::collections::HashMap;
+use std::ops::Range;
 
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
-use super::tonemap::expose;
-use super::RenderSettings;
+use super::film::{sample_offset, Film, FilmContent};
+use super::Camera;
 use crate::mesh::Mesh;
+use crate::progress::{run_stage, Progress, Stage};
 use crate::visibility::PolygonBvh;
 
 /// How the hit element is coloured.
@@ -37,7 +45,7 @@ pub enum Shading {
 /// The mesh of a scene, in a BVH of its elements (one polygon per element, tagged with the
 /// element index), ready to render any number of views.
 pub struct Renderer<'m> {
-    pub(super) mesh: &'m Mesh,
+    mesh: &'m Mesh,
     bvh: PolygonBvh,
     /// Bounding box of all vertices (min, max).
     bounds: (DVec3, DVec3),
@@ -88,16 +96,105 @@ impl<'m> Renderer<'m> {
         self.mesh
     }
 
-    /// The display value (before gamma, in [0, 1] per band) seen along the unit ray
-    /// `eye + t dir`; `footprint` is the angle one pixel subtends (for wireframe lines).
-    pub(super) fn trace(
+    /// The linear film of `camera`'s view, `supersample` x `supersample` rays a pixel (0 is
+    /// treated as 1), before exposure and gamma: turn it into an image with
+    /// [`crate::render::tonemap::to_image`]. `element_b`, `vertex_b` and the progress report
+    /// are as for [`crate::render::render`], which is this followed by the tone map (in
+    /// strips of rows, so that it never holds the samples of a whole large image).
+    ///
+    /// The film holds 24 bytes per sample: `24 n^2 width height` in all.
+    ///
+    /// # Panics
+    /// If `element_b` (or, for smooth shading, `vertex_b`) has the wrong length.
+    pub fn film(
+        &self,
+        camera: &Camera,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        shading: Shading,
+        supersample: u32,
+        progress: &dyn Progress,
+    ) -> Film {
+        self.check_inputs(element_b, vertex_b, shading);
+        let (w, h) = (camera.width as usize, camera.height as usize);
+        let n = supersample.max(1) as usize;
+        if w == 0 || h == 0 {
+            return Film::new(w, h, n, film_content(shading));
+        }
+        run_stage(progress, Stage::Render, h as u64, || {
+            self.film_rows(camera, 0..h, element_b, vertex_b, shading, n, progress)
+        })
+    }
+
+    /// Asserts that there is one radiosity per element and, for smooth shading, one per
+    /// vertex.
+    pub(super) fn check_inputs(
+        &self,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        shading: Shading,
+    ) {
+        assert_eq!(
+            element_b.len(),
+            self.mesh.len(),
+            "one radiosity per element"
+        );
+        if shading == Shading::Smooth {
+            assert_eq!(
+                vertex_b.len(),
+                self.mesh.vertices.len(),
+                "one radiosity per vertex"
+            );
+        }
+    }
+
+    /// The film of the image rows `rows` of `camera`'s view (film row 0 is image row
+    /// `rows.start`), `n` x `n` rays a pixel: the ray loop. Rows are traced in parallel;
+    /// each finished row is reported as `progress.advance(1)`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn film_rows(
+        &self,
+        camera: &Camera,
+        rows: Range<usize>,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        shading: Shading,
+        n: usize,
+        progress: &dyn Progress,
+    ) -> Film {
+        let mut film = Film::new(camera.width as usize, rows.len(), n, film_content(shading));
+        let screen = camera.screen();
+        let footprint = camera.pixel_angle();
+        film.par_rows_mut().for_each(|(r, row)| {
+            let y = rows.start + r;
+            for (x, pixel) in row.chunks_exact_mut(n * n).enumerate() {
+                for j in 0..n {
+                    for i in 0..n {
+                        let sx = x as f64 + sample_offset(i, n);
+                        let sy = y as f64 + sample_offset(j, n);
+                        let dir = camera.direction_in(screen, sx, sy);
+                        pixel[j * n + i] =
+                            self.trace(camera.eye, dir, footprint, element_b, vertex_b, shading);
+                    }
+                }
+            }
+            progress.advance(1);
+        });
+        film
+    }
+
+    /// What the unit ray `eye + t dir` sees: the radiosity of the element it hits first
+    /// (flat), the vertex radiosities interpolated there (smooth), or 1 on an element edge
+    /// and 0 elsewhere (wireframe); 0 for a miss or the back of an element. `footprint` is
+    /// the angle one pixel subtends (for wireframe lines).
+    fn trace(
         &self,
         eye: DVec3,
         dir: DVec3,
         footprint: f64,
         element_b: &[[f64; 3]],
         vertex_b: &[[f64; 3]],
-        settings: &RenderSettings,
+        shading: Shading,
     ) -> [f64; 3] {
         if self.mesh.is_empty() {
             return [0.0; 3];
@@ -113,8 +210,8 @@ impl<'m> Renderer<'m> {
             return [0.0; 3]; // the back of a one-sided surface
         }
         let x = eye + hit.t * dir;
-        match settings.shading {
-            Shading::Flat => expose(element_b[e], settings.exposure_scale),
+        match shading {
+            Shading::Flat => element_b[e],
             Shading::Smooth => {
                 // Interpolation weights of the element's corners at x (no allocation: this
                 // runs once per ray).
@@ -137,7 +234,7 @@ impl<'m> Renderer<'m> {
                         sum[k] += w * b[k];
                     }
                 }
-                expose(sum, settings.exposure_scale)
+                sum
             }
             Shading::Wireframe => {
                 // A shared edge is drawn from both of its elements, half a pixel into each;
@@ -161,6 +258,14 @@ impl<'m> Renderer<'m> {
                 }
             }
         }
+    }
+}
+
+/// The film content a shading mode makes: line coverage for wireframe, else radiosity.
+fn film_content(shading: Shading) -> FilmContent {
+    match shading {
+        Shading::Wireframe => FilmContent::Coverage,
+        Shading::Flat | Shading::Smooth => FilmContent::Radiosity,
     }
 }
 
@@ -267,7 +372,7 @@ mod tests {
     use crate::progress::NoProgress;
     use crate::render::test_support::{cornell_camera, facing_minus_z, px, scene, surface};
     use crate::render::tonemap::tone_map;
-    use crate::render::{render, Camera};
+    use crate::render::{render, RenderSettings};
     use crate::shade::vertex_radiosity;
     use glam::dvec3;
     use image::RgbImage;

@@ -6,8 +6,14 @@
 //! * [`expose`] applies it and clamps;
 //! * [`encode`] (and its table-driven twin [`GammaEncoder`], for images) applies the gamma
 //!   correction and quantises to 8 bits;
-//! * [`tone_map`] is all of it for one colour.
+//! * [`tone_map`] is all of it for one colour;
+//! * [`ToneMap`] (and [`to_image`]) all of it for a [`Film`]: per pixel, each sample exposed
+//!   and clamped, their mean, then gamma and 8 bits.
 
+use image::RgbImage;
+use rayon::prelude::*;
+
+use super::film::{Film, FilmContent};
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 
@@ -132,6 +138,76 @@ pub fn tone_map(value: [f64; 3], scale: f64, gamma: f64) -> [u8; 3] {
     encode(expose(value, scale), gamma)
 }
 
+/// Exposure and gamma for whole films, with the gamma table of [`GammaEncoder`] built once.
+#[derive(Clone, Debug)]
+pub struct ToneMap {
+    exposure_scale: f64,
+    encoder: GammaEncoder,
+}
+
+impl ToneMap {
+    /// Multiplies radiosity by `exposure_scale` (see [`Exposure::scale`]) and corrects for
+    /// `gamma` (not positive and finite: treated as 1, as [`encode`] does).
+    pub fn new(exposure_scale: f64, gamma: f64) -> ToneMap {
+        ToneMap {
+            exposure_scale,
+            encoder: GammaEncoder::new(gamma),
+        }
+    }
+
+    /// The 8-bit colour of a pixel with the film samples `samples`: each sample exposed
+    /// ([`expose`], for a [`FilmContent::Radiosity`] film; coverage is used as it is), the
+    /// samples summed in order and divided by their number, then gamma-encoded.
+    pub fn pixel(&self, samples: &[[f64; 3]], content: FilmContent) -> [u8; 3] {
+        let mut sum = [0.0; 3];
+        for s in samples {
+            let c = match content {
+                FilmContent::Radiosity => expose(*s, self.exposure_scale),
+                FilmContent::Coverage => *s,
+            };
+            for k in 0..3 {
+                sum[k] += c[k];
+            }
+        }
+        let count = samples.len() as f64;
+        self.encoder.encode(sum.map(|s| s / count))
+    }
+
+    /// Writes the 8-bit colours of `film` into `out`, three bytes a pixel, row by row from
+    /// the top-left corner; rows in parallel.
+    ///
+    /// # Panics
+    /// If `out` does not have three bytes per pixel of `film`.
+    pub fn encode_film(&self, film: &Film, out: &mut [u8]) {
+        let (w, n) = (film.width(), film.samples_per_pixel());
+        assert_eq!(out.len(), 3 * w * film.height(), "three bytes per pixel");
+        if out.is_empty() {
+            return;
+        }
+        let content = film.content();
+        out.par_chunks_mut(3 * w)
+            .zip(film.samples().par_chunks(w * n))
+            .for_each(|(row, samples)| {
+                for (rgb, pixel) in row.chunks_exact_mut(3).zip(samples.chunks_exact(n)) {
+                    rgb.copy_from_slice(&self.pixel(pixel, content));
+                }
+            });
+    }
+
+    /// `film` as an 8-bit image.
+    pub fn image(&self, film: &Film) -> RgbImage {
+        let mut buf = vec![0u8; 3 * film.width() * film.height()];
+        self.encode_film(film, &mut buf);
+        RgbImage::from_raw(film.width() as u32, film.height() as u32, buf)
+            .expect("buffer has the image's size")
+    }
+}
+
+/// `film` as an 8-bit image with exposure `exposure_scale` and `gamma`: see [`ToneMap`].
+pub fn to_image(film: &Film, exposure_scale: f64, gamma: f64) -> RgbImage {
+    ToneMap::new(exposure_scale, gamma).image(film)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -205,5 +281,28 @@ mod tests {
         assert_eq!(tone_map([0.128; 3], 0.5, 3.0), [102; 3]);
         // NaN is black; a bad gamma means no correction.
         assert_eq!(tone_map([f64::NAN, 0.2, 0.2], 1.0, 0.0), [0, 51, 51]);
+    }
+
+    #[test]
+    fn films_are_exposed_per_sample_before_the_mean() {
+        // One pixel, 2 x 2 samples: a light (4) and three black samples. Exposed and
+        // clamped first, 1 / 4 of white: 63.75 -> 64 at gamma 1; the mean first would be 1,
+        // white.
+        let mut film = Film::new(1, 1, 2, FilmContent::Radiosity);
+        film.par_rows_mut()
+            .for_each(|(_, row)| row[0] = [4.0, 0.5, 0.0]);
+        let img = to_image(&film, 1.0, 1.0);
+        assert_eq!(img.get_pixel(0, 0).0, [64, 32, 0]);
+        // The exposure scales radiosity: 0.5 * 2 = 1, clamped, over four samples.
+        assert_eq!(to_image(&film, 2.0, 1.0).get_pixel(0, 0).0, [64, 64, 0]);
+        // Wireframe coverage is not scaled by the exposure.
+        let mut lines = Film::new(2, 1, 1, FilmContent::Coverage);
+        lines.par_rows_mut().for_each(|(_, row)| row[1] = [1.0; 3]);
+        let img = to_image(&lines, 0.25, 2.2);
+        assert_eq!(img.get_pixel(0, 0).0, [0; 3]);
+        assert_eq!(img.get_pixel(1, 0).0, [255; 3]);
+        // A film without pixels makes an empty image.
+        let empty = Film::new(0, 3, 1, FilmContent::Radiosity);
+        assert_eq!(to_image(&empty, 1.0, 2.2).dimensions(), (0, 3));
     }
 }
