@@ -502,8 +502,9 @@ mod tests {
         let img = render(&r, &cam, &eb, &[], &settings, &NoProgress);
         assert_eq!(px(&img, 16, 24), [255, 0, 0]); // left half: red
         assert_eq!(px(&img, 48, 24), [0, 255, 0]); // right half: green
-                                                   // Vertical: the quads span y in [100, 450] around the eye height 273, so a row
-                                                   // near the top shows them and the top row (y ~ 556 at z = 0) does not.
+
+        // Vertical: the quads span y in [100, 450] around the eye height 273, so a row
+        // near the top shows them and the top row (y ~ 556 at z = 0) does not.
         assert_eq!(px(&img, 16, 0), [0, 0, 0]);
         assert_eq!(px(&img, 16, 10), [255, 0, 0]);
     }

@@ -47,8 +47,9 @@ impl Camera {
     /// -z face at mid height: `eye = centre - (0, 0, 0.47 dz)`, which sees the far wall
     /// whole and strips of the floor, ceiling and side walls (for the Cornell box, which is
     /// open at -z, this is just inside the opening). A light in the middle of the ceiling is
-    /// out of this view; scenes that want it in view bring a [`CameraHint`]. A flat box (a wall, a floor plan) is seen from
-    /// outside, from -z, at a distance that fits it in the view.
+    /// out of this view; scenes that want it in view bring a [`crate::scene::CameraHint`].
+    /// A flat box (a wall, a floor plan) is seen from outside, from -z, at a distance that
+    /// fits it in the view.
     pub fn framing(scene_bounds: (DVec3, DVec3), width: u32, height: u32) -> Camera {
         let (lo, hi) = scene_bounds;
         let mut cam = Camera {
