@@ -93,11 +93,7 @@ pub fn project(
     other_mesh: &Mesh,
     other: &Radiosity,
 ) -> Result<Radiosity, CompareError> {
-    let polygons: Vec<Vec<glam::DVec3>> = (0..other_mesh.len())
-        .map(|e| other_mesh.corner_positions(e).collect())
-        .collect();
-    let ids: Vec<u32> = (0..other_mesh.len() as u32).collect();
-    let bvh = PolygonBvh::new(&polygons, &ids);
+    let bvh = PolygonBvh::over_elements(other_mesh);
     let delta = 1e-6 * bvh.scale();
     let mut out = Vec::with_capacity(reference_mesh.len());
     let mut points = Vec::new();

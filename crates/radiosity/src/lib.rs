@@ -16,8 +16,9 @@
 //! * [`form_factor`]: form factors F_ij (paper 1.2, 2.3) and their file format (paper 2.8).
 //! * [`light`]: the RGB type of radiosity, emission and reflectance, checked per element.
 //! * [`solve`]: (I - rho F) B = E per band, by LU or Gauss-Seidel (paper figure 6).
-//! * [`shade`]: vertex radiosities, exposure and gamma (paper 2.5, 2.7).
-//! * [`render`]: a CPU ray-cast camera that writes PNG images (paper 2.6).
+//! * [`shade`]: vertex radiosities for smooth shading (paper 2.5).
+//! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7), PNG
+//!   images.
 //! * [`progress`]: the one interface long work reports through.
 //! * [`solution`]: the per-element solution as CSV or JSON.
 //!

@@ -19,6 +19,9 @@ use obvhs::{
     BvhBuildParams,
 };
 
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+
 /// A polygon as the BVH builder sees it: its bounding box.
 struct Bounds(Aabb);
 
@@ -158,6 +161,28 @@ impl PolygonBvh {
             edge_planes,
             scale,
         }
+    }
+
+    /// The hierarchy over every element of `mesh`, each tagged with its element index (the
+    /// BVH that rendering, Monte Carlo form factors and solution comparison cast rays into).
+    pub fn over_elements(mesh: &Mesh) -> PolygonBvh {
+        let polygons: Vec<Vec<DVec3>> = (0..mesh.len())
+            .map(|e| mesh.corner_positions(e).collect())
+            .collect();
+        let ids: Vec<u32> = (0..mesh.len() as u32).collect();
+        PolygonBvh::new(&polygons, &ids)
+    }
+
+    /// The hierarchy over every input surface of `scene`, each tagged with its surface index
+    /// (the occluders of form-factor visibility, and the walls the automatic camera probes).
+    pub fn over_surfaces(scene: &Scene) -> PolygonBvh {
+        let polygons: Vec<&[DVec3]> = scene
+            .surfaces
+            .iter()
+            .map(|s| s.vertices.as_slice())
+            .collect();
+        let ids: Vec<u32> = (0..polygons.len() as u32).collect();
+        PolygonBvh::new(&polygons, &ids)
     }
 
     /// The number of polygons.
@@ -366,5 +391,39 @@ mod tests {
         assert!(bvh
             .closest_hit(dvec3(5.0, 0.5, 3.0), -DVec3::Z, 0.0, 10.0)
             .is_none());
+    }
+
+    #[test]
+    fn element_and_surface_hierarchies_carry_their_indices() {
+        use crate::scene::{MeshSettings, Rgb, Surface};
+        // Two unit squares facing -z at z = 1 and z = 2, the second cut into 4 elements.
+        let surface = |name: &str, z: f64| Surface {
+            name: name.into(),
+            emission: Rgb([0.0; 3]),
+            reflectance: Rgb([0.5; 3]),
+            vertices: square_at_z(z, 0).0.remove(0).into_iter().rev().collect(),
+        };
+        let scene = Scene {
+            settings: MeshSettings {
+                max_patch_area: 1.0,
+                integral_steps: 1,
+            },
+            surfaces: vec![surface("near", 1.0), surface("far", 2.0)],
+            camera: None,
+        };
+        let surfaces = PolygonBvh::over_surfaces(&scene);
+        assert_eq!(surfaces.len(), 2);
+        let hit = surfaces
+            .closest_hit(dvec3(0.25, 0.5, 1.5), DVec3::Z, 0.0, 10.0)
+            .unwrap();
+        assert_eq!(hit.id, 1);
+        let mesh = crate::mesh::mesh_scene(&scene, 0.3).unwrap();
+        let elements = PolygonBvh::over_elements(&mesh);
+        assert_eq!(elements.len(), mesh.len());
+        for (e, el) in mesh.elements.iter().enumerate() {
+            let origin = el.centroid - 0.5 * DVec3::Z;
+            let hit = elements.closest_hit(origin, DVec3::Z, 0.0, 10.0).unwrap();
+            assert_eq!(hit.id as usize, e);
+        }
     }
 }

@@ -21,7 +21,6 @@ pub use file::{
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::mesh::Mesh;
@@ -322,13 +321,7 @@ pub struct FormFactorContext<'a> {
 
 /// Builds the occluder BVH of a scene: every input surface, tagged with its surface index.
 pub fn occluder_bvh(scene: &Scene) -> PolygonBvh {
-    let polygons: Vec<&[DVec3]> = scene
-        .surfaces
-        .iter()
-        .map(|s| s.vertices.as_slice())
-        .collect();
-    let ids: Vec<u32> = (0..polygons.len() as u32).collect();
-    PolygonBvh::new(&polygons, &ids)
+    PolygonBvh::over_surfaces(scene)
 }
 
 /// Counts the rays cast, for rays-per-second figures.
@@ -396,18 +389,11 @@ impl<'a> Engine<'a> {
             FormFactorMethod::Hemicube { resolution } => {
                 Engine::Hemicube(hemicube::Hemicube::new(resolution))
             }
-            FormFactorMethod::MonteCarlo { samples, seed } => {
-                let mesh = ctx.mesh;
-                let polygons: Vec<Vec<DVec3>> = (0..mesh.len())
-                    .map(|e| mesh.corner_positions(e).collect())
-                    .collect();
-                let ids: Vec<u32> = (0..mesh.len() as u32).collect();
-                Engine::MonteCarlo {
-                    elements: PolygonBvh::new(&polygons, &ids),
-                    samples,
-                    seed,
-                }
-            }
+            FormFactorMethod::MonteCarlo { samples, seed } => Engine::MonteCarlo {
+                elements: PolygonBvh::over_elements(ctx.mesh),
+                samples,
+                seed,
+            },
         }
     }
 

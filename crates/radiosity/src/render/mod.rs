@@ -1,0 +1,244 @@
+//! A CPU ray-casting camera that turns a radiosity solution into an image (paper section
+//! 2.6, "Walkthrough Ability", and the plates of Appendix B).
+//!
+//! Radiosity is view-independent: once element radiosities are known, any [`Camera`] can
+//! look at the scene without solving again. The paper draws the patches with OpenGL; here
+//! each pixel casts a ray into a BVH of the mesh's elements ([`Renderer`]) and colours it by
+//! the element it hits first, in one of the paper's three display modes ([`Shading`]).
+//!
+//! * `camera`: the pinhole [`Camera`] and its automatic placement ([`Camera::for_scene`]).
+//! * `renderer`: the element BVH, what a ray sees ([`Shading`]), the interpolation weights
+//!   of smooth shading ([`inverse_bilinear`], [`barycentric`]), and the ray loop that
+//!   writes a view into a [`Film`] ([`Renderer::film`]).
+//! * `film`: the linear film: f64 values per ray sample, no exposure or gamma yet.
+//! * [`tonemap`]: exposure, the paper's gamma correction (section 2.7) and 8-bit encoding,
+//!   from a film to an image.
+//! * [`render`] (here): film then tone map, the one call the CLI makes; and [`write_png`].
+//!
+//! Rows are rendered in parallel with rayon; each finished row is reported to the
+//! [`Progress`] sink as one unit of [`Stage::Render`].
+
+use std::io;
+use std::path::Path;
+
+use image::RgbImage;
+
+use crate::progress::{run_stage, Progress, Stage};
+use tonemap::ToneMap;
+
+mod camera;
+mod film;
+mod renderer;
+#[cfg(test)]
+mod test_support;
+pub mod tonemap;
+
+pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
+pub use film::{sample_offset, Film, FilmContent};
+pub use renderer::{barycentric, inverse_bilinear, Renderer, Shading};
+
+/// Everything about how to render except the camera and the radiosities.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// The display mode.
+    pub shading: Shading,
+    /// Radiosities are multiplied by this before clamping to [0, 1] (see
+    /// [`tonemap::Exposure::scale`]).
+    pub exposure_scale: f64,
+    /// Gamma factor of paper 2.7: display = value^(1 / gamma). 1 means no correction.
+    pub gamma: f64,
+    /// Antialiasing: each pixel is the mean of n x n rays on a regular grid inside it
+    /// (averaged before gamma). 1 (the default) casts one ray through the pixel centre;
+    /// 0 is treated as 1.
+    pub supersample: u32,
+}
+
+impl Default for RenderSettings {
+    /// Smooth shading, exposure 1, gamma 2.2, no supersampling.
+    fn default() -> Self {
+        RenderSettings {
+            shading: Shading::Smooth,
+            exposure_scale: 1.0,
+            gamma: 2.2,
+            supersample: 1,
+        }
+    }
+}
+
+/// At most this many film samples (48 MiB of them) are held at once by [`render`], which
+/// traces and tone-maps a large or heavily supersampled image in strips of rows.
+const STRIP_SAMPLES: usize = 1 << 21;
+
+/// Renders the view of `camera` into a `camera.width` x `camera.height` image.
+///
+/// `element_b` holds one radiosity per element of the renderer's mesh; `vertex_b` one per
+/// mesh vertex (from [`crate::shade::vertex_radiosity`]) and is read only for
+/// [`Shading::Smooth`] (it may be empty otherwise). Rows are rendered in parallel; the work
+/// is reported as [`Stage::Render`] with one `advance(1)` per finished row. An image with
+/// no pixels is returned at once.
+///
+/// The rays write a linear [`Film`] ([`Renderer::film`]), which [`tonemap::ToneMap`] turns
+/// into 8-bit colour: per pixel, each sample exposed and clamped, the mean, then gamma.
+///
+/// # Panics
+/// If `element_b` (or, for smooth shading, `vertex_b`) has the wrong length.
+pub fn render(
+    renderer: &Renderer,
+    camera: &Camera,
+    element_b: &[[f64; 3]],
+    vertex_b: &[[f64; 3]],
+    settings: &RenderSettings,
+    progress: &dyn Progress,
+) -> RgbImage {
+    renderer.check_inputs(element_b, vertex_b, settings.shading);
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    if w == 0 || h == 0 {
+        return RgbImage::new(camera.width, camera.height);
+    }
+    let n = settings.supersample.max(1) as usize;
+    let tone = ToneMap::new(settings.exposure_scale, settings.gamma);
+    let strip = (STRIP_SAMPLES / (w * n * n)).max(1);
+    let mut buf = vec![0u8; w * h * 3];
+    run_stage(progress, Stage::Render, h as u64, || {
+        for (k, out) in buf.chunks_mut(strip * w * 3).enumerate() {
+            let rows = k * strip..k * strip + out.len() / (w * 3);
+            let film = renderer.film_rows(
+                camera,
+                rows,
+                element_b,
+                vertex_b,
+                settings.shading,
+                n,
+                progress,
+            );
+            tone.encode_film(&film, out);
+        }
+    });
+    RgbImage::from_raw(camera.width, camera.height, buf).expect("buffer has the image's size")
+}
+
+/// Writes `image` as a PNG file at `path`, atomically (a temporary file beside it, then a
+/// rename; see [`crate::write_atomically`]).
+pub fn write_png(image: &RgbImage, path: &Path) -> io::Result<()> {
+    use image::ImageEncoder;
+    crate::write_atomically(path, |w| {
+        image::codecs::png::PngEncoder::new(w)
+            .write_image(
+                image.as_raw(),
+                image.width(),
+                image.height(),
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(io::Error::other)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::mesh_scene;
+    use crate::progress::NoProgress;
+    use crate::render::test_support::{facing_minus_z, px, scene, surface};
+    use glam::{dvec3, DVec3};
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    struct Count(AtomicU64, AtomicU64);
+    impl Progress for Count {
+        fn start(&self, stage: Stage, total: u64) {
+            assert_eq!(stage, Stage::Render);
+            self.0.store(total, Ordering::SeqCst);
+        }
+        fn advance(&self, done: u64) {
+            self.1.fetch_add(done, Ordering::SeqCst);
+        }
+        fn finish(&self, _: Stage, _: std::time::Duration) {}
+    }
+
+    #[test]
+    fn progress_counts_rows_and_png_round_trips() {
+        let s = scene(vec![surface(
+            "a",
+            0.0,
+            facing_minus_z(-1., 1., -1., 1., 0.),
+        )]);
+        let mesh = mesh_scene(&s, 1.0).unwrap();
+        let eb = vec![[0.2, 0.4, 0.6]; mesh.len()];
+        let r = Renderer::new(&mesh);
+        let cam = Camera {
+            eye: dvec3(0., 0., -3.),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 50.0,
+            width: 13,
+            height: 7,
+        };
+        let count = Count(AtomicU64::new(0), AtomicU64::new(0));
+        let settings = RenderSettings {
+            shading: Shading::Flat,
+            gamma: 1.0,
+            ..RenderSettings::default()
+        };
+        let img = render(&r, &cam, &eb, &[], &settings, &count);
+        assert_eq!(img.dimensions(), (13, 7));
+        assert_eq!(count.0.load(Ordering::SeqCst), 7);
+        assert_eq!(count.1.load(Ordering::SeqCst), 7);
+        assert_eq!(px(&img, 6, 3), [51, 102, 153]);
+        let dir = std::env::temp_dir().join(format!("radiosity-png-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("view.png");
+        write_png(&img, &path).unwrap();
+        let back = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(back, img);
+        std::fs::remove_dir_all(&dir).unwrap();
+        // Zero-sized requests give empty images.
+        let empty = render(
+            &r,
+            &Camera { width: 0, ..cam },
+            &eb,
+            &[],
+            &settings,
+            &NoProgress,
+        );
+        assert_eq!(empty.dimensions(), (0, 7));
+    }
+
+    #[test]
+    fn render_is_the_tone_mapped_film_in_strips() {
+        // A light above a floor, 200 x 200 pixels of 8 x 8 samples: 2.56 M samples, which
+        // render() traces in two strips; the image must be the whole film's tone map.
+        let s = scene(vec![
+            surface("floor", 0.0, facing_minus_z(-1., 1., -1., 1., 0.)),
+            surface("light", 5.0, facing_minus_z(-0.3, 0.3, -0.3, 0.3, -0.5)),
+        ]);
+        let mesh = mesh_scene(&s, 0.1).unwrap();
+        let eb: Vec<[f64; 3]> = (0..mesh.len())
+            .map(|e| [0.1 + 0.01 * e as f64, 0.5, 5.0 * (e % 3) as f64])
+            .collect();
+        let vb = crate::shade::vertex_radiosity(&mesh, &eb);
+        let r = Renderer::new(&mesh);
+        let cam = Camera {
+            eye: dvec3(0.1, 0.2, -3.),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 45.0,
+            width: 200,
+            height: 200,
+        };
+        assert!(200 * 200 * 64 > STRIP_SAMPLES && 200 * 64 < STRIP_SAMPLES);
+        for shading in [Shading::Smooth, Shading::Flat, Shading::Wireframe] {
+            let settings = RenderSettings {
+                shading,
+                exposure_scale: 0.7,
+                gamma: 1.8,
+                supersample: 8,
+            };
+            let img = render(&r, &cam, &eb, &vb, &settings, &NoProgress);
+            let film = r.film(&cam, &eb, &vb, shading, 8, &NoProgress);
+            assert_eq!(
+                film.content() == FilmContent::Coverage,
+                shading == Shading::Wireframe
+            );
+            assert_eq!(img, tonemap::to_image(&film, 0.7, 1.8), "{shading:?}");
+        }
+    }
+}

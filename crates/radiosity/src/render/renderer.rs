@@ -1,0 +1,607 @@
+//! The ray caster: a BVH of the mesh's elements ([`Renderer`]) that colours the element a
+//! ray hits first in one of the paper's three display modes ([`Shading`]):
+//!
+//! * [`Shading::Flat`] (plate 1): every element in its own radiosity.
+//! * [`Shading::Smooth`] (plate 2, section 2.5): the vertex radiosities of
+//!   [`crate::shade::vertex_radiosity`] interpolated across the element, bilinearly on a
+//!   quadrilateral (as OpenGL's Gouraud shading of a quad approximates, [`inverse_bilinear`])
+//!   and barycentrically on a triangle ([`barycentric`]).
+//! * [`Shading::Wireframe`] (plate 4): element edges as white lines about one pixel wide
+//!   on black. Unlike the paper's OpenGL line mode, hidden lines are removed (only edges of
+//!   the element a ray hits first are drawn).
+//!
+//! Surfaces are one-sided: a ray that reaches the back of an element sees black (the back
+//! reflects and emits nothing). A ray that hits nothing sees black.
+//!
+//! [`Renderer::film`] casts the rays of a view, n x n per pixel, in parallel by rows, and
+//! writes what each sees into a linear [`Film`]: radiosity for flat and smooth shading,
+//! line coverage for wireframe. Exposure and gamma come after, in
+//! [`crate::render::tonemap`].
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use super::film::{sample_offset, Film, FilmContent};
+use super::Camera;
+use crate::mesh::Mesh;
+use crate::progress::{run_stage, Progress, Stage};
+use crate::visibility::PolygonBvh;
+
+/// How the hit element is coloured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Shading {
+    /// Vertex radiosities interpolated across each element (paper 2.5, plate 2).
+    #[default]
+    Smooth,
+    /// Each element in its own radiosity (plate 1).
+    Flat,
+    /// White element edges on black, hidden lines removed (plate 4).
+    Wireframe,
+}
+
+/// The mesh of a scene, in a BVH of its elements (one polygon per element, tagged with the
+/// element index), ready to render any number of views.
+pub struct Renderer<'m> {
+    mesh: &'m Mesh,
+    bvh: PolygonBvh,
+    /// Bounding box of all vertices (min, max).
+    bounds: (DVec3, DVec3),
+    /// Per element, bit i set when edge i (corner i to corner i + 1) is on the boundary of
+    /// its surface (no other element shares it).
+    boundary_edges: Vec<u8>,
+}
+
+impl<'m> Renderer<'m> {
+    /// Builds the element BVH of `mesh`.
+    pub fn new(mesh: &'m Mesh) -> Renderer<'m> {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for v in &mesh.vertices {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        let edge = |el: &crate::mesh::Element, i: usize| {
+            let c = el.corners();
+            let (a, b) = (c[i], c[(i + 1) % c.len()]);
+            (a.min(b), a.max(b))
+        };
+        let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+        for el in &mesh.elements {
+            for i in 0..el.corners().len() {
+                *uses.entry(edge(el, i)).or_default() += 1;
+            }
+        }
+        let boundary_edges = mesh
+            .elements
+            .iter()
+            .map(|el| {
+                (0..el.corners().len())
+                    .filter(|&i| uses[&edge(el, i)] == 1)
+                    .fold(0u8, |m, i| m | (1 << i))
+            })
+            .collect();
+        Renderer {
+            mesh,
+            bvh: PolygonBvh::over_elements(mesh),
+            bounds: (lo, hi),
+            boundary_edges,
+        }
+    }
+
+    /// The mesh being rendered.
+    pub fn mesh(&self) -> &'m Mesh {
+        self.mesh
+    }
+
+    /// The linear film of `camera`'s view, `supersample` x `supersample` rays a pixel (0 is
+    /// treated as 1), before exposure and gamma: turn it into an image with
+    /// [`crate::render::tonemap::to_image`]. `element_b`, `vertex_b` and the progress report
+    /// are as for [`crate::render::render`], which is this followed by the tone map (in
+    /// strips of rows, so that it never holds the samples of a whole large image).
+    ///
+    /// The film holds 24 bytes per sample: `24 n^2 width height` in all.
+    ///
+    /// # Panics
+    /// If `element_b` (or, for smooth shading, `vertex_b`) has the wrong length.
+    pub fn film(
+        &self,
+        camera: &Camera,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        shading: Shading,
+        supersample: u32,
+        progress: &dyn Progress,
+    ) -> Film {
+        self.check_inputs(element_b, vertex_b, shading);
+        let (w, h) = (camera.width as usize, camera.height as usize);
+        let n = supersample.max(1) as usize;
+        if w == 0 || h == 0 {
+            return Film::new(w, h, n, film_content(shading));
+        }
+        run_stage(progress, Stage::Render, h as u64, || {
+            self.film_rows(camera, 0..h, element_b, vertex_b, shading, n, progress)
+        })
+    }
+
+    /// Asserts that there is one radiosity per element and, for smooth shading, one per
+    /// vertex.
+    pub(super) fn check_inputs(
+        &self,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        shading: Shading,
+    ) {
+        assert_eq!(
+            element_b.len(),
+            self.mesh.len(),
+            "one radiosity per element"
+        );
+        if shading == Shading::Smooth {
+            assert_eq!(
+                vertex_b.len(),
+                self.mesh.vertices.len(),
+                "one radiosity per vertex"
+            );
+        }
+    }
+
+    /// The film of the image rows `rows` of `camera`'s view (film row 0 is image row
+    /// `rows.start`), `n` x `n` rays a pixel: the ray loop. Rows are traced in parallel;
+    /// each finished row is reported as `progress.advance(1)`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn film_rows(
+        &self,
+        camera: &Camera,
+        rows: Range<usize>,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        shading: Shading,
+        n: usize,
+        progress: &dyn Progress,
+    ) -> Film {
+        let mut film = Film::new(camera.width as usize, rows.len(), n, film_content(shading));
+        let screen = camera.screen();
+        let footprint = camera.pixel_angle();
+        film.par_rows_mut().for_each(|(r, row)| {
+            let y = rows.start + r;
+            for (x, pixel) in row.chunks_exact_mut(n * n).enumerate() {
+                for j in 0..n {
+                    for i in 0..n {
+                        let sx = x as f64 + sample_offset(i, n);
+                        let sy = y as f64 + sample_offset(j, n);
+                        let dir = camera.direction_in(screen, sx, sy);
+                        pixel[j * n + i] =
+                            self.trace(camera.eye, dir, footprint, element_b, vertex_b, shading);
+                    }
+                }
+            }
+            progress.advance(1);
+        });
+        film
+    }
+
+    /// What the unit ray `eye + t dir` sees: the radiosity of the element it hits first
+    /// (flat), the vertex radiosities interpolated there (smooth), or 1 on an element edge
+    /// and 0 elsewhere (wireframe); 0 for a miss or the back of an element. `footprint` is
+    /// the angle one pixel subtends (for wireframe lines).
+    fn trace(
+        &self,
+        eye: DVec3,
+        dir: DVec3,
+        footprint: f64,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        shading: Shading,
+    ) -> [f64; 3] {
+        if self.mesh.is_empty() {
+            return [0.0; 3];
+        }
+        let (lo, hi) = self.bounds;
+        let t_max = (eye - 0.5 * (lo + hi)).length() + (hi - lo).length() + 1.0;
+        let Some(hit) = self.bvh.closest_hit(eye, dir, 0.0, t_max) else {
+            return [0.0; 3];
+        };
+        let e = hit.id as usize;
+        let el = &self.mesh.elements[e];
+        if el.normal.dot(dir) >= 0.0 {
+            return [0.0; 3]; // the back of a one-sided surface
+        }
+        let x = eye + hit.t * dir;
+        match shading {
+            Shading::Flat => element_b[e],
+            Shading::Smooth => {
+                // Interpolation weights of the element's corners at x (no allocation: this
+                // runs once per ray).
+                let c = el.corners();
+                let mut p = [DVec3::ZERO; 4];
+                for (slot, v) in p.iter_mut().zip(self.mesh.corner_positions(e)) {
+                    *slot = v;
+                }
+                let weights: [f64; 4] = if el.is_quad() {
+                    let (u, v) = inverse_bilinear(&p, x);
+                    [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v]
+                } else {
+                    let w = barycentric(&p[..3], x);
+                    [w[0], w[1], w[2], 0.0]
+                };
+                let mut sum = [0.0; 3];
+                for (i, &w) in weights.iter().enumerate().take(c.len()) {
+                    let b = vertex_b[c[i] as usize];
+                    for k in 0..3 {
+                        sum[k] += w * b[k];
+                    }
+                }
+                sum
+            }
+            Shading::Wireframe => {
+                // A shared edge is drawn from both of its elements, half a pixel into each;
+                // a surface's boundary edge from its one element, a whole pixel in. The
+                // distance to an edge is measured as seen from the eye: the part across
+                // the ray of the in-plane offset perpendicular to the edge.
+                let pixel = hit.t * footprint;
+                let p: Vec<DVec3> = self.mesh.corner_positions(e).collect();
+                let boundary = self.boundary_edges[e];
+                let near_edge = (0..p.len()).any(|i| {
+                    let (a, b) = (p[i], p[(i + 1) % p.len()]);
+                    let across = (b - a).cross(el.normal).normalize_or_zero();
+                    let seen = (1.0 - across.dot(dir).powi(2)).max(0.0).sqrt();
+                    let half_width = if boundary & (1 << i) != 0 { 1.0 } else { 0.5 };
+                    segment_distance(x, a, b) * seen <= half_width * pixel
+                });
+                if near_edge {
+                    [1.0; 3]
+                } else {
+                    [0.0; 3]
+                }
+            }
+        }
+    }
+}
+
+/// The film content a shading mode makes: line coverage for wireframe, else radiosity.
+fn film_content(shading: Shading) -> FilmContent {
+    match shading {
+        Shading::Wireframe => FilmContent::Coverage,
+        Shading::Flat | Shading::Smooth => FilmContent::Radiosity,
+    }
+}
+
+/// The distance from `x` to the segment from `a` to `b`.
+fn segment_distance(x: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let s = if len2 > 0.0 {
+        ((x - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (x - (a + s * ab)).length()
+}
+
+/// The parameters (u, v) in [0, 1]^2 at which the bilinear patch with corners `q`
+/// (see [`crate::mesh::bilinear`]) passes through `p`, for `p` on or near the patch of a
+/// planar convex quadrilateral. Inverse of [`crate::mesh::bilinear`].
+///
+/// The quadrilateral and `p` are projected to the coordinate plane the quad is most nearly
+/// parallel to; v solves the quadratic `k2 v^2 + k1 v + k0 = 0` (with the cancellation-free
+/// root formula, and the linear case of a parallelogram handled by the same formula), the
+/// root nearest [0, 1] is taken, and u follows by least squares. The result is clamped to
+/// [0, 1]^2, so a point just outside the quad maps to its edge.
+pub fn inverse_bilinear(q: &[DVec3], p: DVec3) -> (f64, f64) {
+    let n = crate::geometry::area_vector(q).abs();
+    let flat = |v: DVec3| -> DVec2 {
+        if n.x >= n.y && n.x >= n.z {
+            DVec2::new(v.y, v.z)
+        } else if n.y >= n.z {
+            DVec2::new(v.z, v.x)
+        } else {
+            DVec2::new(v.x, v.y)
+        }
+    };
+    let [a, b, c, d] = [flat(q[0]), flat(q[1]), flat(q[2]), flat(q[3])];
+    let h = flat(p) - a;
+    let e = b - a;
+    let f = d - a;
+    let g = a - b + c - d;
+    let cross = |x: DVec2, y: DVec2| x.x * y.y - x.y * y.x;
+    let k2 = cross(g, f);
+    let k1 = cross(e, f) + cross(h, g);
+    let k0 = cross(h, e);
+    let disc = (k1 * k1 - 4.0 * k0 * k2).max(0.0);
+    let qq = -0.5 * (k1 + disc.sqrt().copysign(k1));
+    let distance_to_unit = |t: f64| {
+        if t < 0.0 {
+            -t
+        } else if t > 1.0 {
+            t - 1.0
+        } else {
+            0.0
+        }
+    };
+    let mut v = 0.5;
+    let mut best = f64::INFINITY;
+    for root in [(qq != 0.0).then(|| k0 / qq), (k2 != 0.0).then(|| qq / k2)]
+        .into_iter()
+        .flatten()
+    {
+        let dist = distance_to_unit(root);
+        if root.is_finite() && dist < best {
+            best = dist;
+            v = root;
+        }
+    }
+    let along = e + g * v;
+    let len2 = along.length_squared();
+    let u = if len2 > 0.0 {
+        (h - f * v).dot(along) / len2
+    } else {
+        0.5
+    };
+    (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0))
+}
+
+/// The barycentric weights of `p` in triangle `t` (p = w0 t0 + w1 t1 + w2 t2 for p in the
+/// triangle's plane), clamped to be non-negative and renormalised to sum to 1, so a point
+/// just outside maps to the nearest edge.
+pub fn barycentric(t: &[DVec3], p: DVec3) -> [f64; 3] {
+    let (v0, v1, v2) = (t[1] - t[0], t[2] - t[0], p - t[0]);
+    let (d00, d01, d11) = (v0.dot(v0), v0.dot(v1), v1.dot(v1));
+    let (d20, d21) = (v2.dot(v0), v2.dot(v1));
+    let denom = d00 * d11 - d01 * d01;
+    if denom == 0.0 {
+        return [1.0 / 3.0; 3];
+    }
+    let w1 = (d11 * d20 - d01 * d21) / denom;
+    let w2 = (d00 * d21 - d01 * d20) / denom;
+    let w = [(1.0 - w1 - w2).max(0.0), w1.max(0.0), w2.max(0.0)];
+    let s = w[0] + w[1] + w[2];
+    if s > 0.0 {
+        w.map(|x| x / s)
+    } else {
+        [1.0 / 3.0; 3]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{bilinear, mesh_scene};
+    use crate::progress::NoProgress;
+    use crate::render::test_support::{cornell_camera, facing_minus_z, px, scene, surface};
+    use crate::render::tonemap::tone_map;
+    use crate::render::{render, RenderSettings};
+    use crate::shade::vertex_radiosity;
+    use glam::dvec3;
+    use image::RgbImage;
+
+    #[test]
+    fn inverse_bilinear_round_trips() {
+        let quads = [
+            // A unit square, a trapezoid, a general convex quad, tilted out of any axis plane.
+            vec![
+                dvec3(0., 0., 0.),
+                dvec3(1., 0., 0.),
+                dvec3(1., 1., 0.),
+                dvec3(0., 1., 0.),
+            ],
+            vec![
+                dvec3(0., 0., 0.),
+                dvec3(10., 0., 0.),
+                dvec3(7., 3., 0.),
+                dvec3(2., 3., 0.),
+            ],
+            vec![
+                dvec3(0., 0., 0.),
+                dvec3(4., 0.5, 0.),
+                dvec3(5., 4., 0.),
+                dvec3(-1., 2., 0.),
+            ],
+        ];
+        let tilt = |p: DVec3| dvec3(p.x, 0.6 * p.y + 0.8 * p.z, -0.8 * p.y + 0.6 * p.z + 7.0);
+        for q in &quads {
+            for q in [q.clone(), q.iter().map(|&p| tilt(p)).collect::<Vec<_>>()] {
+                for j in 0..=10 {
+                    for i in 0..=10 {
+                        let (u, v) = (i as f64 / 10.0, j as f64 / 10.0);
+                        let (u2, v2) = inverse_bilinear(&q, bilinear(&q, u, v));
+                        assert!(
+                            (u - u2).abs() < 1e-9 && (v - v2).abs() < 1e-9,
+                            "({u}, {v}) -> ({u2}, {v2}) on {q:?}"
+                        );
+                    }
+                }
+            }
+        }
+        // Outside points clamp onto the quad.
+        let (u, v) = inverse_bilinear(&quads[0], dvec3(1.5, -0.5, 0.0));
+        assert_eq!((u, v), (1.0, 0.0));
+    }
+
+    #[test]
+    fn barycentric_weights() {
+        let t = [dvec3(0., 0., 1.), dvec3(2., 0., 1.), dvec3(0., 4., 1.)];
+        let w = barycentric(&t, dvec3(0.5, 1.0, 1.0));
+        // p = t0 + 0.25 (t1 - t0) + 0.25 (t2 - t0).
+        for (a, b) in w.iter().zip([0.5, 0.25, 0.25]) {
+            assert!((a - b).abs() < 1e-15);
+        }
+        assert_eq!(barycentric(&t, dvec3(-1., -1., 1.)), [1.0, 0.0, 0.0]);
+    }
+
+    /// A 2 x 2 quad facing -z seen head-on from (0, 0, -4).
+    fn head_on(shading: Shading, b: [f64; 3], gamma: f64) -> (RgbImage, RgbImage) {
+        let s = scene(vec![surface(
+            "light",
+            1.0,
+            facing_minus_z(-1., 1., -1., 1., 0.),
+        )]);
+        let mesh = mesh_scene(&s, 0.3).unwrap();
+        assert_eq!(mesh.len(), 16); // 4 x 4 elements of 0.5 x 0.5
+        let eb = vec![b; mesh.len()];
+        let vb = vertex_radiosity(&mesh, &eb);
+        let r = Renderer::new(&mesh);
+        let settings = RenderSettings {
+            shading,
+            exposure_scale: 1.0,
+            gamma,
+            supersample: 1,
+        };
+        let mut cam = Camera {
+            eye: dvec3(0., 0., -4.),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+            width: 41,
+            height: 31,
+        };
+        let front = render(&r, &cam, &eb, &vb, &settings, &NoProgress);
+        cam.eye = dvec3(0., 0., 4.);
+        let back = render(&r, &cam, &eb, &vb, &settings, &NoProgress);
+        (front, back)
+    }
+
+    #[test]
+    fn emitter_seen_head_on() {
+        // 0.25^(1/2) = 0.5 -> 128, 0.0625^(1/2) = 0.25 -> 63.75 -> 64, 0.04^(1/2) = 0.2 -> 51.
+        let (img, back) = head_on(Shading::Flat, [0.25, 0.0625, 0.04], 2.0);
+        assert_eq!(img.dimensions(), (41, 31));
+        assert_eq!(px(&img, 20, 15), [128, 64, 51]);
+        // A corner of the view misses the quad (it spans 2 * 4 tan 20 = 2.9 units): black.
+        assert_eq!(px(&img, 0, 0), [0, 0, 0]);
+        // Seen from behind, the one-sided quad is black.
+        assert_eq!(px(&back, 20, 15), [0, 0, 0]);
+        // Smooth shading of a uniform field gives the same image as flat shading.
+        for b in [[0.3, 0.6, 0.9], [0.1, 0.02, 0.7]] {
+            let (flat, _) = head_on(Shading::Flat, b, 2.2);
+            let (smooth, _) = head_on(Shading::Smooth, b, 2.2);
+            assert_eq!(flat, smooth);
+            assert_eq!(px(&flat, 20, 15), tone_map(b, 1.0, 2.2));
+        }
+    }
+
+    #[test]
+    fn colours_land_on_the_correct_side() {
+        // Red on the x > 278 side, green on the x < 278 side, seen by the Cornell camera;
+        // the top half of each quad is brighter.
+        let s = scene(vec![
+            surface("red", 0.0, facing_minus_z(300., 500., 100., 450., 0.)),
+            surface("green", 0.0, facing_minus_z(56., 256., 100., 450., 0.)),
+        ]);
+        let mesh = mesh_scene(&s, 1e9).unwrap();
+        assert_eq!(mesh.len(), 2);
+        let eb = vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let r = Renderer::new(&mesh);
+        let settings = RenderSettings {
+            shading: Shading::Flat,
+            ..RenderSettings::default()
+        };
+        let cam = cornell_camera(64, 48);
+        let img = render(&r, &cam, &eb, &[], &settings, &NoProgress);
+        assert_eq!(px(&img, 16, 24), [255, 0, 0]); // left half: red
+        assert_eq!(px(&img, 48, 24), [0, 255, 0]); // right half: green
+
+        // Vertical: the quads span y in [100, 450] around the eye height 273, so a row
+        // near the top shows them and the top row (y ~ 556 at z = 0) does not.
+        assert_eq!(px(&img, 16, 0), [0, 0, 0]);
+        assert_eq!(px(&img, 16, 10), [255, 0, 0]);
+    }
+
+    #[test]
+    fn no_seams_between_elements() {
+        // An 8 x 8 grid of unit elements on [-4, 4]^2; from (0, 0, -4.5) with a 90 degree
+        // view, a 9 x 9 image puts every pixel-centre ray exactly through x, y in
+        // {-4, ..., 4}: through element edges, corners and the surface's boundary.
+        let s = scene(vec![surface(
+            "plane",
+            0.0,
+            facing_minus_z(-4., 4., -4., 4., 0.),
+        )]);
+        let mesh = mesh_scene(&s, 1.0).unwrap();
+        assert_eq!(mesh.len(), 64);
+        let eb = vec![[0.5; 3]; mesh.len()];
+        let vb = vertex_radiosity(&mesh, &eb);
+        let r = Renderer::new(&mesh);
+        let cam = Camera {
+            eye: dvec3(0., 0., -4.5),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 90.0,
+            width: 9,
+            height: 9,
+        };
+        for shading in [Shading::Smooth, Shading::Flat] {
+            let settings = RenderSettings {
+                shading,
+                gamma: 1.0,
+                ..RenderSettings::default()
+            };
+            let img = render(&r, &cam, &eb, &vb, &settings, &NoProgress);
+            for (x, y, p) in img.enumerate_pixels() {
+                // 0.5 * 255 = 127.5 -> 128 (127 allowed for rounding in the interpolation).
+                assert!(p.0[0] >= 127, "{shading:?}: pixel ({x}, {y}) is {:?}", p.0);
+            }
+        }
+        // A subdivided pentagon (triangle elements), with 3 x 3 supersampling: every
+        // sample whose ray meets the pentagon's interior is lit, so pixels well inside
+        // are fully lit.
+        let pent: Vec<DVec3> = (0..5)
+            .map(|i| {
+                let a = -(i as f64) * std::f64::consts::TAU / 5.0;
+                dvec3(4.0 * a.cos(), 4.0 * a.sin(), 0.0)
+            })
+            .collect();
+        let s = scene(vec![surface("pentagon", 0.0, pent)]);
+        let mesh = mesh_scene(&s, 0.2).unwrap();
+        let eb = vec![[1.0; 3]; mesh.len()];
+        let vb = vertex_radiosity(&mesh, &eb);
+        let r = Renderer::new(&mesh);
+        let cam = Camera {
+            width: 63,
+            height: 63,
+            ..cam
+        };
+        let settings = RenderSettings {
+            supersample: 3,
+            gamma: 1.0,
+            ..RenderSettings::default()
+        };
+        let img = render(&r, &cam, &eb, &vb, &settings, &NoProgress);
+        let inner_radius = 4.0 * (std::f64::consts::PI / 5.0).cos() - 0.3;
+        for (x, y, p) in img.enumerate_pixels() {
+            // Pixel centre in the plane: 9 units across 63 pixels, x mirrored.
+            let wx = -(x as f64 + 0.5 - 31.5) * 9.0 / 63.0;
+            let wy = -(y as f64 + 0.5 - 31.5) * 9.0 / 63.0;
+            if wx.hypot(wy) < inner_radius {
+                assert_eq!(p.0, [255; 3], "pixel ({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn wireframe_draws_edges() {
+        // A 4 x 4 grid on [-1, 1]^2 seen head-on; the 41 x 31 image puts pixel (20, 15)
+        // on the vertex (0, 0).
+        let (img, _) = head_on(Shading::Wireframe, [0.5; 3], 1.0);
+        assert_eq!(px(&img, 20, 15), [255; 3]); // centre: the crossing of the edges
+        let cam = Camera {
+            eye: dvec3(0., 0., -4.),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+            width: 41,
+            height: 31,
+        };
+        // The middle of an element (0.25, 0.25) is dark; the image's corner (no hit) too.
+        let (x, y) = cam.project(dvec3(0.25, 0.25, 0.)).unwrap();
+        assert_eq!(px(&img, x as u32, y as u32), [0; 3]);
+        assert_eq!(px(&img, 0, 0), [0; 3]);
+        // The quad's boundary x = 1 is drawn.
+        let (x, y) = cam.project(dvec3(1.0, 0.25, 0.)).unwrap();
+        let x = x.round() as u32;
+        let lit = (x - 1..=x + 1).any(|x| px(&img, x, y as u32) == [255; 3]);
+        assert!(lit);
+    }
+}
