@@ -41,7 +41,7 @@ pub enum FormFactorMethod {
     },
     /// The exact form factor between the two elements (the paper's double contour integral,
     /// figure 5, with the shared-edge and shared-vertex cases in closed form; see
-    /// `exact.rs`). Exact for unoccluded pairs; where an occluder may intervene it is
+    /// `exact/`). Exact for unoccluded pairs; where an occluder may intervene it is
     /// multiplied by the visible fraction of `steps` x `steps` by `steps` x `steps` point
     /// pairs, weighted by the area kernel.
     Contour {
