@@ -252,9 +252,8 @@ impl Prepared {
         path: &Path,
         progress: &dyn Progress,
     ) -> Result<FormFactorMatrix, PipelineError> {
-        let method = self.method().to_string();
         Ok(run_stage(progress, Stage::FormFactors, 0, || {
-            read_form_factors(path, self.fingerprint(), Some(&method))
+            read_form_factors(path, self.fingerprint(), Some(self.method()))
         })?)
     }
 

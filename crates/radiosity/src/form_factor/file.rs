@@ -23,13 +23,18 @@
 //! and the fingerprint (and refuse a stale file) before reading the matrix; the final
 //! checksum covers the whole file. A reader checks the file length against n before it
 //! allocates anything, so a damaged n cannot make it allocate terabytes, and never returns a
-//! partially read matrix.
+//! partially read matrix. A reader that checks the method parses the stored text back into a
+//! [`FormFactorMethod`] (its `FromStr`, which accepts exactly what `Display` writes) and
+//! compares the values.
 
 use std::hash::Hasher;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
-use super::{available_memory_bytes, check_dense_fits, FormFactorMatrix, OutOfMemory};
+use super::{
+    available_memory_bytes, check_dense_fits, FormFactorMatrix, FormFactorMethod, OutOfMemory,
+    ParseMethodError,
+};
 use crate::mesh::Mesh;
 
 /// The first 8 bytes of every form-factor file.
@@ -140,6 +145,20 @@ pub enum FormFactorFileError {
         /// The fingerprint of the current mesh.
         expected: u64,
     },
+    /// The file's method tag is not a [`FormFactorMethod`] (its `FromStr` refuses it), so
+    /// it cannot be checked against the method asked for.
+    #[error(
+        "form-factor file {path} has a method tag this program does not read: {source}; \
+         recompute it with `radiosity formfactors`"
+    )]
+    UnknownMethod {
+        /// The file.
+        path: PathBuf,
+        /// The method tag in the file.
+        tag: String,
+        /// Why it does not parse.
+        source: ParseMethodError,
+    },
     /// The file was computed with a different form-factor method than asked for.
     #[error(
         "form-factor file {path} was computed with method `{found}`, not `{expected}`; \
@@ -150,9 +169,9 @@ pub enum FormFactorFileError {
         /// The file.
         path: PathBuf,
         /// The method in the file.
-        found: String,
+        found: FormFactorMethod,
         /// The method asked for.
-        expected: String,
+        expected: FormFactorMethod,
     },
     /// The matrix would not fit in memory (nothing was allocated).
     #[error("cannot load form-factor file {path}: {source}")]
@@ -208,7 +227,8 @@ impl<W: Write> CrcWriter<W> {
 
 /// Writes `matrix` to `path` in the layout above, atomically (a reader sees the old file or
 /// the whole new one). `fingerprint` is [`mesh_fingerprint`] of the mesh the matrix was
-/// computed for; `method` describes how (for example `FormFactorMethod`'s Display).
+/// computed for; `method` is how, as `FormFactorMethod`'s Display writes it (a reader that
+/// checks the method refuses a file whose text does not parse back).
 pub fn write_form_factors(
     path: &Path,
     matrix: &FormFactorMatrix,
@@ -249,13 +269,15 @@ pub fn write_form_factors(
 /// Reads a form-factor file written by [`write_form_factors`].
 ///
 /// Refuses, with a message naming the file, anything but an intact version-1 file whose
-/// fingerprint is `expected_fingerprint` and, if `expected_method` is given, whose method is
-/// that one. The length is checked against n, and the memory against the available memory,
-/// before the matrix is allocated.
+/// fingerprint is `expected_fingerprint` and, if `expected_method` is given, whose method tag
+/// parses ([`FormFactorFileError::UnknownMethod`] if not) to that method
+/// ([`FormFactorFileError::MethodMismatch`] if not). Without an expected method the tag is
+/// not looked at. The length is checked against n, and the memory against the available
+/// memory, before the matrix is allocated.
 pub fn read_form_factors(
     path: &Path,
     expected_fingerprint: u64,
-    expected_method: Option<&str>,
+    expected_method: Option<FormFactorMethod>,
 ) -> Result<FormFactorMatrix, FormFactorFileError> {
     read_with_memory(
         path,
@@ -276,7 +298,7 @@ fn read_crc(r: &mut impl Read, crc: &mut crc32fast::Hasher, buf: &mut [u8]) -> i
 fn read_with_memory(
     path: &Path,
     expected_fingerprint: u64,
-    expected_method: Option<&str>,
+    expected_method: Option<FormFactorMethod>,
     available: u64,
 ) -> Result<FormFactorMatrix, FormFactorFileError> {
     let p = || path.to_path_buf();
@@ -377,11 +399,21 @@ fn read_with_memory(
         });
     }
     if let Some(expected) = expected_method {
-        if method != expected {
+        let found = match method.parse::<FormFactorMethod>() {
+            Ok(found) => found,
+            Err(source) => {
+                return Err(FormFactorFileError::UnknownMethod {
+                    path: p(),
+                    tag: method,
+                    source,
+                })
+            }
+        };
+        if found != expected {
             return Err(FormFactorFileError::MethodMismatch {
                 path: p(),
-                found: method,
-                expected: expected.to_string(),
+                found,
+                expected,
             });
         }
     }
@@ -485,6 +517,7 @@ mod tests {
     }
 
     const METHOD: &str = "area k=2";
+    const METHOD_VALUE: FormFactorMethod = FormFactorMethod::AreaIntegral { steps: 2 };
 
     /// Writes a valid file for `mesh` and returns its path and the mesh fingerprint.
     fn valid_file(dir: &Path, n: usize) -> (PathBuf, u64, FormFactorMatrix) {
@@ -505,7 +538,7 @@ mod tests {
     fn round_trip_is_bit_identical() {
         let dir = temp_dir("roundtrip");
         let (path, fp, m) = valid_file(&dir, 37);
-        let back = read_form_factors(&path, fp, Some(METHOD)).unwrap();
+        let back = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap();
         assert_eq!(back.n(), 37);
         let bits =
             |m: &FormFactorMatrix| m.as_slice().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -514,8 +547,16 @@ mod tests {
         assert!(read_form_factors(&path, fp, None).is_ok());
         // An empty matrix is a valid file as well.
         let empty = dir.join("empty.bin");
+        write_form_factors(&empty, &FormFactorMatrix::from_rows(0, vec![]), 7, METHOD).unwrap();
+        assert_eq!(
+            read_form_factors(&empty, 7, Some(METHOD_VALUE))
+                .unwrap()
+                .n(),
+            0
+        );
+        // Nor does a method tag matter when none is asked for.
         write_form_factors(&empty, &FormFactorMatrix::from_rows(0, vec![]), 7, "").unwrap();
-        assert_eq!(read_form_factors(&empty, 7, Some("")).unwrap().n(), 0);
+        assert_eq!(read_form_factors(&empty, 7, None).unwrap().n(), 0);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -583,7 +624,7 @@ mod tests {
         let data_start = 36 + METHOD.len();
         bytes[data_start + 123] ^= 0x10;
         std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, Some(METHOD)).unwrap_err();
+        let err = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap_err();
         assert!(
             matches!(err, FormFactorFileError::ChecksumMismatch { .. }),
             "{err}"
@@ -594,7 +635,7 @@ mod tests {
         let last = bytes.len() - 1;
         bytes[last] ^= 1;
         std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, Some(METHOD)).unwrap_err();
+        let err = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap_err();
         assert!(
             matches!(err, FormFactorFileError::ChecksumMismatch { .. }),
             "{err}"
@@ -648,7 +689,7 @@ mod tests {
         let dir = temp_dir("stale");
         let (path, _, _) = valid_file(&dir, 10);
         let other = mesh_fingerprint(&mesh_scene(&scene(0.1), 0.5).unwrap());
-        let err = read_form_factors(&path, other, Some(METHOD)).unwrap_err();
+        let err = read_form_factors(&path, other, Some(METHOD_VALUE)).unwrap_err();
         assert!(matches!(err, FormFactorFileError::Stale { .. }), "{err}");
         let text = err.to_string();
         assert!(text.contains("different mesh"), "{text}");
@@ -661,14 +702,52 @@ mod tests {
     fn different_method_is_refused() {
         let dir = temp_dir("method");
         let (path, fp, _) = valid_file(&dir, 4);
-        let err = read_form_factors(&path, fp, Some("area k=4")).unwrap_err();
+        let other = FormFactorMethod::AreaIntegral { steps: 4 };
+        let err = read_form_factors(&path, fp, Some(other)).unwrap_err();
         let FormFactorFileError::MethodMismatch {
             found, expected, ..
         } = &err
         else {
             panic!("{err}")
         };
-        assert_eq!((found.as_str(), expected.as_str()), (METHOD, "area k=4"));
+        assert_eq!((*found, *expected), (METHOD_VALUE, other));
+        let text = err.to_string();
+        assert!(text.contains("`area k=2`, not `area k=4`"), "{text}");
+        assert_names_file(&err, &path);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn unparsable_method_tag_is_refused_naming_it() {
+        let dir = temp_dir("tag");
+        let mesh = mesh_scene(&scene(0.0), 0.5).unwrap();
+        let fp = mesh_fingerprint(&mesh);
+        let path = dir.join("ff.bin");
+        // Tags an older or newer writer might have left, and near misses of real ones.
+        for tag in [
+            "",
+            "area",
+            "area k=2 ",
+            "radiosity k=2",
+            "contour k=+2",
+            "gpu-hemicube",
+        ] {
+            write_form_factors(&path, &matrix(3), fp, tag).unwrap();
+            let err = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap_err();
+            let FormFactorFileError::UnknownMethod {
+                tag: found, source, ..
+            } = &err
+            else {
+                panic!("{tag:?}: {err}")
+            };
+            assert_eq!(found, tag);
+            assert_eq!(tag.parse::<FormFactorMethod>(), Err(source.clone()));
+            let text = err.to_string();
+            assert!(text.contains(&format!("`{tag}`")), "{text}");
+            assert_names_file(&err, &path);
+            // Without a method to check, the tag is not looked at.
+            assert_eq!(read_form_factors(&path, fp, None).unwrap().n(), 3);
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

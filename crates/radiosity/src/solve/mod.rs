@@ -952,7 +952,7 @@ pub(crate) mod tests {
         let path = dir.join("cube.ff");
         let fp = mesh_fingerprint(&mesh);
         write_form_factors(&path, &f, fp, &method.to_string()).unwrap();
-        let back = read_form_factors(&path, fp, Some("area k=2")).unwrap();
+        let back = read_form_factors(&path, fp, Some("area k=2".parse().unwrap())).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
         assert_eq!(back, f);
 
