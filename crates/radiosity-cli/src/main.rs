@@ -17,6 +17,7 @@ macro_rules! outln {
     }};
 }
 
+mod errors;
 mod progress_bar;
 mod view;
 
@@ -37,6 +38,7 @@ use radiosity::scene::{self, Scene};
 use radiosity::shade::{self, Exposure};
 use radiosity::solve::{ProgressiveState, Solver};
 
+use errors::{describe, hint};
 use progress_bar::{format_duration, Reporter};
 
 /// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
@@ -372,23 +374,6 @@ fn main() -> ExitCode {
             errln!("{}", describe(&err));
             ExitCode::FAILURE
         }
-    }
-}
-
-/// The message for a failed run: the error and the causes its text does not already
-/// include, after "error: " (scene errors carry their own "file:line:column: error:").
-fn describe(err: &anyhow::Error) -> String {
-    let mut text = err.to_string();
-    for cause in err.chain().skip(1) {
-        let cause = cause.to_string();
-        if !text.contains(&cause) {
-            text = format!("{text}: {cause}");
-        }
-    }
-    if err.downcast_ref::<scene::SceneError>().is_some() {
-        text
-    } else {
-        format!("error: {text}")
     }
 }
 
@@ -945,7 +930,10 @@ fn compare_command(args: CompareArgs) -> Result<()> {
     if !args.no_reference {
         let dense = Solver::DEFAULT_GAUSS_SEIDEL;
         match prepared.check_memory(Some(dense)) {
-            Err(e) => reporter.note(&format!("no dense reference: {e}")),
+            Err(e) => reporter.note(&format!(
+                "no dense reference: {e}{}",
+                hint(&e).unwrap_or_default()
+            )),
             Ok(()) => {
                 let reset = reset_peak_memory();
                 let start = std::time::Instant::now();

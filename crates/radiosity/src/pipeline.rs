@@ -37,7 +37,23 @@ pub enum PipelineError {
     /// The solve failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
-    /// A setting cannot be honoured (for example an integration that would not fit).
+    /// The pair methods' integration points (`steps` x `steps` per element) would be more
+    /// than [`MAX_INTEGRATION_POINTS`].
+    #[error(
+        "INTEGRAL_STEPS {steps} on {elements} elements means {points:.2e} integration points \
+         (more than {limit:.0e})"
+    )]
+    TooManyIntegrationPoints {
+        /// Points along each axis of each element (1 for the methods that take none).
+        steps: u32,
+        /// The element count.
+        elements: usize,
+        /// elements x steps^2.
+        points: f64,
+        /// [`MAX_INTEGRATION_POINTS`].
+        limit: f64,
+    },
+    /// A setting cannot be honoured.
     #[error("{0}")]
     Settings(String),
     /// Writing an output failed.
@@ -49,6 +65,10 @@ pub enum PipelineError {
         source: std::io::Error,
     },
 }
+
+/// The most integration points (elements x steps^2) [`Prepared::check_memory`] lets the pair
+/// methods (area, contour, analytic) hold: 32 bytes each, 1.6 GB at the limit.
+pub const MAX_INTEGRATION_POINTS: f64 = 5e7;
 
 /// The most elements `choose_dense` will give the dense solve: its form factors cost
 /// O(n^2) (about 5 s at 10,000 elements on two cores, BENCHMARKS.md), so beyond this the
@@ -199,15 +219,17 @@ impl Prepared {
         let steps = match self.method {
             FormFactorMethod::AreaIntegral { steps }
             | FormFactorMethod::Contour { steps }
-            | FormFactorMethod::Analytic { steps } => steps as f64,
-            _ => 1.0,
+            | FormFactorMethod::Analytic { steps } => steps,
+            _ => 1,
         };
-        let points = n as f64 * steps * steps;
-        if points > 5e7 {
-            return Err(PipelineError::Settings(format!(
-                "INTEGRAL_STEPS {steps} on {n} elements means {points:.2e} integration points (more than 5e7); \
-                 use fewer steps (--steps) or larger elements (--max-area)"
-            )));
+        let points = n as f64 * steps as f64 * steps as f64;
+        if points > MAX_INTEGRATION_POINTS {
+            return Err(PipelineError::TooManyIntegrationPoints {
+                steps,
+                elements: n,
+                points,
+                limit: MAX_INTEGRATION_POINTS,
+            });
         }
         let per_entry = match solver {
             // No matrix: O(n) vectors and one row.
@@ -358,6 +380,7 @@ impl Solution {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::progress::NoProgress;
 
     #[test]
     fn auto_picks_dense_only_when_small_and_comfortable() {
@@ -372,5 +395,35 @@ mod tests {
             choose_dense(9_805, 16 * gib).1.contains("MiB"),
             "the reason states the estimate"
         );
+    }
+
+    #[test]
+    fn too_many_integration_points_are_refused_with_the_numbers() {
+        let overrides = Overrides {
+            max_patch_area: Some(20_000.0),
+            integral_steps: Some(1000),
+        };
+        let prepared = Prepared::new(crate::scene::cornell_box(), overrides, &NoProgress).unwrap();
+        let n = prepared.mesh.len();
+        let err = prepared.check_memory(None).unwrap_err();
+        let PipelineError::TooManyIntegrationPoints {
+            steps,
+            elements,
+            points,
+            limit,
+        } = err
+        else {
+            panic!("{err}")
+        };
+        assert_eq!((steps, elements), (1000, n));
+        assert_eq!((points, limit), (n as f64 * 1e6, MAX_INTEGRATION_POINTS));
+        let text = err.to_string();
+        let want = format!("INTEGRAL_STEPS 1000 on {n} elements means {points:.2e} integration");
+        assert!(text.contains(&want), "{text}");
+        assert!(text.ends_with("(more than 5e7)"), "{text}");
+        // The hemicube holds no integration points: the same mesh passes.
+        let mut hemicube = prepared;
+        hemicube.method = FormFactorMethod::Hemicube { resolution: 8 };
+        assert!(hemicube.check_memory(None).is_ok());
     }
 }

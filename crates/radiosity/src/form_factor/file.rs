@@ -52,7 +52,9 @@ const FIXED_BYTES: u64 = 8 + 4 + 8 + 4 + 8 + 4 + 4;
 /// Entries converted per read or write call.
 const CHUNK_ENTRIES: usize = 1 << 16;
 
-/// A form-factor file cannot be used. Every message names the file.
+/// A form-factor file cannot be used. Every message names the file and says what is wrong
+/// with it; none says how to make a new one (that is the caller's business: the command line
+/// adds its own hint).
 #[derive(Debug, thiserror::Error)]
 pub enum FormFactorFileError {
     /// The file could not be opened or read.
@@ -64,10 +66,7 @@ pub enum FormFactorFileError {
         source: io::Error,
     },
     /// The file does not start with the form-factor magic bytes.
-    #[error(
-        "{path} is not a form-factor file (it does not start with RADFF); write one with \
-         `radiosity formfactors`"
-    )]
+    #[error("{path} is not a form-factor file (it does not start with RADFF)")]
     NotFormFactorFile {
         /// The file.
         path: PathBuf,
@@ -75,7 +74,7 @@ pub enum FormFactorFileError {
     /// The file has a format version this library does not read.
     #[error(
         "form-factor file {path} has format version {version}, but this program reads only \
-         version {FORM_FACTOR_FILE_VERSION}; recompute it with `radiosity formfactors`"
+         version {FORM_FACTOR_FILE_VERSION}"
     )]
     UnsupportedVersion {
         /// The file.
@@ -84,7 +83,7 @@ pub enum FormFactorFileError {
         version: u32,
     },
     /// The header is damaged (checksum mismatch, impossible method length, bad UTF-8).
-    #[error("form-factor file {path} has a corrupt header ({reason}); recompute it with `radiosity formfactors`")]
+    #[error("form-factor file {path} has a corrupt header ({reason})")]
     CorruptHeader {
         /// The file.
         path: PathBuf,
@@ -94,7 +93,7 @@ pub enum FormFactorFileError {
     /// The file is shorter than its header says.
     #[error(
         "form-factor file {path} is truncated: a matrix of {n} elements needs {expected} \
-         bytes, but the file has {actual}; recompute it with `radiosity formfactors`"
+         bytes, but the file has {actual}"
     )]
     Truncated {
         /// The file.
@@ -108,8 +107,7 @@ pub enum FormFactorFileError {
     },
     /// The file is longer than its header says.
     #[error(
-        "form-factor file {path} has {extra} unexpected bytes after the matrix of {n} \
-         elements; recompute it with `radiosity formfactors`"
+        "form-factor file {path} has {extra} unexpected bytes after the matrix of {n} elements"
     )]
     TrailingBytes {
         /// The file.
@@ -122,7 +120,7 @@ pub enum FormFactorFileError {
     /// The data does not match its checksum.
     #[error(
         "form-factor file {path} is corrupt: checksum {computed:08x} does not match the \
-         stored {stored:08x}; recompute it with `radiosity formfactors`"
+         stored {stored:08x}"
     )]
     ChecksumMismatch {
         /// The file.
@@ -135,7 +133,7 @@ pub enum FormFactorFileError {
     /// The file was computed for a different mesh (other scene, area limit or geometry).
     #[error(
         "form-factor file {path} was computed for a different mesh (fingerprint \
-         {found:016x}, this mesh is {expected:016x}) — recompute with `radiosity formfactors`"
+         {found:016x}, this mesh is {expected:016x})"
     )]
     Stale {
         /// The file.
@@ -147,10 +145,7 @@ pub enum FormFactorFileError {
     },
     /// The file's method tag is not a [`FormFactorMethod`] (its `FromStr` refuses it), so
     /// it cannot be checked against the method asked for.
-    #[error(
-        "form-factor file {path} has a method tag this program does not read: {source}; \
-         recompute it with `radiosity formfactors`"
-    )]
+    #[error("form-factor file {path} has a method tag this program does not read: {source}")]
     UnknownMethod {
         /// The file.
         path: PathBuf,
@@ -160,11 +155,7 @@ pub enum FormFactorFileError {
         source: ParseMethodError,
     },
     /// The file was computed with a different form-factor method than asked for.
-    #[error(
-        "form-factor file {path} was computed with method `{found}`, not `{expected}`; \
-         recompute it with `radiosity formfactors` and the same --method and --steps, or use \
-         the settings it was made with"
-    )]
+    #[error("form-factor file {path} was computed with method `{found}`, not `{expected}`")]
     MethodMismatch {
         /// The file.
         path: PathBuf,
@@ -529,9 +520,13 @@ mod tests {
         (path, fp, m)
     }
 
+    /// The message names the file, and neither the program's commands nor its flags (the
+    /// command line adds those).
     fn assert_names_file(err: &FormFactorFileError, path: &Path) {
         let text = err.to_string();
         assert!(text.contains(&path.display().to_string()), "{text}");
+        assert!(!text.contains("radiosity formfactors"), "{text}");
+        assert!(!text.contains(" --"), "{text}");
     }
 
     #[test]
@@ -687,13 +682,16 @@ mod tests {
     #[test]
     fn different_mesh_is_stale() {
         let dir = temp_dir("stale");
-        let (path, _, _) = valid_file(&dir, 10);
+        let (path, fp_file, _) = valid_file(&dir, 10);
         let other = mesh_fingerprint(&mesh_scene(&scene(0.1), 0.5).unwrap());
         let err = read_form_factors(&path, other, Some(METHOD_VALUE)).unwrap_err();
         assert!(matches!(err, FormFactorFileError::Stale { .. }), "{err}");
         let text = err.to_string();
         assert!(text.contains("different mesh"), "{text}");
-        assert!(text.contains("radiosity formfactors"), "{text}");
+        // Both fingerprints, and no command-line advice (the program adds its own).
+        assert!(text.contains(&format!("{fp_file:016x}")), "{text}");
+        assert!(text.contains(&format!("{other:016x}")), "{text}");
+        assert!(!text.contains("radiosity formfactors"), "{text}");
         assert_names_file(&err, &path);
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -41,12 +41,12 @@ pub struct FormFactorMatrix {
     data: Vec<f32>,
 }
 
-/// Not enough memory for a dense problem.
+/// Not enough memory for a dense problem. The message states the sizes; what to change (a
+/// larger `MAX_PATCH_AREA`, or a solver that keeps no matrix) is the caller's to say.
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[error(
     "{what} for {n} elements needs {needed_mib:.0} MiB, but only {available_mib:.0} MiB of memory \
-     is available; at most {fits} elements would fit (raise MAX_PATCH_AREA with --max-area, \
-     or use --solver hierarchical or --solver progressive, which keep no matrix)"
+     is available; at most {fits} elements would fit"
 )]
 pub struct OutOfMemory {
     /// What was to be allocated.
