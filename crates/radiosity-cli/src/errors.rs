@@ -159,7 +159,7 @@ mod tests {
         let unknown = FormFactorFileError::UnknownMethod {
             path: path.clone(),
             tag: tag.into(),
-            source: tag.parse::<FormFactorMethod>().unwrap_err(),
+            source: Box::new(tag.parse::<FormFactorMethod>().unwrap_err()),
         };
         let text = describe(&unknown.into());
         assert!(text.contains(&format!("`{tag}`")), "{text}");

@@ -151,8 +151,9 @@ pub enum FormFactorFileError {
         path: PathBuf,
         /// The method tag in the file.
         tag: String,
-        /// Why it does not parse.
-        source: ParseMethodError,
+        /// Why it does not parse (boxed: it holds the tag again, and this error travels in
+        /// every `Result` of the pipeline).
+        source: Box<ParseMethodError>,
     },
     /// The file was computed with a different form-factor method than asked for.
     #[error("form-factor file {path} was computed with method `{found}`, not `{expected}`")]
@@ -396,7 +397,7 @@ fn read_with_memory(
                 return Err(FormFactorFileError::UnknownMethod {
                     path: p(),
                     tag: method,
-                    source,
+                    source: Box::new(source),
                 })
             }
         };

@@ -290,7 +290,7 @@ fn unparsable_method_tag_is_refused_naming_it() {
             panic!("{tag:?}: {err}")
         };
         assert_eq!(found, tag);
-        assert_eq!(tag.parse::<FormFactorMethod>(), Err(source.clone()));
+        assert_eq!(tag.parse::<FormFactorMethod>(), Err(*source.clone()));
         let text = err.to_string();
         assert!(text.contains(&format!("`{tag}`")), "{text}");
         assert_names_file(&err, &path);
