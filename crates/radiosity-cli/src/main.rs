@@ -17,6 +17,7 @@ macro_rules! outln {
     }};
 }
 
+mod errors;
 mod progress_bar;
 mod view;
 
@@ -42,6 +43,7 @@ use radiosity::solve::{
     keep_going, GaussSeidelSettings, Observer, ProgressiveSettings, Solver, SolverKind, Step,
 };
 
+use errors::{describe, hint};
 use progress_bar::{format_duration, Reporter};
 
 /// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
@@ -388,59 +390,6 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-/// The message for a failed run: the error and the causes its text does not already
-/// include, after "error: " (scene errors carry their own "file:line:column: error:").
-fn describe(err: &anyhow::Error) -> String {
-    let mut text = err.to_string();
-    for cause in err.chain().skip(1) {
-        let cause = cause.to_string();
-        if !text.contains(&cause) {
-            text = format!("{text}: {cause}");
-        }
-    }
-    if let Some(hint) = hint(err) {
-        text = format!("{text}\nhint: {hint}");
-    }
-    if err.downcast_ref::<scene::SceneError>().is_some() {
-        text
-    } else {
-        format!("error: {text}")
-    }
-}
-
-/// The flags that change what the library refused, for the errors where one does (the
-/// library's messages name no flags).
-fn hint(err: &anyhow::Error) -> Option<&'static str> {
-    use radiosity::pipeline::PipelineError;
-    use radiosity::solve::SolveError;
-    let solve_hint = |e: &SolveError| match e {
-        SolveError::HierarchicalTooBig { .. } => {
-            Some("raise --epsilon or --min-area (hierarchical radiosity refines less)")
-        }
-        SolveError::NotConverged { .. } => Some("loosen --tolerance or use --solver lu"),
-        SolveError::ProgressiveNotConverged { .. } => {
-            Some("raise --max-shots or loosen --tolerance")
-        }
-        _ => None,
-    };
-    err.chain().find_map(|cause| {
-        if let Some(e) = cause.downcast_ref::<PipelineError>() {
-            match e {
-                PipelineError::TooManyPoints { .. } => {
-                    Some("use fewer steps (--steps) or larger elements (--max-area)")
-                }
-                PipelineError::FormFactorsUnused { .. } => {
-                    Some("--form-factors applies to --solver gauss-seidel and lu only")
-                }
-                PipelineError::Solve(e) => solve_hint(e),
-                _ => None,
-            }
-        } else {
-            cause.downcast_ref::<SolveError>().and_then(solve_hint)
-        }
-    })
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -991,7 +940,10 @@ fn compare_command(args: CompareArgs) -> Result<()> {
     if !args.no_reference {
         let dense = Solver::DEFAULT_GAUSS_SEIDEL;
         match prepared.check_memory(Some(&dense)) {
-            Err(e) => reporter.note(&format!("no dense reference: {e}")),
+            Err(e) => reporter.note(&format!(
+                "no dense reference: {e}{}",
+                hint(&e).unwrap_or_default()
+            )),
             Ok(()) => {
                 let reset = reset_peak_memory();
                 let start = std::time::Instant::now();

@@ -179,8 +179,43 @@ fn form_factor_file_round_trip_and_refusals() {
         &dir,
     );
     assert!(!out.status.success());
-    assert!(stderr(&out).contains("t.ff"), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("t.ff"), "{err}");
+    assert!(err.contains("different mesh"), "{err}");
+    assert!(
+        err.contains("; recompute it with `radiosity formfactors`"),
+        "{err}"
+    );
     assert!(!dir.join("c.csv").exists(), "no output from a refused run");
+
+    // A file made with another method is refused, naming both and the flags of each.
+    let out = radiosity(
+        &[
+            "solve",
+            &scene,
+            "--method",
+            "contour",
+            "--form-factors",
+            "t.ff",
+            "-o",
+            "e.csv",
+        ],
+        &dir,
+    );
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("was computed with method `area k=2`, not `contour k=2`"),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "; recompute it with `radiosity formfactors` and --method contour --steps 2, or use \
+             the settings it was made with (--method area --steps 2)"
+        ),
+        "{err}"
+    );
+    assert!(!dir.join("e.csv").exists(), "no output from a refused run");
 
     // A corrupted byte is caught by the checksum.
     let mut bytes = std::fs::read(dir.join("t.ff")).unwrap();
@@ -192,7 +227,12 @@ fn form_factor_file_round_trip_and_refusals() {
         &dir,
     );
     assert!(!out.status.success());
-    assert!(stderr(&out).contains("bad.ff"), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("bad.ff"), "{err}");
+    assert!(
+        err.contains("; recompute it with `radiosity formfactors`"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -247,6 +287,12 @@ fn bad_arguments_are_refused_with_a_message() {
         (vec!["render", "--width", "0"], "--width"),
         (vec!["render", "--max-area=-1"], "MAX_PATCH_AREA"),
         (vec!["check", "--steps", "0"], "--steps"),
+        // 1000^2 points on each of the coarse box's elements: more than 5e7 in all.
+        (
+            vec!["check", "--max-area", "20000", "--steps", "1000"],
+            "integration points (more than 5e7); use fewer steps (--steps) or larger elements \
+             (--max-area)",
+        ),
     ] {
         let out = radiosity(&args, &dir);
         assert!(!out.status.success(), "{args:?} should fail");

@@ -41,19 +41,20 @@ pub enum PipelineError {
     /// A surface's reflectance or emission is out of range.
     #[error(transparent)]
     Light(#[from] LightError),
-    /// The integration points of every element would not fit.
+    /// The pair methods' integration points (`steps` x `steps` per element) would be more
+    /// than [`MAX_INTEGRATION_POINTS`].
     #[error(
-        "{steps} integral steps on {elements} elements means {points:.2e} integration points \
-         (more than {limit:.0e}): fewer steps or larger elements would fit"
+        "INTEGRAL_STEPS {steps} on {elements} elements means {points:.2e} integration points \
+         (more than {limit:.0e})"
     )]
-    TooManyPoints {
-        /// k, the points along each axis of each element.
+    TooManyIntegrationPoints {
+        /// Points along each axis of each element (1 for the methods that take none).
         steps: u32,
-        /// Elements.
+        /// The element count.
         elements: usize,
-        /// elements x k^2.
+        /// elements x steps^2.
         points: f64,
-        /// The most allowed.
+        /// [`MAX_INTEGRATION_POINTS`].
         limit: f64,
     },
     /// Form factors were given to a solver that computes its own.
@@ -71,6 +72,10 @@ pub enum PipelineError {
         source: std::io::Error,
     },
 }
+
+/// The most integration points (elements x steps^2) [`Prepared::check_memory`] lets the pair
+/// methods (area, contour, analytic) hold: 32 bytes each, 1.6 GB at the limit.
+pub const MAX_INTEGRATION_POINTS: f64 = 5e7;
 
 /// Settings from the command line that override the scene file's.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -245,7 +250,6 @@ impl Prepared {
     /// hierarchical radiosity store no matrix, so only the integration points are checked
     /// for them. `None`: the form factors alone.
     pub fn check_memory(&self, solver: Option<&Solver>) -> Result<(), PipelineError> {
-        const MAX_POINTS: f64 = 5e7;
         let n = self.mesh.len();
         let steps = match self.method {
             FormFactorMethod::AreaIntegral { steps }
@@ -254,12 +258,12 @@ impl Prepared {
             _ => 1,
         };
         let points = n as f64 * steps as f64 * steps as f64;
-        if points > MAX_POINTS {
-            return Err(PipelineError::TooManyPoints {
+        if points > MAX_INTEGRATION_POINTS {
+            return Err(PipelineError::TooManyIntegrationPoints {
                 steps,
                 elements: n,
                 points,
-                limit: MAX_POINTS,
+                limit: MAX_INTEGRATION_POINTS,
             });
         }
         let per_entry = match solver {
@@ -310,9 +314,8 @@ impl Prepared {
         path: &Path,
         progress: &dyn Progress,
     ) -> Result<FormFactorMatrix, PipelineError> {
-        let method = self.method().to_string();
         Ok(run_stage(progress, Stage::FormFactors, 0, || {
-            read_form_factors(path, self.fingerprint(), Some(&method))
+            read_form_factors(path, self.fingerprint(), Some(self.method()))
         })?)
     }
 
@@ -433,5 +436,41 @@ impl Solution {
                 .collect(),
             _ => self.radiosity.0.clone(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+
+    #[test]
+    fn too_many_integration_points_are_refused_with_the_numbers() {
+        let overrides = Overrides {
+            max_patch_area: Some(20_000.0),
+            integral_steps: Some(1000),
+        };
+        let prepared = Prepared::new(crate::scene::cornell_box(), overrides, &NoProgress).unwrap();
+        let n = prepared.mesh.len();
+        let err = prepared.check_memory(None).unwrap_err();
+        let PipelineError::TooManyIntegrationPoints {
+            steps,
+            elements,
+            points,
+            limit,
+        } = err
+        else {
+            panic!("{err}")
+        };
+        assert_eq!((steps, elements), (1000, n));
+        assert_eq!((points, limit), (n as f64 * 1e6, MAX_INTEGRATION_POINTS));
+        let text = err.to_string();
+        let want = format!("INTEGRAL_STEPS 1000 on {n} elements means {points:.2e} integration");
+        assert!(text.contains(&want), "{text}");
+        assert!(text.ends_with("(more than 5e7)"), "{text}");
+        // The hemicube holds no integration points: the same mesh passes.
+        let mut hemicube = prepared;
+        hemicube.method = FormFactorMethod::Hemicube { resolution: 8 };
+        assert!(hemicube.check_memory(None).is_ok());
     }
 }

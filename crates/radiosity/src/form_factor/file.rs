@@ -23,13 +23,18 @@
 //! and the fingerprint (and refuse a stale file) before reading the matrix; the final
 //! checksum covers the whole file. A reader checks the file length against n before it
 //! allocates anything, so a damaged n cannot make it allocate terabytes, and never returns a
-//! partially read matrix.
+//! partially read matrix. A reader that checks the method parses the stored text back into a
+//! [`FormFactorMethod`] (its `FromStr`, which accepts exactly what `Display` writes) and
+//! compares the values.
 
 use std::hash::Hasher;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
-use super::{available_memory_bytes, check_dense_fits, FormFactorMatrix, OutOfMemory};
+use super::{
+    available_memory_bytes, check_dense_fits, FormFactorMatrix, FormFactorMethod, OutOfMemory,
+    ParseMethodError,
+};
 use crate::mesh::Mesh;
 
 /// The first 8 bytes of every form-factor file.
@@ -47,7 +52,9 @@ const FIXED_BYTES: u64 = 8 + 4 + 8 + 4 + 8 + 4 + 4;
 /// Entries converted per read or write call.
 const CHUNK_ENTRIES: usize = 1 << 16;
 
-/// A form-factor file cannot be used. Every message names the file.
+/// A form-factor file cannot be used. Every message names the file and says what is wrong
+/// with it; none says how to make a new one (that is the caller's business: the command line
+/// adds its own hint).
 #[derive(Debug, thiserror::Error)]
 pub enum FormFactorFileError {
     /// The file could not be opened or read.
@@ -59,10 +66,7 @@ pub enum FormFactorFileError {
         source: io::Error,
     },
     /// The file does not start with the form-factor magic bytes.
-    #[error(
-        "{path} is not a form-factor file (it does not start with RADFF); write one with \
-         `radiosity formfactors`"
-    )]
+    #[error("{path} is not a form-factor file (it does not start with RADFF)")]
     NotFormFactorFile {
         /// The file.
         path: PathBuf,
@@ -70,7 +74,7 @@ pub enum FormFactorFileError {
     /// The file has a format version this library does not read.
     #[error(
         "form-factor file {path} has format version {version}, but this program reads only \
-         version {FORM_FACTOR_FILE_VERSION}; recompute it with `radiosity formfactors`"
+         version {FORM_FACTOR_FILE_VERSION}"
     )]
     UnsupportedVersion {
         /// The file.
@@ -79,7 +83,7 @@ pub enum FormFactorFileError {
         version: u32,
     },
     /// The header is damaged (checksum mismatch, impossible method length, bad UTF-8).
-    #[error("form-factor file {path} has a corrupt header ({reason}); recompute it with `radiosity formfactors`")]
+    #[error("form-factor file {path} has a corrupt header ({reason})")]
     CorruptHeader {
         /// The file.
         path: PathBuf,
@@ -89,7 +93,7 @@ pub enum FormFactorFileError {
     /// The file is shorter than its header says.
     #[error(
         "form-factor file {path} is truncated: a matrix of {n} elements needs {expected} \
-         bytes, but the file has {actual}; recompute it with `radiosity formfactors`"
+         bytes, but the file has {actual}"
     )]
     Truncated {
         /// The file.
@@ -103,8 +107,7 @@ pub enum FormFactorFileError {
     },
     /// The file is longer than its header says.
     #[error(
-        "form-factor file {path} has {extra} unexpected bytes after the matrix of {n} \
-         elements; recompute it with `radiosity formfactors`"
+        "form-factor file {path} has {extra} unexpected bytes after the matrix of {n} elements"
     )]
     TrailingBytes {
         /// The file.
@@ -117,7 +120,7 @@ pub enum FormFactorFileError {
     /// The data does not match its checksum.
     #[error(
         "form-factor file {path} is corrupt: checksum {computed:08x} does not match the \
-         stored {stored:08x}; recompute it with `radiosity formfactors`"
+         stored {stored:08x}"
     )]
     ChecksumMismatch {
         /// The file.
@@ -130,7 +133,7 @@ pub enum FormFactorFileError {
     /// The file was computed for a different mesh (other scene, area limit or geometry).
     #[error(
         "form-factor file {path} was computed for a different mesh (fingerprint \
-         {found:016x}, this mesh is {expected:016x}) — recompute with `radiosity formfactors`"
+         {found:016x}, this mesh is {expected:016x})"
     )]
     Stale {
         /// The file.
@@ -140,19 +143,27 @@ pub enum FormFactorFileError {
         /// The fingerprint of the current mesh.
         expected: u64,
     },
+    /// The file's method tag is not a [`FormFactorMethod`] (its `FromStr` refuses it), so
+    /// it cannot be checked against the method asked for.
+    #[error("form-factor file {path} has a method tag this program does not read: {source}")]
+    UnknownMethod {
+        /// The file.
+        path: PathBuf,
+        /// The method tag in the file.
+        tag: String,
+        /// Why it does not parse (boxed: it holds the tag again, and this error travels in
+        /// every `Result` of the pipeline).
+        source: Box<ParseMethodError>,
+    },
     /// The file was computed with a different form-factor method than asked for.
-    #[error(
-        "form-factor file {path} was computed with method `{found}`, not `{expected}`; \
-         recompute it with `radiosity formfactors` and the same --method and --steps, or use \
-         the settings it was made with"
-    )]
+    #[error("form-factor file {path} was computed with method `{found}`, not `{expected}`")]
     MethodMismatch {
         /// The file.
         path: PathBuf,
         /// The method in the file.
-        found: String,
+        found: FormFactorMethod,
         /// The method asked for.
-        expected: String,
+        expected: FormFactorMethod,
     },
     /// The matrix would not fit in memory (nothing was allocated).
     #[error("cannot load form-factor file {path}: {source}")]
@@ -208,7 +219,8 @@ impl<W: Write> CrcWriter<W> {
 
 /// Writes `matrix` to `path` in the layout above, atomically (a reader sees the old file or
 /// the whole new one). `fingerprint` is [`mesh_fingerprint`] of the mesh the matrix was
-/// computed for; `method` describes how (for example `FormFactorMethod`'s Display).
+/// computed for; `method` is how, as `FormFactorMethod`'s Display writes it (a reader that
+/// checks the method refuses a file whose text does not parse back).
 pub fn write_form_factors(
     path: &Path,
     matrix: &FormFactorMatrix,
@@ -249,13 +261,15 @@ pub fn write_form_factors(
 /// Reads a form-factor file written by [`write_form_factors`].
 ///
 /// Refuses, with a message naming the file, anything but an intact version-1 file whose
-/// fingerprint is `expected_fingerprint` and, if `expected_method` is given, whose method is
-/// that one. The length is checked against n, and the memory against the available memory,
-/// before the matrix is allocated.
+/// fingerprint is `expected_fingerprint` and, if `expected_method` is given, whose method tag
+/// parses ([`FormFactorFileError::UnknownMethod`] if not) to that method
+/// ([`FormFactorFileError::MethodMismatch`] if not). Without an expected method the tag is
+/// not looked at. The length is checked against n, and the memory against the available
+/// memory, before the matrix is allocated.
 pub fn read_form_factors(
     path: &Path,
     expected_fingerprint: u64,
-    expected_method: Option<&str>,
+    expected_method: Option<FormFactorMethod>,
 ) -> Result<FormFactorMatrix, FormFactorFileError> {
     read_with_memory(
         path,
@@ -276,7 +290,7 @@ fn read_crc(r: &mut impl Read, crc: &mut crc32fast::Hasher, buf: &mut [u8]) -> i
 fn read_with_memory(
     path: &Path,
     expected_fingerprint: u64,
-    expected_method: Option<&str>,
+    expected_method: Option<FormFactorMethod>,
     available: u64,
 ) -> Result<FormFactorMatrix, FormFactorFileError> {
     let p = || path.to_path_buf();
@@ -377,11 +391,21 @@ fn read_with_memory(
         });
     }
     if let Some(expected) = expected_method {
-        if method != expected {
+        let found = match method.parse::<FormFactorMethod>() {
+            Ok(found) => found,
+            Err(source) => {
+                return Err(FormFactorFileError::UnknownMethod {
+                    path: p(),
+                    tag: method,
+                    source: Box::new(source),
+                })
+            }
+        };
+        if found != expected {
             return Err(FormFactorFileError::MethodMismatch {
                 path: p(),
-                found: method,
-                expected: expected.to_string(),
+                found,
+                expected,
             });
         }
     }
@@ -425,351 +449,4 @@ fn read_with_memory(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::mesh::mesh_scene;
-    use crate::scene::{MeshSettings, Rgb, Scene, Surface};
-    use glam::dvec3;
-
-    /// A fresh empty directory for one test.
-    fn temp_dir(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("radiosity-fff-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
-    }
-
-    /// An open box of three unit-ish rectangles; `lift` moves the last one.
-    fn scene(lift: f64) -> Scene {
-        let rect = |z: f64, w: f64| {
-            vec![
-                dvec3(0., 0., z),
-                dvec3(w, 0., z),
-                dvec3(w, 1., z),
-                dvec3(0., 1., z),
-            ]
-        };
-        Scene {
-            settings: MeshSettings {
-                max_patch_area: 0.5,
-                integral_steps: 2,
-            },
-            surfaces: [rect(0.0, 1.0), rect(1.0, 2.0), rect(2.0 + lift, 1.0)]
-                .into_iter()
-                .enumerate()
-                .map(|(i, vertices)| Surface {
-                    name: format!("s{i}"),
-                    emission: Rgb::BLACK,
-                    reflectance: Rgb([0.5; 3]),
-                    vertices,
-                })
-                .collect(),
-            camera: None,
-        }
-    }
-
-    /// A matrix with awkward f32 values (subnormal, -0, max, tiny) among ordinary ones.
-    fn matrix(n: usize) -> FormFactorMatrix {
-        let mut state = 0x1234_5678u32;
-        let mut data: Vec<f32> = (0..n * n)
-            .map(|_| {
-                state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-                (state >> 8) as f32 / (1u32 << 24) as f32 / n as f32
-            })
-            .collect();
-        data[1] = f32::MIN_POSITIVE / 8.0;
-        data[2] = -0.0;
-        data[3] = f32::MAX;
-        data[4] = 1e-30;
-        FormFactorMatrix::from_rows(n, data)
-    }
-
-    const METHOD: &str = "area k=2";
-
-    /// Writes a valid file for `mesh` and returns its path and the mesh fingerprint.
-    fn valid_file(dir: &Path, n: usize) -> (PathBuf, u64, FormFactorMatrix) {
-        let mesh = mesh_scene(&scene(0.0), 0.5).unwrap();
-        let fp = mesh_fingerprint(&mesh);
-        let m = matrix(n);
-        let path = dir.join("ff.bin");
-        write_form_factors(&path, &m, fp, METHOD).unwrap();
-        (path, fp, m)
-    }
-
-    fn assert_names_file(err: &FormFactorFileError, path: &Path) {
-        let text = err.to_string();
-        assert!(text.contains(&path.display().to_string()), "{text}");
-    }
-
-    #[test]
-    fn round_trip_is_bit_identical() {
-        let dir = temp_dir("roundtrip");
-        let (path, fp, m) = valid_file(&dir, 37);
-        let back = read_form_factors(&path, fp, Some(METHOD)).unwrap();
-        assert_eq!(back.n(), 37);
-        let bits =
-            |m: &FormFactorMatrix| m.as_slice().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&back), bits(&m));
-        // Without a method to check, it reads too.
-        assert!(read_form_factors(&path, fp, None).is_ok());
-        // An empty matrix is a valid file as well.
-        let empty = dir.join("empty.bin");
-        write_form_factors(&empty, &FormFactorMatrix::from_rows(0, vec![]), 7, "").unwrap();
-        assert_eq!(read_form_factors(&empty, 7, Some("")).unwrap().n(), 0);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn layout_matches_documentation() {
-        let dir = temp_dir("layout");
-        let path = dir.join("two.bin");
-        let m = FormFactorMatrix::from_rows(2, vec![0.0, 0.25, 0.5, 0.0]);
-        write_form_factors(&path, &m, 0x0102_0304_0506_0708, "ab").unwrap();
-        let bytes = std::fs::read(&path).unwrap();
-        // 40 fixed bytes + L = 2 + 4 n^2 = 16.
-        assert_eq!(bytes.len(), 58);
-        assert_eq!(&bytes[0..8], b"RADFF\0\0\0");
-        assert_eq!(bytes[8..12], 1u32.to_le_bytes());
-        assert_eq!(bytes[12..20], 2u64.to_le_bytes());
-        assert_eq!(bytes[20..24], 2u32.to_le_bytes());
-        assert_eq!(&bytes[24..26], b"ab");
-        assert_eq!(bytes[26..34], 0x0102_0304_0506_0708u64.to_le_bytes());
-        assert_eq!(bytes[34..38], crc32fast::hash(&bytes[..34]).to_le_bytes());
-        assert_eq!(bytes[38..42], 0.0f32.to_le_bytes());
-        assert_eq!(bytes[42..46], 0.25f32.to_le_bytes());
-        assert_eq!(bytes[46..50], 0.5f32.to_le_bytes());
-        assert_eq!(bytes[50..54], 0.0f32.to_le_bytes());
-        assert_eq!(bytes[54..58], crc32fast::hash(&bytes[..54]).to_le_bytes());
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn fingerprint_is_fnv1a_of_documented_bytes() {
-        let mesh = mesh_scene(&scene(0.0), 0.5).unwrap();
-        // FNV-1a 64 written out here (offset basis and prime from the FNV specification).
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        let mut eat = |bytes: &[u8]| {
-            for &b in bytes {
-                h ^= b as u64;
-                h = h.wrapping_mul(0x0000_0100_0000_01b3);
-            }
-        };
-        eat(&(mesh.len() as u64).to_le_bytes());
-        for (e, el) in mesh.elements.iter().enumerate() {
-            eat(&el.surface.to_le_bytes());
-            eat(&(el.corners().len() as u64).to_le_bytes());
-            for &c in el.corners() {
-                let v = mesh.vertices[c as usize];
-                for x in [v.x, v.y, v.z] {
-                    eat(&x.to_bits().to_le_bytes());
-                }
-            }
-            eat(&el.area.to_bits().to_le_bytes());
-            assert_eq!(mesh.corner_positions(e).len(), el.corners().len());
-        }
-        assert_eq!(mesh_fingerprint(&mesh), h);
-        // Any geometric change changes it.
-        let moved = mesh_scene(&scene(1e-9), 0.5).unwrap();
-        assert_ne!(mesh_fingerprint(&moved), h);
-        let finer = mesh_scene(&scene(0.0), 0.25).unwrap();
-        assert_ne!(mesh_fingerprint(&finer), h);
-    }
-
-    #[test]
-    fn flipped_data_byte_is_a_checksum_error() {
-        let dir = temp_dir("flip");
-        let (path, fp, _) = valid_file(&dir, 10);
-        let mut bytes = std::fs::read(&path).unwrap();
-        let data_start = 36 + METHOD.len();
-        bytes[data_start + 123] ^= 0x10;
-        std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, Some(METHOD)).unwrap_err();
-        assert!(
-            matches!(err, FormFactorFileError::ChecksumMismatch { .. }),
-            "{err}"
-        );
-        assert_names_file(&err, &path);
-        // The final checksum itself damaged: the same refusal.
-        bytes[data_start + 123] ^= 0x10;
-        let last = bytes.len() - 1;
-        bytes[last] ^= 1;
-        std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, Some(METHOD)).unwrap_err();
-        assert!(
-            matches!(err, FormFactorFileError::ChecksumMismatch { .. }),
-            "{err}"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn flipped_header_byte_is_a_corrupt_header() {
-        let dir = temp_dir("header");
-        let (path, fp, _) = valid_file(&dir, 10);
-        let mut bytes = std::fs::read(&path).unwrap();
-        bytes[25] ^= 0x01; // inside the method string
-        std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, None).unwrap_err();
-        assert!(
-            matches!(err, FormFactorFileError::CorruptHeader { .. }),
-            "{err}"
-        );
-        assert_names_file(&err, &path);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn truncated_and_padded_files_are_refused() {
-        let dir = temp_dir("trunc");
-        let (path, fp, _) = valid_file(&dir, 10);
-        let bytes = std::fs::read(&path).unwrap();
-        for keep in [bytes.len() - 1, bytes.len() - 200, 40, 14] {
-            std::fs::write(&path, &bytes[..keep]).unwrap();
-            let err = read_form_factors(&path, fp, None).unwrap_err();
-            assert!(
-                matches!(err, FormFactorFileError::Truncated { .. }),
-                "{keep}: {err}"
-            );
-            assert_names_file(&err, &path);
-        }
-        let mut longer = bytes.clone();
-        longer.push(0);
-        std::fs::write(&path, &longer).unwrap();
-        let err = read_form_factors(&path, fp, None).unwrap_err();
-        assert!(
-            matches!(err, FormFactorFileError::TrailingBytes { extra: 1, .. }),
-            "{err}"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn different_mesh_is_stale() {
-        let dir = temp_dir("stale");
-        let (path, _, _) = valid_file(&dir, 10);
-        let other = mesh_fingerprint(&mesh_scene(&scene(0.1), 0.5).unwrap());
-        let err = read_form_factors(&path, other, Some(METHOD)).unwrap_err();
-        assert!(matches!(err, FormFactorFileError::Stale { .. }), "{err}");
-        let text = err.to_string();
-        assert!(text.contains("different mesh"), "{text}");
-        assert!(text.contains("radiosity formfactors"), "{text}");
-        assert_names_file(&err, &path);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn different_method_is_refused() {
-        let dir = temp_dir("method");
-        let (path, fp, _) = valid_file(&dir, 4);
-        let err = read_form_factors(&path, fp, Some("area k=4")).unwrap_err();
-        let FormFactorFileError::MethodMismatch {
-            found, expected, ..
-        } = &err
-        else {
-            panic!("{err}")
-        };
-        assert_eq!((found.as_str(), expected.as_str()), (METHOD, "area k=4"));
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn garbage_is_not_a_form_factor_file() {
-        let dir = temp_dir("garbage");
-        let path = dir.join("scene.txt");
-        for content in [
-            &b"MAX_PATCH_AREA 0.1\nINTEGRAL_STEPS 2\n"[..],
-            b"",
-            b"RADFF",
-        ] {
-            std::fs::write(&path, content).unwrap();
-            let err = read_form_factors(&path, 0, None).unwrap_err();
-            assert!(
-                matches!(err, FormFactorFileError::NotFormFactorFile { .. }),
-                "{err}"
-            );
-            assert_names_file(&err, &path);
-        }
-        let err = read_form_factors(&dir.join("missing.bin"), 0, None).unwrap_err();
-        assert!(matches!(err, FormFactorFileError::Io { .. }), "{err}");
-        assert!(err.to_string().contains("missing.bin"), "{err}");
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn newer_version_is_refused() {
-        let dir = temp_dir("version");
-        let (path, fp, _) = valid_file(&dir, 3);
-        let mut bytes = std::fs::read(&path).unwrap();
-        bytes[8..12].copy_from_slice(&2u32.to_le_bytes());
-        std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, None).unwrap_err();
-        assert!(
-            matches!(
-                err,
-                FormFactorFileError::UnsupportedVersion { version: 2, .. }
-            ),
-            "{err}"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn huge_n_is_refused_without_allocating() {
-        let dir = temp_dir("huge");
-        let path = dir.join("huge.bin");
-        // A header claiming n = 2^40 (4 * 2^80 bytes of data) or n = u64::MAX, with a valid
-        // header checksum, followed by a few bytes: only the length check can stop it, and a
-        // vec![0; n * n] would abort the test.
-        for n in [1u64 << 40, u64::MAX] {
-            let mut bytes = Vec::new();
-            bytes.extend_from_slice(&FORM_FACTOR_MAGIC);
-            bytes.extend_from_slice(&1u32.to_le_bytes());
-            bytes.extend_from_slice(&n.to_le_bytes());
-            bytes.extend_from_slice(&0u32.to_le_bytes());
-            bytes.extend_from_slice(&42u64.to_le_bytes());
-            let crc = crc32fast::hash(&bytes);
-            bytes.extend_from_slice(&crc.to_le_bytes());
-            bytes.extend_from_slice(&[0u8; 64]);
-            std::fs::write(&path, &bytes).unwrap();
-            let err = read_form_factors(&path, 42, None).unwrap_err();
-            let FormFactorFileError::Truncated { n: got, actual, .. } = err else {
-                panic!("{err}")
-            };
-            assert_eq!((got, actual), (n, bytes.len() as u64));
-        }
-        // A damaged n without a matching header checksum is a corrupt header.
-        let (path, fp, _) = valid_file(&dir, 5);
-        let mut bytes = std::fs::read(&path).unwrap();
-        bytes[19] = 0x7f;
-        std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, None).unwrap_err();
-        assert!(
-            matches!(err, FormFactorFileError::CorruptHeader { .. }),
-            "{err}"
-        );
-        // A method length beyond the limit is refused before it is allocated.
-        bytes[19] = 0;
-        bytes[20..24].copy_from_slice(&u32::MAX.to_le_bytes());
-        std::fs::write(&path, &bytes).unwrap();
-        let err = read_form_factors(&path, fp, None).unwrap_err();
-        assert!(
-            matches!(err, FormFactorFileError::CorruptHeader { .. }),
-            "{err}"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn matrix_too_big_for_memory_is_refused() {
-        let dir = temp_dir("oom");
-        let (path, fp, _) = valid_file(&dir, 20);
-        // 20 x 20 f32 = 1600 bytes (1760 with headroom) do not fit in 1000.
-        let err = read_with_memory(&path, fp, None, 1000).unwrap_err();
-        let FormFactorFileError::OutOfMemory { source, .. } = &err else {
-            panic!("{err}")
-        };
-        assert_eq!(source.n, 20);
-        assert_names_file(&err, &path);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-}
+mod tests;

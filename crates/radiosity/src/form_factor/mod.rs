@@ -9,6 +9,7 @@ mod area;
 pub mod exact;
 mod file;
 mod hemicube;
+mod method;
 mod montecarlo;
 pub mod reference;
 
@@ -17,6 +18,7 @@ pub use file::{
     mesh_fingerprint, read_form_factors, write_form_factors, FormFactorFileError,
     FORM_FACTOR_FILE_VERSION, FORM_FACTOR_MAGIC, MAX_METHOD_LEN,
 };
+pub use method::{FormFactorMethod, ParseMethodError};
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -28,88 +30,6 @@ use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::Scene;
 use crate::visibility::PolygonBvh;
 
-/// How form factors are computed. Recorded in the form-factor file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FormFactorMethod {
-    /// The paper's double area integral (figure 4) by the midpoint rule with `steps` x `steps`
-    /// points on each element, a disc-regularised kernel (see `area.rs`) and the visibility
-    /// of every point pair by a ray cast against candidate occluders.
-    AreaIntegral {
-        /// k, points along each axis of each element (`INTEGRAL_STEPS`).
-        steps: u32,
-    },
-    /// The exact form factor between the two elements (the paper's double contour integral,
-    /// figure 5, with the shared-edge and shared-vertex cases in closed form; see
-    /// `exact.rs`). Exact for unoccluded pairs; where an occluder may intervene it is
-    /// multiplied by the visible fraction of `steps` x `steps` by `steps` x `steps` point
-    /// pairs, weighted by the area kernel.
-    Contour {
-        /// Points along each axis of each element for the visibility estimate.
-        steps: u32,
-    },
-    /// Lambert's exact point-to-polygon form factor at `steps` x `steps` points on the
-    /// receiving element, each times the visible fraction of `steps` x `steps` points on
-    /// the source (Wallace, Elmquist and Haines 1989). Accurate at shared edges.
-    Analytic {
-        /// Points along each axis of each element.
-        steps: u32,
-    },
-    /// The hemicube (Cohen and Greenberg 1985): each element's view rasterised on the CPU
-    /// onto a half cube of `resolution` x `resolution` cells on top.
-    Hemicube {
-        /// Cells across the top face (even).
-        resolution: u32,
-    },
-    /// Stratified Monte Carlo ray casting: `samples` cosine-distributed rays per element,
-    /// from a seeded generator (deterministic).
-    MonteCarlo {
-        /// Rays per element (rounded up to a square).
-        samples: u32,
-        /// Generator seed.
-        seed: u64,
-    },
-}
-
-impl FormFactorMethod {
-    /// True when the method's estimate is symmetric (A_i F_ij = A_j F_ji exactly), so only
-    /// the upper triangle need be computed.
-    pub fn is_reciprocal(&self) -> bool {
-        matches!(
-            self,
-            FormFactorMethod::AreaIntegral { .. } | FormFactorMethod::Contour { .. }
-        )
-    }
-
-    /// How the method handles occlusion, for the command line's help and notes.
-    pub fn occlusion(&self) -> &'static str {
-        match self {
-            FormFactorMethod::AreaIntegral { .. } => "ray cast per point pair",
-            FormFactorMethod::Contour { .. } => {
-                "exact when unoccluded; pairs with a possible occluder are scaled by the visible fraction of their point pairs"
-            }
-            FormFactorMethod::Analytic { .. } => "rays from each receiver point to the source's points",
-            FormFactorMethod::Hemicube { .. } => "depth buffer",
-            FormFactorMethod::MonteCarlo { .. } => "closest hit of each ray",
-        }
-    }
-}
-
-impl std::fmt::Display for FormFactorMethod {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            FormFactorMethod::AreaIntegral { steps } => write!(f, "area k={steps}"),
-            FormFactorMethod::Contour { steps } => write!(f, "contour k={steps}"),
-            FormFactorMethod::Analytic { steps } => write!(f, "analytic k={steps}"),
-            FormFactorMethod::Hemicube { resolution } => {
-                write!(f, "hemicube resolution={resolution}")
-            }
-            FormFactorMethod::MonteCarlo { samples, seed } => {
-                write!(f, "montecarlo samples={samples} seed={seed}")
-            }
-        }
-    }
-}
-
 /// A dense n x n matrix of form factors, stored row by row in f32.
 ///
 /// f32 keeps 7 significant digits, far below the discretisation error of any method here
@@ -120,12 +40,12 @@ pub struct FormFactorMatrix {
     data: Vec<f32>,
 }
 
-/// Not enough memory for a dense problem.
+/// Not enough memory for a dense problem. The message states the sizes; what to change (a
+/// larger `MAX_PATCH_AREA`, or a solver that keeps no matrix) is the caller's to say.
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[error(
     "{what} for {n} elements needs {needed_mib:.0} MiB, but only {available_mib:.0} MiB of memory \
-     is available; at most {fits} elements would fit (raise MAX_PATCH_AREA with --max-area, \
-     or use --solver hierarchical or --solver progressive, which keep no matrix)"
+     is available; at most {fits} elements would fit"
 )]
 pub struct OutOfMemory {
     /// What was to be allocated.

@@ -461,7 +461,7 @@ fn closed_cube_with_computed_form_factors_stays_within_furnace_bounds() {
     let path = dir.join("cube.ff");
     let fp = mesh_fingerprint(&mesh);
     write_form_factors(&path, &f, fp, &method.to_string()).unwrap();
-    let back = read_form_factors(&path, fp, Some("area k=2")).unwrap();
+    let back = read_form_factors(&path, fp, Some("area k=2".parse().unwrap())).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(back, f);
 

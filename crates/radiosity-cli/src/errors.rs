@@ -1,0 +1,204 @@
+//! What the command line says when a run fails: the library's message, its causes, and the
+//! hint in this program's own commands and flags that the library cannot give.
+
+use radiosity::form_factor::{FormFactorFileError, FormFactorMethod, OutOfMemory};
+use radiosity::pipeline::PipelineError;
+use radiosity::scene;
+use radiosity::solve::SolveError;
+
+/// The message for a failed run: the error and the causes its text does not already
+/// include, then the command-line hint for it (see [`hint`]), after "error: " (scene errors
+/// carry their own "file:line:column: error:").
+pub fn describe(err: &anyhow::Error) -> String {
+    let mut text = err.to_string();
+    for cause in err.chain().skip(1) {
+        let cause = cause.to_string();
+        if !text.contains(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    if let Some(hint) = err.chain().find_map(hint) {
+        text.push_str(&hint);
+    }
+    if err.downcast_ref::<scene::SceneError>().is_some() {
+        text
+    } else {
+        format!("error: {text}")
+    }
+}
+
+/// What to run instead, in this program's commands and flags, for a library error that can
+/// be fixed by other settings: text to append to its message. The library's messages state
+/// what is wrong with the numbers; only the command line knows its flags.
+pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
+    const MEMORY: &str = " (raise MAX_PATCH_AREA with --max-area, or use --solver hierarchical \
+                          or --solver progressive, which keep no matrix)";
+    const RECOMPUTE: &str = "; recompute it with `radiosity formfactors`";
+    if let Some(e) = err.downcast_ref::<PipelineError>() {
+        return match e {
+            PipelineError::OutOfMemory(_) | PipelineError::Solve(SolveError::OutOfMemory(_)) => {
+                Some(MEMORY.into())
+            }
+            PipelineError::TooManyIntegrationPoints { .. } => {
+                Some("; use fewer steps (--steps) or larger elements (--max-area)".into())
+            }
+            PipelineError::FormFactorFile(e) => hint(e),
+            PipelineError::FormFactorsUnused { .. } => {
+                Some(" (--form-factors applies to --solver gauss-seidel and lu only)".into())
+            }
+            PipelineError::Solve(e) => hint(e),
+            _ => None,
+        };
+    }
+    if let Some(e) = err.downcast_ref::<FormFactorFileError>() {
+        return match e {
+            FormFactorFileError::Io { .. } => None,
+            FormFactorFileError::NotFormFactorFile { .. } => {
+                Some("; write one with `radiosity formfactors`".into())
+            }
+            FormFactorFileError::MethodMismatch {
+                found, expected, ..
+            } => Some(format!(
+                "{RECOMPUTE} and {}, or use the settings it was made with ({})",
+                method_flags(expected),
+                method_flags(found)
+            )),
+            FormFactorFileError::OutOfMemory { .. } => Some(MEMORY.into()),
+            _ => Some(RECOMPUTE.into()),
+        };
+    }
+    if let Some(e) = err.downcast_ref::<SolveError>() {
+        return match e {
+            SolveError::OutOfMemory(_) => Some(MEMORY.into()),
+            SolveError::HierarchicalTooBig { .. } => Some(": raise --epsilon or --min-area".into()),
+            SolveError::NotConverged { .. } => {
+                Some(" (--tolerance loosens it; --solver lu solves directly)".into())
+            }
+            SolveError::ProgressiveNotConverged { .. } => {
+                Some(" (--max-shots raises the shot limit, --tolerance loosens it)".into())
+            }
+            _ => None,
+        };
+    }
+    err.downcast_ref::<OutOfMemory>().map(|_| MEMORY.into())
+}
+
+/// The flags that select `method`: `--method contour --steps 4`.
+fn method_flags(method: &FormFactorMethod) -> String {
+    match *method {
+        FormFactorMethod::AreaIntegral { steps } => format!("--method area --steps {steps}"),
+        FormFactorMethod::Contour { steps } => format!("--method contour --steps {steps}"),
+        FormFactorMethod::Analytic { steps } => format!("--method analytic --steps {steps}"),
+        FormFactorMethod::Hemicube { resolution } => {
+            format!("--method hemicube --resolution {resolution}")
+        }
+        FormFactorMethod::MonteCarlo { samples, seed } => {
+            format!("--method montecarlo --samples {samples} --seed {seed}")
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiosity::form_factor::check_dense_fits;
+
+    /// 100,000 x 100,000 f32 (44 GB with headroom) in 1 GiB.
+    fn oom() -> OutOfMemory {
+        check_dense_fits("the form-factor matrix (f32)", 100_000, 4.0, 1 << 30).unwrap_err()
+    }
+
+    #[test]
+    fn memory_errors_get_the_flags_that_help() {
+        let want = "error: the form-factor matrix (f32) for 100000 elements needs 41962 MiB, but \
+                    only 1024 MiB of memory is available; at most 15621 elements would fit (raise \
+                    MAX_PATCH_AREA with --max-area, or use --solver hierarchical or --solver \
+                    progressive, which keep no matrix)";
+        // However it reaches the command line.
+        let direct = anyhow::Error::new(oom());
+        let pipeline = anyhow::Error::new(PipelineError::OutOfMemory(oom()));
+        let solve = anyhow::Error::new(PipelineError::Solve(SolveError::OutOfMemory(oom())));
+        for err in [direct, pipeline, solve] {
+            assert_eq!(describe(&err), want);
+        }
+        let file = anyhow::Error::new(PipelineError::FormFactorFile(
+            FormFactorFileError::OutOfMemory {
+                path: "f.ff".into(),
+                source: oom(),
+            },
+        ));
+        assert_eq!(
+            describe(&file),
+            want.replace("error: ", "error: cannot load form-factor file f.ff: ")
+        );
+    }
+
+    #[test]
+    fn integration_points_error_gets_the_flags_that_help() {
+        let err = anyhow::Error::new(PipelineError::TooManyIntegrationPoints {
+            steps: 1000,
+            elements: 130,
+            points: 1.3e8,
+            limit: 5e7,
+        });
+        assert_eq!(
+            describe(&err),
+            "error: INTEGRAL_STEPS 1000 on 130 elements means 1.30e8 integration points (more \
+             than 5e7); use fewer steps (--steps) or larger elements (--max-area)"
+        );
+    }
+
+    #[test]
+    fn form_factor_file_errors_get_the_command_that_remakes_them() {
+        let path = std::path::PathBuf::from("t.ff");
+        let recompute = "; recompute it with `radiosity formfactors`";
+        let stale = FormFactorFileError::Stale {
+            path: path.clone(),
+            found: 1,
+            expected: 2,
+        };
+        let text = describe(&PipelineError::FormFactorFile(stale).into());
+        assert!(text.ends_with(recompute), "{text}");
+        assert!(
+            text.contains("0000000000000001, this mesh is 0000000000000002"),
+            "{text}"
+        );
+        let not_one = FormFactorFileError::NotFormFactorFile { path: path.clone() };
+        let text = describe(&not_one.into());
+        assert!(
+            text.ends_with("; write one with `radiosity formfactors`"),
+            "{text}"
+        );
+        let tag = "hemicube-gpu resolution=8";
+        let unknown = FormFactorFileError::UnknownMethod {
+            path: path.clone(),
+            tag: tag.into(),
+            source: Box::new(tag.parse::<FormFactorMethod>().unwrap_err()),
+        };
+        let text = describe(&unknown.into());
+        assert!(text.contains(&format!("`{tag}`")), "{text}");
+        assert!(text.ends_with(recompute), "{text}");
+        let mismatch = FormFactorFileError::MethodMismatch {
+            path: path.clone(),
+            found: FormFactorMethod::MonteCarlo {
+                samples: 64,
+                seed: 3,
+            },
+            expected: FormFactorMethod::Hemicube { resolution: 32 },
+        };
+        assert_eq!(
+            describe(&mismatch.into()),
+            "error: form-factor file t.ff was computed with method `montecarlo samples=64 \
+             seed=3`, not `hemicube resolution=32`; recompute it with `radiosity formfactors` \
+             and --method hemicube --resolution 32, or use the settings it was made with \
+             (--method montecarlo --samples 64 --seed 3)"
+        );
+        // An unreadable file has nothing to recompute.
+        let io = FormFactorFileError::Io {
+            path,
+            source: std::io::Error::from(std::io::ErrorKind::NotFound),
+        };
+        let text = describe(&io.into());
+        assert!(!text.contains("radiosity formfactors"), "{text}");
+    }
+}

@@ -1,0 +1,402 @@
+//! The form-factor file's tests: round trips bit for bit, the documented layout and
+//! fingerprint, and a typed refusal naming the file for every kind of damage.
+
+use super::*;
+use crate::mesh::mesh_scene;
+use crate::scene::{MeshSettings, Rgb, Scene, Surface};
+use glam::dvec3;
+
+/// A fresh empty directory for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("radiosity-fff-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// An open box of three unit-ish rectangles; `lift` moves the last one.
+fn scene(lift: f64) -> Scene {
+    let rect = |z: f64, w: f64| {
+        vec![
+            dvec3(0., 0., z),
+            dvec3(w, 0., z),
+            dvec3(w, 1., z),
+            dvec3(0., 1., z),
+        ]
+    };
+    Scene {
+        settings: MeshSettings {
+            max_patch_area: 0.5,
+            integral_steps: 2,
+        },
+        surfaces: [rect(0.0, 1.0), rect(1.0, 2.0), rect(2.0 + lift, 1.0)]
+            .into_iter()
+            .enumerate()
+            .map(|(i, vertices)| Surface {
+                name: format!("s{i}"),
+                emission: Rgb::BLACK,
+                reflectance: Rgb([0.5; 3]),
+                vertices,
+            })
+            .collect(),
+        camera: None,
+    }
+}
+
+/// A matrix with awkward f32 values (subnormal, -0, max, tiny) among ordinary ones.
+fn matrix(n: usize) -> FormFactorMatrix {
+    let mut state = 0x1234_5678u32;
+    let mut data: Vec<f32> = (0..n * n)
+        .map(|_| {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32 / n as f32
+        })
+        .collect();
+    data[1] = f32::MIN_POSITIVE / 8.0;
+    data[2] = -0.0;
+    data[3] = f32::MAX;
+    data[4] = 1e-30;
+    FormFactorMatrix::from_rows(n, data)
+}
+
+const METHOD: &str = "area k=2";
+const METHOD_VALUE: FormFactorMethod = FormFactorMethod::AreaIntegral { steps: 2 };
+
+/// Writes a valid file for `mesh` and returns its path and the mesh fingerprint.
+fn valid_file(dir: &Path, n: usize) -> (PathBuf, u64, FormFactorMatrix) {
+    let mesh = mesh_scene(&scene(0.0), 0.5).unwrap();
+    let fp = mesh_fingerprint(&mesh);
+    let m = matrix(n);
+    let path = dir.join("ff.bin");
+    write_form_factors(&path, &m, fp, METHOD).unwrap();
+    (path, fp, m)
+}
+
+/// The message names the file, and neither the program's commands nor its flags (the
+/// command line adds those).
+fn assert_names_file(err: &FormFactorFileError, path: &Path) {
+    let text = err.to_string();
+    assert!(text.contains(&path.display().to_string()), "{text}");
+    assert!(!text.contains("radiosity formfactors"), "{text}");
+    assert!(!text.contains(" --"), "{text}");
+}
+
+#[test]
+fn round_trip_is_bit_identical() {
+    let dir = temp_dir("roundtrip");
+    let (path, fp, m) = valid_file(&dir, 37);
+    let back = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap();
+    assert_eq!(back.n(), 37);
+    let bits = |m: &FormFactorMatrix| m.as_slice().iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&back), bits(&m));
+    // Without a method to check, it reads too.
+    assert!(read_form_factors(&path, fp, None).is_ok());
+    // An empty matrix is a valid file as well.
+    let empty = dir.join("empty.bin");
+    write_form_factors(&empty, &FormFactorMatrix::from_rows(0, vec![]), 7, METHOD).unwrap();
+    assert_eq!(
+        read_form_factors(&empty, 7, Some(METHOD_VALUE))
+            .unwrap()
+            .n(),
+        0
+    );
+    // Nor does a method tag matter when none is asked for.
+    write_form_factors(&empty, &FormFactorMatrix::from_rows(0, vec![]), 7, "").unwrap();
+    assert_eq!(read_form_factors(&empty, 7, None).unwrap().n(), 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn layout_matches_documentation() {
+    let dir = temp_dir("layout");
+    let path = dir.join("two.bin");
+    let m = FormFactorMatrix::from_rows(2, vec![0.0, 0.25, 0.5, 0.0]);
+    write_form_factors(&path, &m, 0x0102_0304_0506_0708, "ab").unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    // 40 fixed bytes + L = 2 + 4 n^2 = 16.
+    assert_eq!(bytes.len(), 58);
+    assert_eq!(&bytes[0..8], b"RADFF\0\0\0");
+    assert_eq!(bytes[8..12], 1u32.to_le_bytes());
+    assert_eq!(bytes[12..20], 2u64.to_le_bytes());
+    assert_eq!(bytes[20..24], 2u32.to_le_bytes());
+    assert_eq!(&bytes[24..26], b"ab");
+    assert_eq!(bytes[26..34], 0x0102_0304_0506_0708u64.to_le_bytes());
+    assert_eq!(bytes[34..38], crc32fast::hash(&bytes[..34]).to_le_bytes());
+    assert_eq!(bytes[38..42], 0.0f32.to_le_bytes());
+    assert_eq!(bytes[42..46], 0.25f32.to_le_bytes());
+    assert_eq!(bytes[46..50], 0.5f32.to_le_bytes());
+    assert_eq!(bytes[50..54], 0.0f32.to_le_bytes());
+    assert_eq!(bytes[54..58], crc32fast::hash(&bytes[..54]).to_le_bytes());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn fingerprint_is_fnv1a_of_documented_bytes() {
+    let mesh = mesh_scene(&scene(0.0), 0.5).unwrap();
+    // FNV-1a 64 written out here (offset basis and prime from the FNV specification).
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    eat(&(mesh.len() as u64).to_le_bytes());
+    for (e, el) in mesh.elements.iter().enumerate() {
+        eat(&el.surface.to_le_bytes());
+        eat(&(el.corners().len() as u64).to_le_bytes());
+        for &c in el.corners() {
+            let v = mesh.vertices[c as usize];
+            for x in [v.x, v.y, v.z] {
+                eat(&x.to_bits().to_le_bytes());
+            }
+        }
+        eat(&el.area.to_bits().to_le_bytes());
+        assert_eq!(mesh.corner_positions(e).len(), el.corners().len());
+    }
+    assert_eq!(mesh_fingerprint(&mesh), h);
+    // Any geometric change changes it.
+    let moved = mesh_scene(&scene(1e-9), 0.5).unwrap();
+    assert_ne!(mesh_fingerprint(&moved), h);
+    let finer = mesh_scene(&scene(0.0), 0.25).unwrap();
+    assert_ne!(mesh_fingerprint(&finer), h);
+}
+
+#[test]
+fn flipped_data_byte_is_a_checksum_error() {
+    let dir = temp_dir("flip");
+    let (path, fp, _) = valid_file(&dir, 10);
+    let mut bytes = std::fs::read(&path).unwrap();
+    let data_start = 36 + METHOD.len();
+    bytes[data_start + 123] ^= 0x10;
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap_err();
+    assert!(
+        matches!(err, FormFactorFileError::ChecksumMismatch { .. }),
+        "{err}"
+    );
+    assert_names_file(&err, &path);
+    // The final checksum itself damaged: the same refusal.
+    bytes[data_start + 123] ^= 0x10;
+    let last = bytes.len() - 1;
+    bytes[last] ^= 1;
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap_err();
+    assert!(
+        matches!(err, FormFactorFileError::ChecksumMismatch { .. }),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn flipped_header_byte_is_a_corrupt_header() {
+    let dir = temp_dir("header");
+    let (path, fp, _) = valid_file(&dir, 10);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[25] ^= 0x01; // inside the method string
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    assert!(
+        matches!(err, FormFactorFileError::CorruptHeader { .. }),
+        "{err}"
+    );
+    assert_names_file(&err, &path);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn truncated_and_padded_files_are_refused() {
+    let dir = temp_dir("trunc");
+    let (path, fp, _) = valid_file(&dir, 10);
+    let bytes = std::fs::read(&path).unwrap();
+    for keep in [bytes.len() - 1, bytes.len() - 200, 40, 14] {
+        std::fs::write(&path, &bytes[..keep]).unwrap();
+        let err = read_form_factors(&path, fp, None).unwrap_err();
+        assert!(
+            matches!(err, FormFactorFileError::Truncated { .. }),
+            "{keep}: {err}"
+        );
+        assert_names_file(&err, &path);
+    }
+    let mut longer = bytes.clone();
+    longer.push(0);
+    std::fs::write(&path, &longer).unwrap();
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    assert!(
+        matches!(err, FormFactorFileError::TrailingBytes { extra: 1, .. }),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn different_mesh_is_stale() {
+    let dir = temp_dir("stale");
+    let (path, fp_file, _) = valid_file(&dir, 10);
+    let other = mesh_fingerprint(&mesh_scene(&scene(0.1), 0.5).unwrap());
+    let err = read_form_factors(&path, other, Some(METHOD_VALUE)).unwrap_err();
+    assert!(matches!(err, FormFactorFileError::Stale { .. }), "{err}");
+    let text = err.to_string();
+    assert!(text.contains("different mesh"), "{text}");
+    // Both fingerprints, and no command-line advice (the program adds its own).
+    assert!(text.contains(&format!("{fp_file:016x}")), "{text}");
+    assert!(text.contains(&format!("{other:016x}")), "{text}");
+    assert!(!text.contains("radiosity formfactors"), "{text}");
+    assert_names_file(&err, &path);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn different_method_is_refused() {
+    let dir = temp_dir("method");
+    let (path, fp, _) = valid_file(&dir, 4);
+    let other = FormFactorMethod::AreaIntegral { steps: 4 };
+    let err = read_form_factors(&path, fp, Some(other)).unwrap_err();
+    let FormFactorFileError::MethodMismatch {
+        found, expected, ..
+    } = &err
+    else {
+        panic!("{err}")
+    };
+    assert_eq!((*found, *expected), (METHOD_VALUE, other));
+    let text = err.to_string();
+    assert!(text.contains("`area k=2`, not `area k=4`"), "{text}");
+    assert_names_file(&err, &path);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn unparsable_method_tag_is_refused_naming_it() {
+    let dir = temp_dir("tag");
+    let mesh = mesh_scene(&scene(0.0), 0.5).unwrap();
+    let fp = mesh_fingerprint(&mesh);
+    let path = dir.join("ff.bin");
+    // Tags an older or newer writer might have left, and near misses of real ones.
+    for tag in [
+        "",
+        "area",
+        "area k=2 ",
+        "radiosity k=2",
+        "contour k=+2",
+        "gpu-hemicube",
+    ] {
+        write_form_factors(&path, &matrix(3), fp, tag).unwrap();
+        let err = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap_err();
+        let FormFactorFileError::UnknownMethod {
+            tag: found, source, ..
+        } = &err
+        else {
+            panic!("{tag:?}: {err}")
+        };
+        assert_eq!(found, tag);
+        assert_eq!(tag.parse::<FormFactorMethod>(), Err(*source.clone()));
+        let text = err.to_string();
+        assert!(text.contains(&format!("`{tag}`")), "{text}");
+        assert_names_file(&err, &path);
+        // Without a method to check, the tag is not looked at.
+        assert_eq!(read_form_factors(&path, fp, None).unwrap().n(), 3);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn garbage_is_not_a_form_factor_file() {
+    let dir = temp_dir("garbage");
+    let path = dir.join("scene.txt");
+    for content in [
+        &b"MAX_PATCH_AREA 0.1\nINTEGRAL_STEPS 2\n"[..],
+        b"",
+        b"RADFF",
+    ] {
+        std::fs::write(&path, content).unwrap();
+        let err = read_form_factors(&path, 0, None).unwrap_err();
+        assert!(
+            matches!(err, FormFactorFileError::NotFormFactorFile { .. }),
+            "{err}"
+        );
+        assert_names_file(&err, &path);
+    }
+    let err = read_form_factors(&dir.join("missing.bin"), 0, None).unwrap_err();
+    assert!(matches!(err, FormFactorFileError::Io { .. }), "{err}");
+    assert!(err.to_string().contains("missing.bin"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn newer_version_is_refused() {
+    let dir = temp_dir("version");
+    let (path, fp, _) = valid_file(&dir, 3);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[8..12].copy_from_slice(&2u32.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FormFactorFileError::UnsupportedVersion { version: 2, .. }
+        ),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn huge_n_is_refused_without_allocating() {
+    let dir = temp_dir("huge");
+    let path = dir.join("huge.bin");
+    // A header claiming n = 2^40 (4 * 2^80 bytes of data) or n = u64::MAX, with a valid
+    // header checksum, followed by a few bytes: only the length check can stop it, and a
+    // vec![0; n * n] would abort the test.
+    for n in [1u64 << 40, u64::MAX] {
+        let mut bytes = Vec::new();
+        bytes.extend_from_slice(&FORM_FACTOR_MAGIC);
+        bytes.extend_from_slice(&1u32.to_le_bytes());
+        bytes.extend_from_slice(&n.to_le_bytes());
+        bytes.extend_from_slice(&0u32.to_le_bytes());
+        bytes.extend_from_slice(&42u64.to_le_bytes());
+        let crc = crc32fast::hash(&bytes);
+        bytes.extend_from_slice(&crc.to_le_bytes());
+        bytes.extend_from_slice(&[0u8; 64]);
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read_form_factors(&path, 42, None).unwrap_err();
+        let FormFactorFileError::Truncated { n: got, actual, .. } = err else {
+            panic!("{err}")
+        };
+        assert_eq!((got, actual), (n, bytes.len() as u64));
+    }
+    // A damaged n without a matching header checksum is a corrupt header.
+    let (path, fp, _) = valid_file(&dir, 5);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[19] = 0x7f;
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    assert!(
+        matches!(err, FormFactorFileError::CorruptHeader { .. }),
+        "{err}"
+    );
+    // A method length beyond the limit is refused before it is allocated.
+    bytes[19] = 0;
+    bytes[20..24].copy_from_slice(&u32::MAX.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    assert!(
+        matches!(err, FormFactorFileError::CorruptHeader { .. }),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn matrix_too_big_for_memory_is_refused() {
+    let dir = temp_dir("oom");
+    let (path, fp, _) = valid_file(&dir, 20);
+    // 20 x 20 f32 = 1600 bytes (1760 with headroom) do not fit in 1000.
+    let err = read_with_memory(&path, fp, None, 1000).unwrap_err();
+    let FormFactorFileError::OutOfMemory { source, .. } = &err else {
+        panic!("{err}")
+    };
+    assert_eq!(source.n, 20);
+    assert_names_file(&err, &path);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
