@@ -9,6 +9,7 @@ mod area;
 pub mod exact;
 mod file;
 mod hemicube;
+pub(crate) mod kernel;
 mod method;
 mod montecarlo;
 pub mod reference;

@@ -1,0 +1,154 @@
+//! Refinement: which node of a refined pair to split, breadth-first refinement of candidate
+//! pairs into links (estimates in parallel, splits in order), and a pass over all links
+//! with the current radiosity.
+
+use rayon::prelude::*;
+
+use super::link::Estimate;
+use super::solver::Solver;
+use crate::solve::SolveError;
+
+impl Solver<'_> {
+    /// Which of p and q to split for a refined link: Some(true) for p, Some(false) for q,
+    /// None when neither can be.
+    pub(super) fn split_choice(&self, p: u32, q: u32) -> Option<bool> {
+        let (np, nq) = (&self.nodes[p as usize], &self.nodes[q as usize]);
+        let min = self.settings.min_area;
+        let can_p = np.is_cluster() || np.area > min;
+        let can_q = nq.is_cluster() || nq.area > min;
+        if can_p && (!can_q || np.radius >= nq.radius) {
+            Some(true)
+        } else if can_q {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
+    /// Refines the candidate pairs (p, q) breadth first until the oracle is satisfied,
+    /// storing the resulting links (estimates in parallel, splits in order); returns whether
+    /// anything was split.
+    pub(super) fn refine(
+        &mut self,
+        mut frontier: Vec<(u32, u32)>,
+        b_ref: f64,
+    ) -> Result<bool, SolveError> {
+        let mut split = false;
+        while !frontier.is_empty() {
+            let used = self.memory_bytes();
+            if used > self.memory_limit {
+                return Err(SolveError::HierarchicalTooBig {
+                    used_mib: used >> 20,
+                    limit_mib: self.memory_limit >> 20,
+                    nodes: self.nodes.len(),
+                    links: self.link_count,
+                });
+            }
+            // A cluster's link to itself becomes the links between its children.
+            let mut pairs = Vec::with_capacity(frontier.len());
+            for &(p, q) in &frontier {
+                if p == q {
+                    let node = &self.nodes[p as usize];
+                    if node.is_cluster() {
+                        for &a in node.children() {
+                            for &b in node.children() {
+                                pairs.push((a, b));
+                            }
+                        }
+                    }
+                } else {
+                    pairs.push((p, q));
+                }
+            }
+            let this = &*self;
+            let estimates: Vec<Estimate> = pairs
+                .par_iter()
+                .map_init(Vec::new, |scratch, &(p, q)| {
+                    if p == q {
+                        // Expanded again next time round (a child cluster's self-link).
+                        Estimate::TooClose
+                    } else {
+                        this.estimate(p, q, b_ref, scratch)
+                    }
+                })
+                .collect();
+            let mut next = Vec::new();
+            for (&(p, q), estimate) in pairs.iter().zip(estimates) {
+                let link = match estimate {
+                    Estimate::Nothing => continue,
+                    Estimate::TooClose => {
+                        if p == q {
+                            next.push((p, q));
+                            continue;
+                        }
+                        None
+                    }
+                    Estimate::Link(link, rays) => {
+                        self.rays += rays;
+                        Some(link)
+                    }
+                    Estimate::Refine => None,
+                };
+                let refine = match &link {
+                    None => true,
+                    Some(link) => self.wants_refining(p, link, b_ref),
+                };
+                let choice = if refine {
+                    self.split_choice(p, q)
+                } else {
+                    None
+                };
+                match (choice, link) {
+                    (Some(split_p), _) => {
+                        split = true;
+                        let (node, other) = if split_p { (p, q) } else { (q, p) };
+                        let children: Vec<u32> = if self.nodes[node as usize].is_cluster() {
+                            self.nodes[node as usize].children().to_vec()
+                        } else {
+                            self.split_patch(node)
+                        };
+                        for c in children {
+                            next.push(if split_p { (c, other) } else { (other, c) });
+                        }
+                    }
+                    (None, Some(link)) => {
+                        self.link_count += 1;
+                        self.nodes[p as usize].links.push(link);
+                    }
+                    (None, None) => {
+                        unreachable!("a pair without a link is one that can be split")
+                    }
+                }
+            }
+            frontier = next;
+        }
+        Ok(split)
+    }
+
+    /// One refinement pass over all links with the current B; returns the links refined.
+    pub(super) fn refine_all(&mut self, b_ref: f64) -> Result<usize, SolveError> {
+        let mut pairs = Vec::new();
+        for p in 0..self.nodes.len() {
+            let links = std::mem::take(&mut self.nodes[p].links);
+            let mut kept = Vec::with_capacity(links.len());
+            for link in links {
+                if self.wants_refining(p as u32, &link, b_ref)
+                    && self.split_choice(p as u32, link.source).is_some()
+                {
+                    pairs.push((p as u32, link.source));
+                } else {
+                    kept.push(link);
+                }
+            }
+            self.nodes[p].links = kept;
+        }
+        let refined = pairs.len();
+        self.link_count -= refined;
+        if refined > 0 {
+            // The pairs are estimated again (cheap next to their children) so that `refine`
+            // handles them like any candidate.
+            self.refine(pairs, b_ref)?;
+        }
+        Ok(refined)
+    }
+}

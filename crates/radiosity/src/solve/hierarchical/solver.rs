@@ -1,0 +1,53 @@
+//! The solver's state: the nodes (quadtree patches and clusters) with the links they hold,
+//! every node's radiosity, the input surfaces' normals, reflectances and emissions, the
+//! counts a report gives, and the memory all of it holds. Its methods live beside the steps
+//! they make (tree, link, oracle, visibility, refine, sweep).
+
+use glam::DVec3;
+
+use super::link::Link;
+use super::tree::{Cluster, Node, CLUSTER_SAMPLES};
+use super::HierarchicalSettings;
+use crate::visibility::PolygonBvh;
+
+/// The largest of three bands.
+pub(super) fn max3(v: [f64; 3]) -> f64 {
+    v[0].max(v[1]).max(v[2])
+}
+
+/// Everything a hierarchical solve holds.
+pub(super) struct Solver<'a> {
+    pub(super) nodes: Vec<Node>,
+    /// Area-averaged radiosity of every node (apart from the nodes: the sweeps read it at
+    /// random).
+    pub(super) b: Vec<[f64; 3]>,
+    /// Smallest and largest radiosity (largest band) of the leaves under every patch.
+    pub(super) b_span: Vec<(f64, f64)>,
+    /// Cluster index of every node, NONE for patches.
+    pub(super) cluster_of: Vec<u32>,
+    pub(super) clusters: Vec<Cluster>,
+    /// Quadtree roots of each input surface.
+    pub(super) roots: Vec<Vec<u32>>,
+    pub(super) top: u32,
+    /// Nodes 0..root_count are the roots; cluster c is node root_count + c.
+    pub(super) root_count: usize,
+    pub(super) normal: Vec<DVec3>,
+    pub(super) rho: Vec<[f64; 3]>,
+    pub(super) emission: Vec<[f64; 3]>,
+    pub(super) occluders: &'a PolygonBvh,
+    pub(super) settings: HierarchicalSettings,
+    pub(super) rays: u64,
+    /// Links held by all nodes.
+    pub(super) link_count: usize,
+    /// Refinement stops with an error when [`Solver::memory_bytes`] passes this.
+    pub(super) memory_limit: u64,
+}
+
+impl Solver<'_> {
+    /// Bytes held by nodes, clusters and links (links with the slack of their vectors).
+    pub(super) fn memory_bytes(&self) -> u64 {
+        (self.nodes.len() * (std::mem::size_of::<Node>() + 28)
+            + self.clusters.len() * (std::mem::size_of::<Cluster>() + CLUSTER_SAMPLES * 48)
+            + self.link_count * std::mem::size_of::<Link>() * 3 / 2) as u64
+    }
+}

@@ -1,0 +1,307 @@
+//! The hierarchy: a quadtree of patches over every input surface (split along the mesh's
+//! grid lines where a patch spans several of its cells, else at midpoints) and the binary
+//! tree of clusters above their roots, with their nodes and how the leaves under a node are
+//! found.
+
+use glam::DVec3;
+
+use super::bins::bin;
+use super::link::Link;
+use super::solver::{max3, Solver};
+use crate::form_factor::kernel::quarter_points;
+use crate::geometry;
+
+/// No node index.
+pub(super) const NONE: u32 = u32::MAX;
+/// Sample points kept per cluster for visibility.
+pub(super) const CLUSTER_SAMPLES: usize = 8;
+
+/// A node: a patch of a surface's quadtree, or a cluster.
+#[derive(Clone, Debug)]
+pub(super) struct Node {
+    /// Input surface of a patch; NONE for a cluster.
+    pub(super) surface: u32,
+    /// Index into `Solver::clusters`; NONE for a patch.
+    pub(super) cluster: u32,
+    /// Corners of a patch (3 or 4).
+    pub(super) count: u8,
+    pub(super) children: [u32; 4],
+    pub(super) child_count: u8,
+    /// The cells of the scene's mesh across a patch (see [`crate::mesh::grid_of`]): [cu, cv]
+    /// for a quadrilateral, [m, 0] for a triangle cut into m^2; [0, 0] for a patch smaller
+    /// than one cell or off the mesh's lattice.
+    pub(super) grid: [u32; 2],
+    pub(super) corners: [DVec3; 4],
+    pub(super) centre: DVec3,
+    pub(super) radius: f64,
+    pub(super) area: f64,
+    pub(super) links: Vec<Link>,
+    /// A patch's gathered irradiance.
+    pub(super) gathered: [f64; 3],
+}
+
+impl Node {
+    pub(super) fn polygon(&self) -> &[DVec3] {
+        &self.corners[..self.count as usize]
+    }
+    pub(super) fn is_cluster(&self) -> bool {
+        self.cluster != NONE
+    }
+    pub(super) fn children(&self) -> &[u32] {
+        &self.children[..self.child_count as usize]
+    }
+}
+
+/// What a cluster node keeps beyond [`Node`]: its box, bounds for the oracle, its bins and
+/// its sample points.
+#[derive(Clone, Debug)]
+pub(super) struct Cluster {
+    pub(super) lo: DVec3,
+    pub(super) hi: DVec3,
+    /// Largest reflectance of any band of any patch inside.
+    pub(super) rho: f64,
+    /// Area bins: sum over its patches of A max(0, ±n_k).
+    pub(super) area_bins: [f64; 6],
+    /// Power bins per band (see the module documentation of [`super`]).
+    pub(super) power: [[f64; 6]; 3],
+    /// Largest radiosity (largest band) of its patches (root level): what the oracle uses,
+    /// as a cluster's mean hides a small bright light among dark surfaces.
+    pub(super) b_max: f64,
+    /// Gathered irradiance bins per band.
+    pub(super) incident: [[f64; 6]; 3],
+    /// Points on surfaces inside, with their normals, for visibility.
+    pub(super) samples: Vec<(DVec3, DVec3)>,
+}
+
+/// The midpoint of `a` and `b`.
+fn mid(a: DVec3, b: DVec3) -> DVec3 {
+    0.5 * (a + b)
+}
+
+impl Solver<'_> {
+    pub(super) fn new_patch(
+        &mut self,
+        surface: u32,
+        poly: &[DVec3],
+        grid: [u32; 2],
+        b: [f64; 3],
+    ) -> u32 {
+        let mut corners = [DVec3::ZERO; 4];
+        corners[..poly.len()].copy_from_slice(poly);
+        let centre = geometry::vertex_mean(poly);
+        let radius = poly.iter().map(|v| v.distance(centre)).fold(0.0, f64::max);
+        self.nodes.push(Node {
+            surface,
+            cluster: NONE,
+            count: poly.len() as u8,
+            children: [NONE; 4],
+            child_count: 0,
+            grid,
+            corners,
+            centre,
+            radius,
+            area: geometry::polygon_area(poly),
+            links: Vec::new(),
+            gathered: [0.0; 3],
+        });
+        self.b.push(b);
+        self.b_span.push((max3(b), max3(b)));
+        self.cluster_of.push(NONE);
+        self.nodes.len() as u32 - 1
+    }
+
+    /// Builds the cluster tree over `items` (patch roots); returns its top node.
+    pub(super) fn build_clusters(&mut self, items: &mut [u32]) -> u32 {
+        if items.len() == 1 {
+            return items[0];
+        }
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for &i in items.iter() {
+            let c = self.nodes[i as usize].centre;
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+        let axis = (hi - lo).max_position();
+        let half = items.len() / 2;
+        items.select_nth_unstable_by(half, |&a, &b| {
+            let (ca, cb) = (
+                self.nodes[a as usize].centre[axis],
+                self.nodes[b as usize].centre[axis],
+            );
+            ca.total_cmp(&cb).then(a.cmp(&b))
+        });
+        let (left, right) = items.split_at_mut(half);
+        let a = self.build_clusters(left);
+        let b = self.build_clusters(right);
+        // The cluster's box, area, reflectance and sample points from its two children.
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        let mut rho: f64 = 0.0;
+        let mut area = 0.0;
+        let mut samples = Vec::new();
+        let mut per_child = Vec::new();
+        let mut area_bins = [0.0; 6];
+        for c in [a, b] {
+            let n = &self.nodes[c as usize];
+            area += n.area;
+            if n.is_cluster() {
+                let cl = &self.clusters[n.cluster as usize];
+                for k in 0..6 {
+                    area_bins[k] += cl.area_bins[k];
+                }
+                lo = lo.min(cl.lo);
+                hi = hi.max(cl.hi);
+                rho = rho.max(cl.rho);
+                per_child.push(cl.samples.clone());
+            } else {
+                for &v in n.polygon() {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+                rho = rho.max(max3(self.rho[n.surface as usize]));
+                let m = self.normal[n.surface as usize];
+                for k in 0..3 {
+                    area_bins[bin(k, m[k])] += n.area * m[k].abs();
+                }
+                // The quarter points, not the centre: the centre of a large patch may lie
+                // under something standing on it (the Cornell box's floor centre is under
+                // the tall block), which would hide the whole cluster.
+                let m = self.normal[n.surface as usize];
+                per_child.push(quarter_points(n.polygon()).map(|x| (x, m)).to_vec());
+            }
+        }
+        for k in 0..CLUSTER_SAMPLES {
+            if let Some(&s) = per_child[k % 2].get(k / 2) {
+                samples.push(s);
+            }
+        }
+        let centre = 0.5 * (lo + hi);
+        self.clusters.push(Cluster {
+            lo,
+            hi,
+            rho,
+            area_bins,
+            b_max: 0.0,
+            power: [[0.0; 6]; 3],
+            incident: [[0.0; 6]; 3],
+            samples,
+        });
+        self.nodes.push(Node {
+            surface: NONE,
+            cluster: self.clusters.len() as u32 - 1,
+            count: 0,
+            children: [a, b, NONE, NONE],
+            child_count: 2,
+            grid: [0, 0],
+            corners: [DVec3::ZERO; 4],
+            centre,
+            radius: 0.5 * (hi - lo).length(),
+            area,
+            links: Vec::new(),
+            gathered: [0.0; 3],
+        });
+        self.b.push([0.0; 3]);
+        self.b_span.push((0.0, 0.0));
+        self.cluster_of.push(self.clusters.len() as u32 - 1);
+        self.nodes.len() as u32 - 1
+    }
+
+    /// The children of patch `n`, made on first use (they start with the parent's B).
+    ///
+    /// A patch that spans several cells of the scene's mesh splits along the grid lines
+    /// nearest its middle (four children; two, across its length, when it is twice as
+    /// many cells long as wide), so that every element of the mesh is a node of the
+    /// quadtree and the leaves nest with the mesh's elements (a leaf is a union of elements
+    /// or a piece of one); a triangle of m^2 cells with m even splits at its edge midpoints
+    /// into four of (m/2)^2. Below one cell, or off the lattice (a triangle of odd m), a
+    /// quadrilateral splits at its bilinear midpoints and a triangle at its edge midpoints.
+    pub(super) fn split_patch(&mut self, n: u32) -> Vec<u32> {
+        let node = &self.nodes[n as usize];
+        if node.child_count > 0 {
+            return node.children().to_vec();
+        }
+        let (surface, b) = (node.surface, self.b[n as usize]);
+        let p = node.corners;
+        let [cu, cv] = node.grid;
+        // (corners, grid) of each child.
+        let mut made: Vec<([DVec3; 4], [u32; 2])> = Vec::with_capacity(4);
+        if node.count == 4 {
+            let aligned = cu > 1 || cv > 1;
+            // Cuts in u and v: (parameter, cells before it) for each piece boundary. The
+            // mesh's cells are near square, so a patch twice as many cells long as wide is
+            // cut across its length only: children stay near square (an elongated patch
+            // has a large bounding sphere for its area, which the oracle and the near-pair
+            // test pay for).
+            let (split_u, split_v) = if cu >= 2 * cv {
+                (true, false)
+            } else if cv >= 2 * cu {
+                (false, true)
+            } else {
+                (cu > 1, cv > 1)
+            };
+            let cuts = |c: u32, split: bool| -> Vec<(f64, u32)> {
+                if !aligned {
+                    vec![(0.0, 0), (0.5, 0), (1.0, 0)]
+                } else if split {
+                    let h = c / 2;
+                    vec![(0.0, 0), (h as f64 / c as f64, h), (1.0, c)]
+                } else {
+                    vec![(0.0, 0), (1.0, c)]
+                }
+            };
+            let (us, vs) = (cuts(cu, split_u), cuts(cv, split_v));
+            for j in 0..vs.len() - 1 {
+                for i in 0..us.len() - 1 {
+                    let (u0, u1, v0, v1) = (us[i].0, us[i + 1].0, vs[j].0, vs[j + 1].0);
+                    let q = |u: f64, v: f64| crate::mesh::bilinear(&p, u, v);
+                    let grid = if aligned {
+                        [us[i + 1].1 - us[i].1, vs[j + 1].1 - vs[j].1]
+                    } else {
+                        [0, 0]
+                    };
+                    made.push(([q(u0, v0), q(u1, v0), q(u1, v1), q(u0, v1)], grid));
+                }
+            }
+        } else {
+            let (m01, m12, m20) = (mid(p[0], p[1]), mid(p[1], p[2]), mid(p[2], p[0]));
+            let z = DVec3::ZERO;
+            let grid = if cu >= 2 && cu % 2 == 0 {
+                [cu / 2, 0]
+            } else {
+                [0, 0]
+            };
+            for t in [
+                [p[0], m01, m20, z],
+                [m01, p[1], m12, z],
+                [m20, m12, p[2], z],
+                [m01, m12, m20, z],
+            ] {
+                made.push((t, grid));
+            }
+        }
+        let count = node.count as usize;
+        let children: Vec<u32> = made
+            .iter()
+            .map(|(poly, grid)| self.new_patch(surface, &poly[..count], *grid, b))
+            .collect();
+        let node = &mut self.nodes[n as usize];
+        node.children[..children.len()].copy_from_slice(&children);
+        node.child_count = children.len() as u8;
+        children
+    }
+
+    /// Roots are made first, surface by surface, before any cluster or child.
+    pub(super) fn is_root(&self, n: u32) -> bool {
+        (n as usize) < self.root_count
+    }
+
+    pub(super) fn leaves_of(&self, n: u32, out: &mut Vec<u32>) {
+        let node = &self.nodes[n as usize];
+        if node.child_count == 0 {
+            out.push(n);
+        } else {
+            for &k in node.children() {
+                self.leaves_of(k, out);
+            }
+        }
+    }
+}
