@@ -224,15 +224,6 @@ fn decide(prepared: &Prepared, choice: ViewSolver, progress: &Reporter) -> Solve
     }
 }
 
-/// A BVH over the elements of `mesh` (ids are element indices), for picking.
-fn element_bvh(mesh: &Mesh) -> Arc<PolygonBvh> {
-    let polygons: Vec<Vec<_>> = (0..mesh.len())
-        .map(|e| mesh.corner_positions(e).collect())
-        .collect();
-    let ids: Vec<u32> = (0..mesh.len() as u32).collect();
-    Arc::new(PolygonBvh::new(&polygons, &ids))
-}
-
 fn run(
     scene: Scene,
     overrides: Overrides,
@@ -244,7 +235,7 @@ fn run(
     let mut prepared = Prepared::new(scene, overrides, progress).map_err(|e| e.to_string())?;
     send(Update::Mesh(
         prepared.mesh.clone(),
-        element_bvh(&prepared.mesh),
+        Arc::new(PolygonBvh::over_elements(&prepared.mesh)),
     ));
     let n = prepared.mesh.len();
     let solver = decide(&prepared, choice, progress);
@@ -350,7 +341,7 @@ fn run(
                 // their radiosity.
                 send(Update::Mesh(
                     solution.mesh.clone(),
-                    element_bvh(&solution.mesh),
+                    Arc::new(PolygonBvh::over_elements(&solution.mesh)),
                 ));
                 format!(
                     "{} leaves, hierarchical radiosity in {seconds:.1} s (edits re-run it)",
