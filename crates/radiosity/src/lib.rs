@@ -15,12 +15,45 @@
 //! * [`visibility`]: BVH ray queries over triangles (occlusion and closest hit).
 //! * [`form_factor`]: form factors F_ij (paper 1.2, 2.3) and their file format (paper 2.8).
 //! * [`light`]: the RGB type of radiosity, emission and reflectance, checked per element.
-//! * [`solve`]: (I - rho F) B = E per band, by LU or Gauss-Seidel (paper figure 6).
+//! * [`solve`]: (I - rho F) B = E per band: [`Solver`] names every solver with its
+//!   settings (dense LU or Gauss-Seidel, paper figure 6; progressive refinement;
+//!   hierarchical radiosity).
+//! * [`pipeline`]: a meshed scene ([`Prepared`]) and [`pipeline::solve`], the one entry
+//!   point that takes any [`Solver`] and returns a [`Solution`] on its own mesh.
 //! * [`shade`]: vertex radiosities for smooth shading (paper 2.5).
 //! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7), PNG
 //!   images.
 //! * [`progress`]: the one interface long work reports through.
 //! * [`solution`]: the per-element solution as CSV or JSON.
+//!
+//! The whole chain, from the built-in Cornell box to an image:
+//!
+//! ```
+//! use radiosity::progress::NoProgress;
+//! use radiosity::render::{self, Camera, RenderSettings, Renderer};
+//! use radiosity::shade::{self, Exposure};
+//! use radiosity::{pipeline, Overrides, Prepared, SolveRequest, Solver};
+//!
+//! // A coarse mesh keeps the example quick.
+//! let coarse = Overrides { max_patch_area: Some(20_000.0), integral_steps: Some(1) };
+//! let prepared = Prepared::new(radiosity::scene::cornell_box(), coarse, &NoProgress)?;
+//! let request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
+//! let solution = pipeline::solve(&prepared, &request, &mut radiosity::solve::keep_going, &NoProgress)?;
+//! // Energy is conserved: what is emitted is absorbed or escapes (the box is closed but
+//! // for its open front).
+//! assert!(solution.balance.relative_error() < 1e-3);
+//!
+//! let b = solution.element_rgb();
+//! let vertex_b = shade::vertex_radiosity(&solution.mesh, b);
+//! let settings = RenderSettings {
+//!     exposure_scale: Exposure::Brightest.scale(&prepared.scene, &solution.mesh, b),
+//!     ..RenderSettings::default()
+//! };
+//! let camera = Camera::for_scene(&prepared.scene, 64, 64);
+//! let image = render::render(&Renderer::new(&solution.mesh), &camera, b, &vertex_b, &settings, &NoProgress);
+//! assert_eq!(image.dimensions(), (64, 64));
+//! # Ok::<(), radiosity::pipeline::PipelineError>(())
+//! ```
 //!
 //! Conventions used throughout: F_ij is the fraction of the energy leaving element i that
 //! arrives at element j; radiosity B and emission E are exitances in the scene's own units
@@ -43,3 +76,8 @@ pub mod solve;
 pub mod visibility;
 
 pub use atomic_write::write_atomically;
+
+pub use light::{ElementLight, Rgb};
+pub use pipeline::{FormFactors, Overrides, PipelineError, Prepared, Solution, SolveRequest};
+pub use scene::Scene;
+pub use solve::{DenseSolver, Radiosity, Solver, SolverKind};
