@@ -1,23 +1,11 @@
 //! `radiosity`: the command-line program. A thin layer over the `radiosity` library:
 //! parse the arguments, run the pipeline, report progress and timings.
 
-/// `eprintln!` that ignores a closed or failing stderr (a `| head` must not abort a run).
-macro_rules! errln {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), $($arg)*);
-    }};
-}
-
-/// `println!` that ignores a closed or failing stdout.
-macro_rules! outln {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
-    }};
-}
+#[macro_use]
+mod macros;
 
 mod errors;
+mod peak_memory;
 mod progress_bar;
 mod view;
 
@@ -44,6 +32,7 @@ use radiosity::solve::{
 };
 
 use errors::{describe, hint};
+use peak_memory::{peak_memory_bytes, reset_peak_memory};
 use progress_bar::{format_duration, Reporter};
 
 /// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
@@ -895,20 +884,6 @@ fn solve_command(args: SolveArgs) -> Result<()> {
     ));
     reporter.print_timings();
     Ok(())
-}
-
-/// Resets the process's peak resident memory (Linux: `/proc/self/clear_refs`), so that
-/// [`peak_memory_bytes`] measures from now; false where that is not possible.
-fn reset_peak_memory() -> bool {
-    std::fs::write("/proc/self/clear_refs", "5").is_ok()
-}
-
-/// The process's peak resident memory (VmHWM) in bytes, where the system reports it.
-fn peak_memory_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
 }
 
 fn mib(bytes: Option<u64>, reset: bool) -> String {
