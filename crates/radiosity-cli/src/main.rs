@@ -4,9 +4,11 @@
 #[macro_use]
 mod macros;
 
+mod args;
 mod errors;
 mod peak_memory;
 mod progress_bar;
+mod setup;
 mod view;
 
 use std::ops::ControlFlow;
@@ -14,26 +16,28 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, Parser, Subcommand, ValueEnum};
-use glam::DVec3;
+use clap::{Parser, Subcommand};
 use image::RgbImage;
-use radiosity::form_factor::{FormFactorMatrix, FormFactorMethod};
+use radiosity::form_factor::FormFactorMatrix;
 use radiosity::mesh::Mesh;
 use radiosity::pipeline::{
-    self as pipeline, FormFactorStats, FormFactors, Overrides, Prepared, Solution, SolutionReport,
+    self as pipeline, FormFactorStats, FormFactors, Prepared, Solution, SolutionReport,
     SolveRequest,
 };
 use radiosity::progress::{run_stage, Stage};
-use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
-use radiosity::scene::{self, Scene};
+use radiosity::render::{self, Camera, RenderSettings, Renderer};
+use radiosity::scene;
 use radiosity::shade::{self, Exposure};
-use radiosity::solve::{
-    keep_going, GaussSeidelSettings, Observer, ProgressiveSettings, Solver, SolverKind, Step,
-};
+use radiosity::solve::{keep_going, Observer, Solver, SolverKind, Step};
 
+use args::{
+    BenchArgs, BuildingArgs, CheckArgs, CompareArgs, FormFactorArgs, GenerateCommand, RenderArgs,
+    SceneArgs, SolveArgs, SolveOptions, ViewArgs,
+};
 use errors::{describe, hint};
 use peak_memory::{peak_memory_bytes, reset_peak_memory};
 use progress_bar::{format_duration, Reporter};
+use setup::{camera, parse_exposure, prepare, render_settings};
 
 /// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
 ///
@@ -66,308 +70,12 @@ enum Command {
     /// and the difference of element radiosity as a Markdown table row.
     Compare(CompareArgs),
     /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
-    View(view::ViewArgs),
+    View(ViewArgs),
     /// Generate a scene file procedurally.
     Generate {
         #[command(subcommand)]
         what: GenerateCommand,
     },
-}
-
-#[derive(Subcommand)]
-enum GenerateCommand {
-    /// A building: a grid of furnished rooms on one or more floors, joined by doors, lit by
-    /// a ceiling panel per room and daylight in every exterior window (metres).
-    Building(BuildingArgs),
-}
-
-#[derive(Args)]
-struct BuildingArgs {
-    /// Output scene file.
-    #[arg(short, long, value_name = "FILE")]
-    output: PathBuf,
-    /// Storeys.
-    #[arg(long, default_value_t = 2, value_name = "N")]
-    floors: u32,
-    /// Rooms along x on each floor.
-    #[arg(long, default_value_t = 6, value_name = "N")]
-    rooms_x: u32,
-    /// Rooms along z on each floor.
-    #[arg(long, default_value_t = 6, value_name = "N")]
-    rooms_z: u32,
-    /// Inner side of each square room (m; at least 5.7 with furniture).
-    #[arg(long, default_value_t = 6.0, value_name = "M")]
-    room_size: f64,
-    /// Floor-to-ceiling height (m).
-    #[arg(long, default_value_t = 2.7, value_name = "M")]
-    height: f64,
-    /// Empty rooms.
-    #[arg(long)]
-    no_furniture: bool,
-    /// Seed of door positions, window widths, furniture placement and colours.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// The scene's MAX_PATCH_AREA (m^2): 1 gives about 40,000 elements for the default
-    /// building, 0.0125 about a million.
-    #[arg(long, default_value_t = 1.0, value_name = "AREA")]
-    max_area: f64,
-    /// The scene's INTEGRAL_STEPS.
-    #[arg(long, default_value_t = 2, value_name = "K")]
-    steps: u32,
-    /// Exitance of the ceiling panels (W/m^2); windows emit 0.6 of it, bluish.
-    #[arg(long, default_value_t = 20.0, value_name = "E")]
-    light: f64,
-}
-
-/// Options every command shares.
-#[derive(Args)]
-struct SceneArgs {
-    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
-    scene: Option<PathBuf>,
-    /// Override the scene's MAX_PATCH_AREA (scene units squared).
-    #[arg(long, value_name = "AREA")]
-    max_area: Option<f64>,
-    /// Override the scene's INTEGRAL_STEPS (points along each axis of each element, for
-    /// the area method).
-    #[arg(long, value_name = "K")]
-    steps: Option<u32>,
-    #[command(flatten)]
-    method: MethodArgs,
-    /// No progress bars, timings or notes (errors are still printed).
-    #[arg(short, long)]
-    quiet: bool,
-}
-
-/// How form factors are computed.
-#[derive(Args, Clone)]
-struct MethodArgs {
-    /// Form-factor method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Area)]
-    method: MethodArg,
-    /// Hemicube resolution: cells across the top face.
-    #[arg(long, default_value_t = 128, value_name = "CELLS")]
-    resolution: u32,
-    /// Monte Carlo rays per element.
-    #[arg(long, default_value_t = 1024, value_name = "N")]
-    samples: u32,
-    /// Monte Carlo generator seed (the same seed gives the same numbers).
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-}
-
-/// Options of commands that solve.
-#[derive(Args)]
-struct SolveOptions {
-    /// Solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
-    solver: SolverArg,
-    /// Where the solver stops. Gauss-Seidel: the relative residual (default 1e-9).
-    /// Progressive: the unshot power as a fraction of the emitted power, in every band (the
-    /// convergence value of Cohen et al. 1988; default 0.01 = 1 %).
-    #[arg(long, value_name = "TOL")]
-    tolerance: Option<f64>,
-    /// Hierarchical: the BF refinement threshold, relative to the mean radiosity (smaller is
-    /// finer and slower).
-    #[arg(long, default_value_t = 0.05, value_name = "E")]
-    epsilon: f64,
-    /// Hierarchical: nodes of at most this area (scene units squared) are not split
-    /// (default: MAX_PATCH_AREA / 16).
-    #[arg(long, value_name = "AREA")]
-    min_area: Option<f64>,
-    /// Progressive: give up after this many shots.
-    #[arg(long, default_value_t = 1_000_000, value_name = "N")]
-    max_shots: usize,
-    /// Read form factors from this file (written by `radiosity formfactors`) instead of
-    /// computing them; refused if it was made for another mesh or method.
-    #[arg(long, value_name = "FILE")]
-    form_factors: Option<PathBuf>,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum MethodArg {
-    /// The paper's double area integral, INTEGRAL_STEPS^2 points per element, a ray per
-    /// point pair for occlusion.
-    Area,
-    /// Exact element-to-element form factors (the double contour integral); pairs that an
-    /// occluder may block are scaled by the visible fraction of INTEGRAL_STEPS^2 point pairs.
-    Contour,
-    /// Lambert's exact point-to-polygon form factor at INTEGRAL_STEPS^2 receiver points,
-    /// with rays to the source's points for occlusion.
-    Analytic,
-    /// Hemicube (Cohen and Greenberg 1985) rasterised on the CPU, --resolution; occlusion
-    /// by depth buffer.
-    Hemicube,
-    /// Stratified Monte Carlo ray casting, --samples rays per element, --seed; occlusion by
-    /// each ray's first hit.
-    Montecarlo,
-}
-
-/// `--solver`: the library's [`SolverKind`], its names and help as the library gives them.
-#[derive(Clone, Copy)]
-struct SolverArg(SolverKind);
-
-impl ValueEnum for SolverArg {
-    fn value_variants<'a>() -> &'a [Self] {
-        const ALL: [SolverArg; 5] = [
-            SolverArg(SolverKind::ALL[0]),
-            SolverArg(SolverKind::ALL[1]),
-            SolverArg(SolverKind::ALL[2]),
-            SolverArg(SolverKind::ALL[3]),
-            SolverArg(SolverKind::ALL[4]),
-        ];
-        &ALL
-    }
-
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.0.name()).help(self.0.help()))
-    }
-}
-
-impl std::fmt::Display for SolverArg {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.0.fmt(f)
-    }
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum ShadingArg {
-    /// Vertex radiosities interpolated across elements (paper plate 2).
-    Smooth,
-    /// One colour per element (paper plate 1).
-    Flat,
-    /// Element edges (paper plate 4).
-    Wireframe,
-}
-
-#[derive(Args)]
-struct RenderArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    #[command(flatten)]
-    solve: SolveOptions,
-    /// Output PNG (default: cornell.png for the built-in box, else the scene's name).
-    #[arg(short, long, value_name = "FILE")]
-    output: Option<PathBuf>,
-    /// Shading.
-    #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
-    shading: ShadingArg,
-    /// Gamma: displayed = value^(1/gamma) (paper 2.7).
-    #[arg(long, default_value_t = 2.2)]
-    gamma: f64,
-    /// Exposure: "auto" scales the brightest non-emitting element to white (the paper's
-    /// normalisation), a number multiplies radiosities by it.
-    #[arg(long, default_value = "auto")]
-    exposure: String,
-    /// Eye position "x,y,z" (default: the scene's camera, or one that frames the scene).
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    eye: Option<String>,
-    /// Point looked at "x,y,z".
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    look_at: Option<String>,
-    /// Up direction "x,y,z".
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    up: Option<String>,
-    /// Vertical field of view in degrees.
-    #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
-    fov: Option<f64>,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 512)]
-    width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 512)]
-    height: u32,
-    /// Rays per pixel along each axis: 2 or more antialiases edges (N^2 times the rays).
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    supersample: u32,
-    /// Progressive: write the picture as it converges to DIR/shot-00010.png and so on, every
-    /// --snapshot-every shots (with the ambient term added for display).
-    #[arg(long, value_name = "DIR")]
-    snapshots: Option<PathBuf>,
-    /// Progressive: shots between snapshots.
-    #[arg(long, default_value_t = 10, value_name = "N")]
-    snapshot_every: usize,
-}
-
-#[derive(Args)]
-struct FormFactorArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    /// Output file (default: the scene's name with .ff).
-    #[arg(short, long, value_name = "FILE")]
-    output: Option<PathBuf>,
-}
-
-#[derive(Args)]
-struct SolveArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    #[command(flatten)]
-    solve: SolveOptions,
-    /// Output file: CSV, or JSON when it ends in .json (default: the scene's name with .csv).
-    #[arg(short, long, value_name = "FILE")]
-    output: Option<PathBuf>,
-}
-
-#[derive(Args)]
-struct CheckArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    #[command(flatten)]
-    solve: SolveOptions,
-    /// Instead of checking a scene, print the accuracy table: every form-factor method
-    /// against closed forms (opposed and perpendicular squares, coaxial discs, a small
-    /// element under a rectangle), its row-sum error in a closed box, its reciprocity
-    /// error and its time, as Markdown.
-    #[arg(long)]
-    compare_methods: bool,
-}
-
-#[derive(Args)]
-struct CompareArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    #[command(flatten)]
-    solve: SolveOptions,
-    /// Only time the solver (no dense reference).
-    #[arg(long)]
-    no_reference: bool,
-}
-
-#[derive(Args)]
-struct BenchArgs {
-    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
-    scene: Option<PathBuf>,
-    #[command(flatten)]
-    method: MethodArgs,
-    /// MAX_PATCH_AREA values to time, one table row each (repeat the option or give several
-    /// values); the scene's own when omitted.
-    #[arg(long, value_name = "AREA", num_args = 1..)]
-    max_area: Vec<f64>,
-    /// Override the scene's INTEGRAL_STEPS.
-    #[arg(long, value_name = "K")]
-    steps: Option<u32>,
-    /// Runs per configuration; the table shows the median of each column.
-    #[arg(long, default_value_t = 5, value_name = "N")]
-    repeat: usize,
-    /// Solver for (I - rho F) B = E.
-    #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
-    solver: SolverArg,
-    /// Where the solver stops (as for `render --tolerance`: 1e-9 residual for Gauss-Seidel,
-    /// 0.01 unshot for progressive).
-    #[arg(long, value_name = "TOL")]
-    tolerance: Option<f64>,
-    /// Image width and height in pixels.
-    #[arg(long, default_value_t = 512, value_name = "PIXELS")]
-    size: u32,
-    /// Rays per pixel along each axis (as `render --supersample`).
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    supersample: u32,
-    /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
-    #[arg(long, default_value_t = 0.05, value_name = "E")]
-    epsilon: f64,
-    /// Hierarchical: the minimum node area (as for `render --min-area`).
-    #[arg(long, value_name = "AREA")]
-    min_area: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -393,89 +101,6 @@ fn run(cli: Cli) -> Result<()> {
         Command::Generate {
             what: GenerateCommand::Building(args),
         } => generate_building(args),
-    }
-}
-
-/// The scene (from its file or built in), meshed, with a short name for default outputs.
-/// Refuses, before any work, a problem whose matrices would not fit in memory (for
-/// `solver`, or the form factors alone when `None`).
-fn prepare(
-    args: &SceneArgs,
-    options: Option<&SolveOptions>,
-    reporter: &Reporter,
-) -> Result<(Prepared, String, Option<Solver>)> {
-    let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
-    let overrides = Overrides {
-        max_patch_area: args.max_area,
-        integral_steps: args.steps,
-    };
-    if let Some(k) = args.steps {
-        if k == 0 {
-            bail!("--steps must be at least 1");
-        }
-    }
-    let mut prepared = Prepared::new(scene, overrides, reporter)?;
-    let m = &args.method;
-    let steps = prepared.scene.settings.integral_steps;
-    prepared.method = match m.method {
-        MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
-        MethodArg::Contour => FormFactorMethod::Contour { steps },
-        MethodArg::Analytic => FormFactorMethod::Analytic { steps },
-        MethodArg::Hemicube => {
-            if m.resolution < 2 || m.resolution > 16_384 {
-                bail!(
-                    "--resolution must be between 2 and 16384, got {}",
-                    m.resolution
-                );
-            }
-            FormFactorMethod::Hemicube {
-                resolution: m.resolution,
-            }
-        }
-        MethodArg::Montecarlo => {
-            if m.samples == 0 {
-                bail!("--samples must be at least 1");
-            }
-            FormFactorMethod::MonteCarlo {
-                samples: m.samples,
-                seed: m.seed,
-            }
-        }
-    };
-    let solver = match options {
-        Some(options) => Some(solver(
-            options,
-            prepared.mesh.len(),
-            prepared.scene.settings.max_patch_area,
-            reporter,
-        )?),
-        None => None,
-    };
-    prepared.check_memory(solver.as_ref())?;
-    reporter.note(&format!(
-        "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
-        stem,
-        prepared.scene.surfaces.len(),
-        prepared.mesh.len(),
-        prepared.scene.settings.max_patch_area,
-        prepared.scene.settings.integral_steps
-    ));
-    Ok((prepared, stem, solver))
-}
-
-fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
-    match path {
-        None => Ok((
-            run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
-            "cornell".to_string(),
-        )),
-        Some(path) => {
-            let scene = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
-            let stem = path
-                .file_stem()
-                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-            Ok((scene, stem))
-        }
     }
 }
 
@@ -516,82 +141,6 @@ fn note_form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter
         stats.reciprocity.max_relative,
         stats.reciprocity.total_relative
     ));
-}
-
-/// The solver the options ask for; `auto` is decided from the element count `n` and the
-/// memory available, and the choice and its reason are noted.
-fn solver(
-    options: &SolveOptions,
-    n: usize,
-    max_patch_area: f64,
-    reporter: &Reporter,
-) -> Result<Solver> {
-    if let Some(t) = options.tolerance {
-        if !(t > 0.0 && t.is_finite()) {
-            bail!("--tolerance must be a positive number, got {t}");
-        }
-    }
-    let choice = match options.solver.0 {
-        SolverKind::Auto if options.form_factors.is_some() => SolverKind::GaussSeidel,
-        SolverKind::Auto => {
-            let choice =
-                radiosity::solve::choose(n, radiosity::form_factor::available_memory_bytes());
-            reporter.note(&format!("solver auto: {choice}"));
-            choice.kind()
-        }
-        other => other,
-    };
-    Ok(match choice {
-        SolverKind::Auto => unreachable!("auto is resolved above"),
-        SolverKind::Lu => Solver::LU,
-        SolverKind::GaussSeidel => Solver::Dense(radiosity::solve::DenseSolver::GaussSeidel(
-            GaussSeidelSettings {
-                tolerance: options.tolerance.unwrap_or(1e-9),
-                ..GaussSeidelSettings::default()
-            },
-        )),
-        SolverKind::Progressive => {
-            if options.form_factors.is_some() {
-                bail!("--form-factors cannot be used with --solver progressive, which computes its rows as it shoots");
-            }
-            if options.max_shots == 0 {
-                bail!("--max-shots must be at least 1");
-            }
-            Solver::Progressive(ProgressiveSettings {
-                tolerance: options
-                    .tolerance
-                    .unwrap_or(radiosity::solve::DEFAULT_PROGRESSIVE_TOLERANCE),
-                max_shots: options.max_shots,
-            })
-        }
-        SolverKind::Hierarchical => {
-            if options.form_factors.is_some() {
-                bail!("--form-factors cannot be used with --solver hierarchical, which uses links, not a matrix");
-            }
-            let min_area = options.min_area.unwrap_or(max_patch_area / 16.0);
-            if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
-                bail!(
-                    "--epsilon must be a positive number, got {}",
-                    options.epsilon
-                );
-            }
-            if !(min_area > 0.0 && min_area.is_finite()) {
-                bail!("--min-area must be a positive number, got {min_area}");
-            }
-            let tolerance = options
-                .tolerance
-                .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
-            if !(tolerance > 0.0 && tolerance < 1.0) {
-                bail!("--tolerance must be a number in (0, 1) for --solver hierarchical, got {tolerance}");
-            }
-            Solver::Hierarchical(radiosity::solve::HierarchicalSettings {
-                epsilon: options.epsilon,
-                min_area,
-                tolerance,
-                max_memory_bytes: None,
-            })
-        }
-    })
 }
 
 /// Solves with `solver`: the dense solvers on the form factors (read from `file` or
@@ -742,97 +291,6 @@ fn shade_and_render(
     };
     let renderer = Renderer::new(mesh);
     render::render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
-}
-
-fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
-    if let Some(out) = &args.output {
-        let png = out
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        if !png {
-            bail!(
-                "{}: only PNG images are written; give the output a .png name",
-                out.display()
-            );
-        }
-    }
-    if args.width == 0 || args.height == 0 {
-        bail!("--width and --height must be at least 1");
-    }
-    if (args.width as u64) * (args.height as u64) > 100_000_000 {
-        bail!(
-            "an image of {} x {} pixels is too large (at most 100 megapixels)",
-            args.width,
-            args.height
-        );
-    }
-    if !(args.gamma > 0.0 && args.gamma.is_finite()) {
-        bail!("--gamma must be a positive number, got {}", args.gamma);
-    }
-    if args.supersample == 0 || args.supersample > 16 {
-        bail!("--supersample must be between 1 and 16");
-    }
-    let shading = match args.shading {
-        ShadingArg::Smooth => Shading::Smooth,
-        ShadingArg::Flat => Shading::Flat,
-        ShadingArg::Wireframe => Shading::Wireframe,
-    };
-    Ok(RenderSettings {
-        shading,
-        gamma: args.gamma,
-        supersample: args.supersample,
-        ..RenderSettings::default()
-    })
-}
-
-fn parse_exposure(text: &str) -> Result<Exposure> {
-    if text.eq_ignore_ascii_case("auto") {
-        return Ok(Exposure::Brightest);
-    }
-    match text.parse::<f64>() {
-        Ok(s) if s > 0.0 && s.is_finite() => Ok(Exposure::Fixed(s)),
-        _ => bail!("--exposure must be \"auto\" or a positive number, got \"{text}\""),
-    }
-}
-
-fn parse_vec3(name: &str, text: &str) -> Result<DVec3> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f64> = parts
-        .iter()
-        .filter_map(|p| p.parse::<f64>().ok())
-        .filter(|v| v.is_finite())
-        .collect();
-    if parts.len() != 3 || values.len() != 3 {
-        bail!("--{name} expects three numbers \"x,y,z\", got \"{text}\"");
-    }
-    Ok(DVec3::new(values[0], values[1], values[2]))
-}
-
-fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
-    let mut camera = Camera::for_scene(scene, args.width, args.height);
-    if let Some(eye) = &args.eye {
-        camera.eye = parse_vec3("eye", eye)?;
-    }
-    if let Some(at) = &args.look_at {
-        camera.look_at = parse_vec3("look-at", at)?;
-    }
-    if let Some(up) = &args.up {
-        camera.up = parse_vec3("up", up)?;
-    }
-    if let Some(fov) = args.fov {
-        if !(fov > 0.0 && fov < 180.0) {
-            bail!("--fov must be between 0 and 180 degrees, got {fov}");
-        }
-        camera.fov_y_degrees = fov;
-    }
-    let forward = camera.look_at - camera.eye;
-    if forward.length() == 0.0 {
-        bail!("--eye and --look-at must differ");
-    }
-    if forward.cross(camera.up).length() <= 1e-12 * forward.length() * camera.up.length() {
-        bail!("--up must not be parallel to the viewing direction (or zero)");
-    }
-    Ok(camera)
 }
 
 fn formfactors_command(args: FormFactorArgs) -> Result<()> {

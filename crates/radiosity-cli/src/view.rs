@@ -1,79 +1,8 @@
 //! `radiosity view`: the walkthrough window and modeller (crate `radiosity-viewer`, cargo
 //! feature `viewer`, on by default).
 
-use std::path::PathBuf;
-
+use crate::args::ViewArgs;
 use anyhow::Result;
-use clap::Args;
-
-/// Options of `radiosity view`.
-#[derive(Args)]
-#[cfg_attr(not(feature = "viewer"), allow(dead_code))]
-pub struct ViewArgs {
-    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
-    scene: Option<PathBuf>,
-    /// Override the scene's MAX_PATCH_AREA (scene units squared).
-    #[arg(long, value_name = "AREA")]
-    max_area: Option<f64>,
-    /// Override the scene's INTEGRAL_STEPS.
-    #[arg(long, value_name = "K")]
-    steps: Option<u32>,
-    /// Always solve by progressive refinement (no form-factor matrix; colour edits re-run
-    /// it). By default the dense solve is used up to 6,000 elements (see --dense).
-    #[arg(long, conflicts_with = "dense")]
-    progressive: bool,
-    /// Compute the dense form-factor matrix whenever it fits (up to 20,000 elements), so
-    /// edits are quick re-solves; by default only up to 6,000 elements, beyond which
-    /// progressive refinement shows light sooner.
-    #[arg(long)]
-    dense: bool,
-    /// The solver: auto (the two options above decide), dense or gauss-seidel (Gauss-Seidel
-    /// on the cached matrix when it fits), lu, progressive, hierarchical (hierarchical
-    /// radiosity with clustering, --epsilon, --min-area; the window shows its leaves and an
-    /// edit re-runs it).
-    #[arg(long, value_name = "SOLVER", default_value = "auto", conflicts_with_all = ["dense", "progressive"])]
-    solver: String,
-    /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
-    #[arg(long, default_value_t = 0.05, value_name = "E")]
-    epsilon: f64,
-    /// Hierarchical: the minimum node area (default: MAX_PATCH_AREA / 16).
-    #[arg(long, value_name = "AREA")]
-    min_area: Option<f64>,
-    /// Open the window, draw `--frames` frames of the solved scene, save the window to this
-    /// PNG and exit.
-    #[arg(long, value_name = "FILE")]
-    screenshot: Option<PathBuf>,
-    /// Frames drawn before `--screenshot`.
-    #[arg(long, default_value_t = 30, value_name = "N")]
-    frames: u32,
-    /// Show the modeller panel in the `--screenshot` (the window always shows it otherwise).
-    #[arg(long)]
-    panel: bool,
-    /// The shading the window starts with: smooth, flat or wireframe.
-    #[arg(long, default_value = "smooth", value_name = "MODE")]
-    shading: String,
-    /// Select the first surface whose name starts with this (as a click on it would).
-    #[arg(long, value_name = "NAME")]
-    select: Option<String>,
-    /// No window: measure frame time offscreen (Cornell box and a tiled scene of
-    /// `--bench-triangles`) and edit-to-picture time at `--bench-elements`, print Markdown.
-    #[arg(long)]
-    bench: bool,
-    /// Triangles of the large frame-time scene (0 skips it).
-    #[arg(long, default_value_t = 1_000_000, value_name = "N")]
-    bench_triangles: usize,
-    /// Element counts for edit-to-picture timing (comma-separated).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "1000,5000,20000",
-        value_name = "N,.."
-    )]
-    bench_elements: Vec<usize>,
-    /// Frames timed per scene.
-    #[arg(long, default_value_t = 30, value_name = "N")]
-    bench_frames: u32,
-}
 
 #[cfg(feature = "viewer")]
 pub fn view_command(args: ViewArgs) -> Result<()> {
