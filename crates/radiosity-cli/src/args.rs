@@ -1,4 +1,6 @@
-//! The command line's flags, first stage: what clap parses, as typed as clap can make it.
+//! The command line's flags, first stage: what clap parses, as typed as clap can make it
+//! (the value parsers at the end turn "x,y,z", "auto" and the like into the library's
+//! types, so that a bad value is refused, with its flag named, before any work).
 //! The second stage, [`crate::setup`], turns them into the library's objects (a
 //! [`radiosity::pipeline::Prepared`] scene, a [`radiosity::solve::Solver`], a camera...)
 //! and checks what depends on more than one flag.
@@ -6,6 +8,9 @@
 use std::path::PathBuf;
 
 use clap::{Args, Subcommand, ValueEnum};
+use glam::DVec3;
+use radiosity::render::Shading;
+use radiosity::shade::Exposure;
 use radiosity::solve::SolverKind;
 
 #[derive(Subcommand)]
@@ -190,17 +195,17 @@ pub struct RenderArgs {
     pub gamma: f64,
     /// Exposure: "auto" scales the brightest non-emitting element to white (the paper's
     /// normalisation), a number multiplies radiosities by it.
-    #[arg(long, default_value = "auto")]
-    pub exposure: String,
+    #[arg(long, default_value = "auto", value_parser = parse_exposure)]
+    pub exposure: Exposure,
     /// Eye position "x,y,z" (default: the scene's camera, or one that frames the scene).
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    pub eye: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
+    pub eye: Option<DVec3>,
     /// Point looked at "x,y,z".
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    pub look_at: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
+    pub look_at: Option<DVec3>,
     /// Up direction "x,y,z".
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    pub up: Option<String>,
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
+    pub up: Option<DVec3>,
     /// Vertical field of view in degrees.
     #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
     pub fov: Option<f64>,
@@ -329,8 +334,14 @@ pub struct ViewArgs {
     /// on the cached matrix when it fits), lu, progressive, hierarchical (hierarchical
     /// radiosity with clustering, --epsilon, --min-area; the window shows its leaves and an
     /// edit re-runs it).
-    #[arg(long, value_name = "SOLVER", default_value = "auto", conflicts_with_all = ["dense", "progressive"])]
-    pub solver: String,
+    #[arg(
+        long,
+        value_name = "SOLVER",
+        default_value = "auto",
+        conflicts_with_all = ["dense", "progressive"],
+        value_parser = parse_view_solver
+    )]
+    pub solver: SolverKind,
     /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
     #[arg(long, default_value_t = 0.05, value_name = "E")]
     pub epsilon: f64,
@@ -348,8 +359,8 @@ pub struct ViewArgs {
     #[arg(long)]
     pub panel: bool,
     /// The shading the window starts with: smooth, flat or wireframe.
-    #[arg(long, default_value = "smooth", value_name = "MODE")]
-    pub shading: String,
+    #[arg(long, default_value = "smooth", value_name = "MODE", value_parser = parse_shading)]
+    pub shading: Shading,
     /// Select the first surface whose name starts with this (as a click on it would).
     #[arg(long, value_name = "NAME")]
     pub select: Option<String>,
@@ -371,4 +382,90 @@ pub struct ViewArgs {
     /// Frames timed per scene.
     #[arg(long, default_value_t = 30, value_name = "N")]
     pub bench_frames: u32,
+}
+
+// Value parsers. clap names the flag and the value in its message ("invalid value '1,2'
+// for '--eye <X,Y,Z>': ..."); these say what was expected.
+
+/// `--eye`, `--look-at`, `--up`: three finite numbers "x,y,z".
+pub fn parse_vec3(text: &str) -> Result<DVec3, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Vec<f64> = parts
+        .iter()
+        .filter_map(|p| p.parse::<f64>().ok())
+        .filter(|v| v.is_finite())
+        .collect();
+    if parts.len() != 3 || values.len() != 3 {
+        return Err(format!("expected three numbers \"x,y,z\", got \"{text}\""));
+    }
+    Ok(DVec3::new(values[0], values[1], values[2]))
+}
+
+/// `render --exposure`: "auto" (any case) or a positive number.
+pub fn parse_exposure(text: &str) -> Result<Exposure, String> {
+    if text.eq_ignore_ascii_case("auto") {
+        return Ok(Exposure::Brightest);
+    }
+    match text.parse::<f64>() {
+        Ok(s) if s > 0.0 && s.is_finite() => Ok(Exposure::Fixed(s)),
+        _ => Err(format!(
+            "expected \"auto\" or a positive number, got \"{text}\""
+        )),
+    }
+}
+
+/// `view --solver`: the library's solver names, and `dense`, the window's name for
+/// Gauss-Seidel on the cached matrix.
+pub fn parse_view_solver(text: &str) -> Result<SolverKind, String> {
+    match text {
+        "dense" => Ok(SolverKind::GaussSeidel),
+        name => name.parse::<SolverKind>().map_err(|e| e.to_string()),
+    }
+}
+
+/// `view --shading`: smooth, flat or wireframe.
+pub fn parse_shading(text: &str) -> Result<Shading, String> {
+    match text {
+        "smooth" => Ok(Shading::Smooth),
+        "flat" => Ok(Shading::Flat),
+        "wireframe" => Ok(Shading::Wireframe),
+        other => Err(format!(
+            "expected smooth, flat or wireframe, got \"{other}\""
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_are_three_finite_numbers() {
+        assert_eq!(parse_vec3("1, -2.5,3e1"), Ok(DVec3::new(1.0, -2.5, 30.0)));
+        for bad in ["1,2", "1,2,3,4", "1,x,3", "1,inf,3", "1,NaN,3", ""] {
+            let err = parse_vec3(bad).unwrap_err();
+            assert!(err.contains("three numbers") && err.contains(bad), "{err}");
+        }
+    }
+
+    #[test]
+    fn exposure_is_auto_or_a_positive_number() {
+        assert_eq!(parse_exposure("AUTO"), Ok(Exposure::Brightest));
+        assert_eq!(parse_exposure("2.5"), Ok(Exposure::Fixed(2.5)));
+        for bad in ["bright", "0", "-1", "inf"] {
+            let err = parse_exposure(bad).unwrap_err();
+            assert!(err.contains("\"auto\" or a positive number"), "{err}");
+        }
+    }
+
+    #[test]
+    fn view_solver_and_shading_names() {
+        assert_eq!(parse_view_solver("dense"), Ok(SolverKind::GaussSeidel));
+        assert_eq!(parse_view_solver("lu"), Ok(SolverKind::Lu));
+        assert!(parse_view_solver("fast")
+            .unwrap_err()
+            .contains("unknown solver"));
+        assert_eq!(parse_shading("flat"), Ok(Shading::Flat));
+        assert!(parse_shading("toon").unwrap_err().contains("wireframe"));
+    }
 }

@@ -37,7 +37,7 @@ use args::{
 use errors::{describe, hint};
 use peak_memory::{peak_memory_bytes, reset_peak_memory};
 use progress_bar::{format_duration, Reporter};
-use setup::{camera, parse_exposure, prepare, render_settings};
+use setup::{camera, prepare, render_settings};
 
 /// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
 ///
@@ -193,7 +193,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         bail!("--snapshots needs --solver progressive");
     }
     let camera = camera(&args, &prepared.scene)?;
-    let exposure = parse_exposure(&args.exposure)?;
+    let exposure = args.exposure;
     if let Some(dir) = &args.snapshots {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }

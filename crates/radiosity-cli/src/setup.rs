@@ -5,13 +5,11 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
-use glam::DVec3;
 use radiosity::form_factor::FormFactorMethod;
 use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{Camera, RenderSettings, Shading};
 use radiosity::scene::{self, Scene};
-use radiosity::shade::Exposure;
 use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
 
 use crate::args::{MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions};
@@ -217,39 +215,16 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     })
 }
 
-pub fn parse_exposure(text: &str) -> Result<Exposure> {
-    if text.eq_ignore_ascii_case("auto") {
-        return Ok(Exposure::Brightest);
-    }
-    match text.parse::<f64>() {
-        Ok(s) if s > 0.0 && s.is_finite() => Ok(Exposure::Fixed(s)),
-        _ => bail!("--exposure must be \"auto\" or a positive number, got \"{text}\""),
-    }
-}
-
-pub fn parse_vec3(name: &str, text: &str) -> Result<DVec3> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f64> = parts
-        .iter()
-        .filter_map(|p| p.parse::<f64>().ok())
-        .filter(|v| v.is_finite())
-        .collect();
-    if parts.len() != 3 || values.len() != 3 {
-        bail!("--{name} expects three numbers \"x,y,z\", got \"{text}\"");
-    }
-    Ok(DVec3::new(values[0], values[1], values[2]))
-}
-
 pub fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
     let mut camera = Camera::for_scene(scene, args.width, args.height);
-    if let Some(eye) = &args.eye {
-        camera.eye = parse_vec3("eye", eye)?;
+    if let Some(eye) = args.eye {
+        camera.eye = eye;
     }
-    if let Some(at) = &args.look_at {
-        camera.look_at = parse_vec3("look-at", at)?;
+    if let Some(at) = args.look_at {
+        camera.look_at = at;
     }
-    if let Some(up) = &args.up {
-        camera.up = parse_vec3("up", up)?;
+    if let Some(up) = args.up {
+        camera.up = up;
     }
     if let Some(fov) = args.fov {
         if !(fov > 0.0 && fov < 180.0) {

@@ -34,12 +34,8 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
         max_patch_area: args.max_area,
         integral_steps: args.steps,
     };
-    // `dense` is the window's name for Gauss-Seidel on the cached matrix; every other name
-    // is the library's.
-    let mut kind = match args.solver.as_str() {
-        "dense" => SolverKind::GaussSeidel,
-        name => name.parse::<SolverKind>()?,
-    };
+    // `--solver dense` arrives as Gauss-Seidel (on the cached matrix).
+    let mut kind = args.solver;
     if args.progressive {
         kind = SolverKind::Progressive;
     } else if args.dense {
@@ -68,12 +64,7 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
     options.frames = args.frames;
     options.panel = args.panel;
     options.select = args.select;
-    options.shading = match args.shading.as_str() {
-        "smooth" => radiosity::render::Shading::Smooth,
-        "flat" => radiosity::render::Shading::Flat,
-        "wireframe" => radiosity::render::Shading::Wireframe,
-        other => bail!("--shading must be smooth, flat or wireframe, got {other}"),
-    };
+    options.shading = args.shading;
     for note in radiosity_viewer::run(options)? {
         outln!("{note}");
     }
