@@ -5,7 +5,7 @@ use crate::args::ViewArgs;
 use anyhow::Result;
 
 #[cfg(feature = "viewer")]
-pub fn view_command(args: ViewArgs) -> Result<()> {
+pub fn run(args: ViewArgs) -> Result<()> {
     use anyhow::bail;
     use radiosity::pipeline::Overrides;
     use radiosity::solve::SolverKind;
@@ -72,7 +72,7 @@ pub fn view_command(args: ViewArgs) -> Result<()> {
 }
 
 #[cfg(not(feature = "viewer"))]
-pub fn view_command(_args: ViewArgs) -> Result<()> {
+pub fn run(_args: ViewArgs) -> Result<()> {
     anyhow::bail!(
         "this radiosity was built without the window (cargo feature `viewer`); rebuild with \
          `cargo build --release --features viewer` (it is on by default unless \
