@@ -1,0 +1,471 @@
+//! The command line's flags, first stage: what clap parses, as typed as clap can make it
+//! (the value parsers at the end turn "x,y,z", "auto" and the like into the library's
+//! types, so that a bad value is refused, with its flag named, before any work).
+//! The second stage, [`crate::setup`], turns them into the library's objects (a
+//! [`radiosity::pipeline::Prepared`] scene, a [`radiosity::solve::Solver`], a camera...)
+//! and checks what depends on more than one flag.
+
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand, ValueEnum};
+use glam::DVec3;
+use radiosity::render::Shading;
+use radiosity::shade::Exposure;
+use radiosity::solve::SolverKind;
+
+#[derive(Subcommand)]
+pub enum GenerateCommand {
+    /// A building: a grid of furnished rooms on one or more floors, joined by doors, lit by
+    /// a ceiling panel per room and daylight in every exterior window (metres).
+    Building(BuildingArgs),
+}
+
+#[derive(Args)]
+pub struct BuildingArgs {
+    /// Output scene file.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Storeys.
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    pub floors: u32,
+    /// Rooms along x on each floor.
+    #[arg(long, default_value_t = 6, value_name = "N")]
+    pub rooms_x: u32,
+    /// Rooms along z on each floor.
+    #[arg(long, default_value_t = 6, value_name = "N")]
+    pub rooms_z: u32,
+    /// Inner side of each square room (m; at least 5.7 with furniture).
+    #[arg(long, default_value_t = 6.0, value_name = "M")]
+    pub room_size: f64,
+    /// Floor-to-ceiling height (m).
+    #[arg(long, default_value_t = 2.7, value_name = "M")]
+    pub height: f64,
+    /// Empty rooms.
+    #[arg(long)]
+    pub no_furniture: bool,
+    /// Seed of door positions, window widths, furniture placement and colours.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// The scene's MAX_PATCH_AREA (m^2): 1 gives about 40,000 elements for the default
+    /// building, 0.0125 about a million.
+    #[arg(long, default_value_t = 1.0, value_name = "AREA")]
+    pub max_area: f64,
+    /// The scene's INTEGRAL_STEPS.
+    #[arg(long, default_value_t = 2, value_name = "K")]
+    pub steps: u32,
+    /// Exitance of the ceiling panels (W/m^2); windows emit 0.6 of it, bluish.
+    #[arg(long, default_value_t = 20.0, value_name = "E")]
+    pub light: f64,
+}
+
+/// Options every command shares.
+#[derive(Args)]
+pub struct SceneArgs {
+    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    pub scene: Option<PathBuf>,
+    /// Override the scene's MAX_PATCH_AREA (scene units squared).
+    #[arg(long, value_name = "AREA")]
+    pub max_area: Option<f64>,
+    /// Override the scene's INTEGRAL_STEPS (points along each axis of each element, for
+    /// the area method).
+    #[arg(long, value_name = "K")]
+    pub steps: Option<u32>,
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// No progress bars, timings or notes (errors are still printed).
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// How form factors are computed.
+#[derive(Args, Clone)]
+pub struct MethodArgs {
+    /// Form-factor method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Area)]
+    pub method: MethodArg,
+    /// Hemicube resolution: cells across the top face.
+    #[arg(long, default_value_t = 128, value_name = "CELLS")]
+    pub resolution: u32,
+    /// Monte Carlo rays per element.
+    #[arg(long, default_value_t = 1024, value_name = "N")]
+    pub samples: u32,
+    /// Monte Carlo generator seed (the same seed gives the same numbers).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+/// Options of commands that solve.
+#[derive(Args)]
+pub struct SolveOptions {
+    /// Solver for (I - rho F) B = E.
+    #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
+    pub solver: SolverArg,
+    /// Where the solver stops. Gauss-Seidel: the relative residual (default 1e-9).
+    /// Progressive: the unshot power as a fraction of the emitted power, in every band (the
+    /// convergence value of Cohen et al. 1988; default 0.01 = 1 %).
+    #[arg(long, value_name = "TOL")]
+    pub tolerance: Option<f64>,
+    /// Hierarchical: the BF refinement threshold, relative to the mean radiosity (smaller is
+    /// finer and slower).
+    #[arg(long, default_value_t = 0.05, value_name = "E")]
+    pub epsilon: f64,
+    /// Hierarchical: nodes of at most this area (scene units squared) are not split
+    /// (default: MAX_PATCH_AREA / 16).
+    #[arg(long, value_name = "AREA")]
+    pub min_area: Option<f64>,
+    /// Progressive: give up after this many shots.
+    #[arg(long, default_value_t = 1_000_000, value_name = "N")]
+    pub max_shots: usize,
+    /// Read form factors from this file (written by `radiosity formfactors`) instead of
+    /// computing them; refused if it was made for another mesh or method.
+    #[arg(long, value_name = "FILE")]
+    pub form_factors: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MethodArg {
+    /// The paper's double area integral, INTEGRAL_STEPS^2 points per element, a ray per
+    /// point pair for occlusion.
+    Area,
+    /// Exact element-to-element form factors (the double contour integral); pairs that an
+    /// occluder may block are scaled by the visible fraction of INTEGRAL_STEPS^2 point pairs.
+    Contour,
+    /// Lambert's exact point-to-polygon form factor at INTEGRAL_STEPS^2 receiver points,
+    /// with rays to the source's points for occlusion.
+    Analytic,
+    /// Hemicube (Cohen and Greenberg 1985) rasterised on the CPU, --resolution; occlusion
+    /// by depth buffer.
+    Hemicube,
+    /// Stratified Monte Carlo ray casting, --samples rays per element, --seed; occlusion by
+    /// each ray's first hit.
+    Montecarlo,
+}
+
+/// `--solver`: the library's [`SolverKind`], its names and help as the library gives them.
+#[derive(Clone, Copy)]
+pub struct SolverArg(pub SolverKind);
+
+impl ValueEnum for SolverArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        const ALL: [SolverArg; 5] = [
+            SolverArg(SolverKind::ALL[0]),
+            SolverArg(SolverKind::ALL[1]),
+            SolverArg(SolverKind::ALL[2]),
+            SolverArg(SolverKind::ALL[3]),
+            SolverArg(SolverKind::ALL[4]),
+        ];
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()).help(self.0.help()))
+    }
+}
+
+impl std::fmt::Display for SolverArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum ShadingArg {
+    /// Vertex radiosities interpolated across elements (paper plate 2).
+    Smooth,
+    /// One colour per element (paper plate 1).
+    Flat,
+    /// Element edges (paper plate 4).
+    Wireframe,
+}
+
+#[derive(Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveOptions,
+    /// Output PNG (default: cornell.png for the built-in box, else the scene's name).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Shading.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
+    pub shading: ShadingArg,
+    /// Gamma: displayed = value^(1/gamma) (paper 2.7).
+    #[arg(long, default_value_t = 2.2)]
+    pub gamma: f64,
+    /// Exposure: "auto" scales the brightest non-emitting element to white (the paper's
+    /// normalisation), a number multiplies radiosities by it.
+    #[arg(long, default_value = "auto", value_parser = parse_exposure)]
+    pub exposure: Exposure,
+    /// Eye position "x,y,z" (default: the scene's camera, or one that frames the scene).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
+    pub eye: Option<DVec3>,
+    /// Point looked at "x,y,z".
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
+    pub look_at: Option<DVec3>,
+    /// Up direction "x,y,z".
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
+    pub up: Option<DVec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
+    pub fov: Option<f64>,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512)]
+    pub width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512)]
+    pub height: u32,
+    /// Rays per pixel along each axis: 2 or more antialiases edges (N^2 times the rays).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub supersample: u32,
+    /// Progressive: write the picture as it converges to DIR/shot-00010.png and so on, every
+    /// --snapshot-every shots (with the ambient term added for display).
+    #[arg(long, value_name = "DIR")]
+    pub snapshots: Option<PathBuf>,
+    /// Progressive: shots between snapshots.
+    #[arg(long, default_value_t = 10, value_name = "N")]
+    pub snapshot_every: usize,
+}
+
+#[derive(Args)]
+pub struct FormFactorArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Output file (default: the scene's name with .ff).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct SolveArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveOptions,
+    /// Output file: CSV, or JSON when it ends in .json (default: the scene's name with .csv).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveOptions,
+    /// Instead of checking a scene, print the accuracy table: every form-factor method
+    /// against closed forms (opposed and perpendicular squares, coaxial discs, a small
+    /// element under a rectangle), its row-sum error in a closed box, its reciprocity
+    /// error and its time, as Markdown.
+    #[arg(long)]
+    pub compare_methods: bool,
+}
+
+#[derive(Args)]
+pub struct CompareArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveOptions,
+    /// Only time the solver (no dense reference).
+    #[arg(long)]
+    pub no_reference: bool,
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    pub scene: Option<PathBuf>,
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// MAX_PATCH_AREA values to time, one table row each (repeat the option or give several
+    /// values); the scene's own when omitted.
+    #[arg(long, value_name = "AREA", num_args = 1..)]
+    pub max_area: Vec<f64>,
+    /// Override the scene's INTEGRAL_STEPS.
+    #[arg(long, value_name = "K")]
+    pub steps: Option<u32>,
+    /// Runs per configuration; the table shows the median of each column.
+    #[arg(long, default_value_t = 5, value_name = "N")]
+    pub repeat: usize,
+    /// Solver for (I - rho F) B = E.
+    #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
+    pub solver: SolverArg,
+    /// Where the solver stops (as for `render --tolerance`: 1e-9 residual for Gauss-Seidel,
+    /// 0.01 unshot for progressive).
+    #[arg(long, value_name = "TOL")]
+    pub tolerance: Option<f64>,
+    /// Image width and height in pixels.
+    #[arg(long, default_value_t = 512, value_name = "PIXELS")]
+    pub size: u32,
+    /// Rays per pixel along each axis (as `render --supersample`).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub supersample: u32,
+    /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
+    #[arg(long, default_value_t = 0.05, value_name = "E")]
+    pub epsilon: f64,
+    /// Hierarchical: the minimum node area (as for `render --min-area`).
+    #[arg(long, value_name = "AREA")]
+    pub min_area: Option<f64>,
+}
+
+/// Options of `radiosity view`.
+#[derive(Args)]
+#[cfg_attr(not(feature = "viewer"), allow(dead_code))]
+pub struct ViewArgs {
+    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    pub scene: Option<PathBuf>,
+    /// Override the scene's MAX_PATCH_AREA (scene units squared).
+    #[arg(long, value_name = "AREA")]
+    pub max_area: Option<f64>,
+    /// Override the scene's INTEGRAL_STEPS.
+    #[arg(long, value_name = "K")]
+    pub steps: Option<u32>,
+    /// Always solve by progressive refinement (no form-factor matrix; colour edits re-run
+    /// it). By default the dense solve is used up to 6,000 elements (see --dense).
+    #[arg(long, conflicts_with = "dense")]
+    pub progressive: bool,
+    /// Compute the dense form-factor matrix whenever it fits (up to 20,000 elements), so
+    /// edits are quick re-solves; by default only up to 6,000 elements, beyond which
+    /// progressive refinement shows light sooner.
+    #[arg(long)]
+    pub dense: bool,
+    /// The solver: auto (the two options above decide), dense or gauss-seidel (Gauss-Seidel
+    /// on the cached matrix when it fits), lu, progressive, hierarchical (hierarchical
+    /// radiosity with clustering, --epsilon, --min-area; the window shows its leaves and an
+    /// edit re-runs it).
+    #[arg(
+        long,
+        value_name = "SOLVER",
+        default_value = "auto",
+        conflicts_with_all = ["dense", "progressive"],
+        value_parser = parse_view_solver
+    )]
+    pub solver: SolverKind,
+    /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
+    #[arg(long, default_value_t = 0.05, value_name = "E")]
+    pub epsilon: f64,
+    /// Hierarchical: the minimum node area (default: MAX_PATCH_AREA / 16).
+    #[arg(long, value_name = "AREA")]
+    pub min_area: Option<f64>,
+    /// Open the window, draw `--frames` frames of the solved scene, save the window to this
+    /// PNG and exit.
+    #[arg(long, value_name = "FILE")]
+    pub screenshot: Option<PathBuf>,
+    /// Frames drawn before `--screenshot`.
+    #[arg(long, default_value_t = 30, value_name = "N")]
+    pub frames: u32,
+    /// Show the modeller panel in the `--screenshot` (the window always shows it otherwise).
+    #[arg(long)]
+    pub panel: bool,
+    /// The shading the window starts with: smooth, flat or wireframe.
+    #[arg(long, default_value = "smooth", value_name = "MODE", value_parser = parse_shading)]
+    pub shading: Shading,
+    /// Select the first surface whose name starts with this (as a click on it would).
+    #[arg(long, value_name = "NAME")]
+    pub select: Option<String>,
+    /// No window: measure frame time offscreen (Cornell box and a tiled scene of
+    /// `--bench-triangles`) and edit-to-picture time at `--bench-elements`, print Markdown.
+    #[arg(long)]
+    pub bench: bool,
+    /// Triangles of the large frame-time scene (0 skips it).
+    #[arg(long, default_value_t = 1_000_000, value_name = "N")]
+    pub bench_triangles: usize,
+    /// Element counts for edit-to-picture timing (comma-separated).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1000,5000,20000",
+        value_name = "N,.."
+    )]
+    pub bench_elements: Vec<usize>,
+    /// Frames timed per scene.
+    #[arg(long, default_value_t = 30, value_name = "N")]
+    pub bench_frames: u32,
+}
+
+// Value parsers. clap names the flag and the value in its message ("invalid value '1,2'
+// for '--eye <X,Y,Z>': ..."); these say what was expected.
+
+/// `--eye`, `--look-at`, `--up`: three finite numbers "x,y,z".
+pub fn parse_vec3(text: &str) -> Result<DVec3, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Vec<f64> = parts
+        .iter()
+        .filter_map(|p| p.parse::<f64>().ok())
+        .filter(|v| v.is_finite())
+        .collect();
+    if parts.len() != 3 || values.len() != 3 {
+        return Err(format!("expected three numbers \"x,y,z\", got \"{text}\""));
+    }
+    Ok(DVec3::new(values[0], values[1], values[2]))
+}
+
+/// `render --exposure`: "auto" (any case) or a positive number.
+pub fn parse_exposure(text: &str) -> Result<Exposure, String> {
+    if text.eq_ignore_ascii_case("auto") {
+        return Ok(Exposure::Brightest);
+    }
+    match text.parse::<f64>() {
+        Ok(s) if s > 0.0 && s.is_finite() => Ok(Exposure::Fixed(s)),
+        _ => Err(format!(
+            "expected \"auto\" or a positive number, got \"{text}\""
+        )),
+    }
+}
+
+/// `view --solver`: the library's solver names, and `dense`, the window's name for
+/// Gauss-Seidel on the cached matrix.
+pub fn parse_view_solver(text: &str) -> Result<SolverKind, String> {
+    match text {
+        "dense" => Ok(SolverKind::GaussSeidel),
+        name => name.parse::<SolverKind>().map_err(|e| e.to_string()),
+    }
+}
+
+/// `view --shading`: smooth, flat or wireframe.
+pub fn parse_shading(text: &str) -> Result<Shading, String> {
+    match text {
+        "smooth" => Ok(Shading::Smooth),
+        "flat" => Ok(Shading::Flat),
+        "wireframe" => Ok(Shading::Wireframe),
+        other => Err(format!(
+            "expected smooth, flat or wireframe, got \"{other}\""
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_are_three_finite_numbers() {
+        assert_eq!(parse_vec3("1, -2.5,3e1"), Ok(DVec3::new(1.0, -2.5, 30.0)));
+        for bad in ["1,2", "1,2,3,4", "1,x,3", "1,inf,3", "1,NaN,3", ""] {
+            let err = parse_vec3(bad).unwrap_err();
+            assert!(err.contains("three numbers") && err.contains(bad), "{err}");
+        }
+    }
+
+    #[test]
+    fn exposure_is_auto_or_a_positive_number() {
+        assert_eq!(parse_exposure("AUTO"), Ok(Exposure::Brightest));
+        assert_eq!(parse_exposure("2.5"), Ok(Exposure::Fixed(2.5)));
+        for bad in ["bright", "0", "-1", "inf"] {
+            let err = parse_exposure(bad).unwrap_err();
+            assert!(err.contains("\"auto\" or a positive number"), "{err}");
+        }
+    }
+
+    #[test]
+    fn view_solver_and_shading_names() {
+        assert_eq!(parse_view_solver("dense"), Ok(SolverKind::GaussSeidel));
+        assert_eq!(parse_view_solver("lu"), Ok(SolverKind::Lu));
+        assert!(parse_view_solver("fast")
+            .unwrap_err()
+            .contains("unknown solver"));
+        assert_eq!(parse_shading("flat"), Ok(Shading::Flat));
+        assert!(parse_shading("toon").unwrap_err().contains("wireframe"));
+    }
+}

@@ -1,0 +1,197 @@
+//! `radiosity bench`: time every stage of the whole pipeline, the median of several runs.
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use radiosity::pipeline::SolutionReport;
+use radiosity::progress::Stage;
+use radiosity::render::{Camera, RenderSettings};
+use radiosity::shade::Exposure;
+use radiosity::solve::{keep_going, SolverKind};
+
+use super::{shade_and_render, solve_scene};
+use crate::args::{BenchArgs, SceneArgs, SolveOptions};
+use crate::progress_bar::Reporter;
+use crate::setup::prepare;
+
+pub fn run(args: BenchArgs) -> Result<()> {
+    if args.repeat == 0 {
+        bail!("--repeat must be at least 1");
+    }
+    if args.size == 0 || args.size > 10_000 {
+        bail!("--size must be between 1 and 10000");
+    }
+    if args.supersample == 0 || args.supersample > 16 {
+        bail!("--supersample must be between 1 and 16");
+    }
+    if let Some(&a) = args.max_area.iter().find(|a| !(**a > 0.0 && a.is_finite())) {
+        bail!("--max-area must be a positive number, got {a}");
+    }
+    let name = args
+        .scene
+        .as_deref()
+        .and_then(Path::file_name)
+        .map_or("cornell (built in)".to_string(), |s| {
+            s.to_string_lossy().into_owned()
+        });
+    let areas: Vec<Option<f64>> = if args.max_area.is_empty() {
+        vec![None]
+    } else {
+        args.max_area.iter().copied().map(Some).collect()
+    };
+    let solver_name = match args.solver.0 {
+        SolverKind::Auto => {
+            "auto (dense Gauss-Seidel up to 20,000 elements when it fits, else progressive)"
+        }
+        SolverKind::Lu => "LU",
+        SolverKind::GaussSeidel => "Gauss-Seidel",
+        SolverKind::Progressive => "progressive (form factors computed within the solve)",
+        SolverKind::Hierarchical => "hierarchical (links computed within the solve)",
+    };
+    errln!(
+        "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
+        args.repeat, args.size, args.supersample
+    );
+    outln!(
+        "| scene | max area | elements | k | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
+    );
+    outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for max_area in areas {
+        let runs = (0..args.repeat)
+            .map(|_| bench_run(&args, max_area))
+            .collect::<Result<Vec<_>>>()?;
+        let first = &runs[0];
+        if runs.iter().any(|r| r.rays != first.rays) {
+            errln!("note: the ray count differed between runs");
+        }
+        let stage = |k: usize| median(runs.iter().map(|r| r.stages[k]).collect());
+        let total = median(runs.iter().map(|r| r.total).collect());
+        let other = median(
+            runs.iter()
+                .map(|r| r.total - r.stages.iter().sum::<f64>())
+                .collect(),
+        );
+        let no_render = median(
+            runs.iter()
+                .map(|r| r.total - r.stages[BENCH_STAGES.len() - 1])
+                .collect(),
+        );
+        let ff = stage(3);
+        let area = max_area.map_or("scene's".to_string(), |a| a.to_string());
+        let stages: Vec<String> = (0..BENCH_STAGES.len()).map(|k| ms(stage(k))).collect();
+        outln!(
+            "| {name} | {area} | {} | {} | {} | {} | {} | {} | {} | {:.2} M |",
+            first.elements,
+            first.steps,
+            stages.join(" | "),
+            ms(other),
+            ms(total),
+            ms(no_render),
+            first.rays,
+            first.rays as f64 / ff.max(1e-9) / 1e6,
+        );
+    }
+    Ok(())
+}
+
+/// One timed run of the whole pipeline.
+struct BenchRun {
+    elements: usize,
+    steps: u32,
+    /// Seconds per stage, in the order of [`BENCH_STAGES`].
+    stages: [f64; BENCH_STAGES.len()],
+    /// Wall-clock seconds from before parsing to the rendered image.
+    total: f64,
+    rays: u64,
+}
+
+/// The stages a bench run reports, in pipeline order.
+const BENCH_STAGES: [Stage; 7] = [
+    Stage::Parse,
+    Stage::Mesh,
+    Stage::Bvh,
+    Stage::FormFactors,
+    Stage::Solve,
+    Stage::Shade,
+    Stage::Render,
+];
+
+fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
+    let scene_args = SceneArgs {
+        scene: args.scene.clone(),
+        max_area,
+        steps: args.steps,
+        method: args.method.clone(),
+        quiet: true,
+    };
+    let options = SolveOptions {
+        solver: args.solver,
+        tolerance: args.tolerance,
+        max_shots: 1_000_000,
+        form_factors: None,
+        epsilon: args.epsilon,
+        min_area: args.min_area,
+    };
+    let settings = RenderSettings {
+        supersample: args.supersample,
+        ..RenderSettings::default()
+    };
+    let reporter = Reporter::new(true);
+    let start = std::time::Instant::now();
+    let (prepared, _, solver) = prepare(&scene_args, Some(&options), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (solution, stats) = solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?;
+    let rays = match (&stats, &solution.report) {
+        (Some(s), _) => s.rays,
+        (None, SolutionReport::Progressive(r)) => r.rays,
+        (None, SolutionReport::Hierarchical(r)) => r.rays,
+        (None, _) => 0,
+    };
+    let camera = Camera::for_scene(&prepared.scene, args.size, args.size);
+    let image = shade_and_render(
+        &prepared,
+        &solution.mesh,
+        solution.element_rgb(),
+        &camera,
+        settings,
+        Exposure::Brightest,
+        &reporter,
+    );
+    let total = start.elapsed().as_secs_f64();
+    std::hint::black_box(image);
+    let mut stages = [0.0; BENCH_STAGES.len()];
+    for (stage, d) in reporter.timings() {
+        if let Some(k) = BENCH_STAGES.iter().position(|s| *s == stage) {
+            stages[k] += d.as_secs_f64();
+        }
+    }
+    Ok(BenchRun {
+        elements: solution.mesh.len(),
+        steps: prepared.scene.settings.integral_steps,
+        stages,
+        total,
+        rays,
+    })
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// Milliseconds with three significant digits or so.
+fn ms(seconds: f64) -> String {
+    let ms = seconds * 1e3;
+    if ms >= 100.0 {
+        format!("{ms:.0}")
+    } else if ms >= 10.0 {
+        format!("{ms:.1}")
+    } else {
+        format!("{ms:.2}")
+    }
+}

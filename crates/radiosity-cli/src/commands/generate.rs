@@ -1,0 +1,50 @@
+//! `radiosity generate`: scene files made procedurally.
+
+use anyhow::{bail, Context, Result};
+use radiosity::scene;
+
+use crate::args::BuildingArgs;
+
+pub fn building(args: BuildingArgs) -> Result<()> {
+    let params = scene::BuildingParams {
+        floors: args.floors,
+        rooms_x: args.rooms_x,
+        rooms_z: args.rooms_z,
+        room_size: args.room_size,
+        height: args.height,
+        furniture: !args.no_furniture,
+        seed: args.seed,
+        max_patch_area: args.max_area,
+        integral_steps: args.steps,
+        light: args.light,
+    };
+    if let Err(e) = params.check() {
+        bail!("{e}");
+    }
+    let built = scene::building(&params);
+    scene::write_scene_file(&built, &args.output)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    // The element count, also where meshing would refuse it (more than MAX_ELEMENTS).
+    let elements = match radiosity::mesh::mesh_scene(&built, params.max_patch_area) {
+        Ok(mesh) => format!("{} elements", mesh.len()),
+        Err(radiosity::mesh::MeshError::TooManyElements { count, limit, .. }) => {
+            format!("{count} elements (more than the meshing limit of {limit})")
+        }
+        Err(e) => return Err(e.into()),
+    };
+    let (lo, hi) = built.bounds();
+    let size = hi - lo;
+    outln!(
+        "{}: {} rooms, {} surfaces, {:.0} m^2, {:.1} x {:.1} x {:.1} m; MAX_PATCH_AREA {}: {}",
+        args.output.display(),
+        params.floors * params.rooms_x * params.rooms_z,
+        built.surfaces.len(),
+        built.total_area(),
+        size.x,
+        size.y,
+        size.z,
+        params.max_patch_area,
+        elements
+    );
+    Ok(())
+}

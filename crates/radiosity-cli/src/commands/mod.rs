@@ -1,0 +1,103 @@
+//! One file per command, each with its `run` (`generate building`: `generate::building`),
+//! and what several of them share: solving a prepared scene, shading and rendering it.
+
+pub mod bench;
+pub mod check;
+pub mod compare;
+pub mod formfactors;
+pub mod generate;
+pub mod render;
+pub mod solve;
+pub mod view;
+
+use std::path::Path;
+
+use anyhow::Result;
+use image::RgbImage;
+use radiosity::mesh::Mesh;
+use radiosity::pipeline::{
+    self as pipeline, FormFactorStats, FormFactors, Prepared, Solution, SolveRequest,
+};
+use radiosity::progress::{run_stage, Stage};
+use radiosity::render::{Camera, RenderSettings, Renderer};
+use radiosity::shade::{self, Exposure};
+use radiosity::solve::{Observer, Solver};
+
+use crate::progress_bar::Reporter;
+
+/// Notes what computing the form factors found.
+pub fn note_form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter: &Reporter) {
+    reporter.note(&format!(
+        "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
+         reciprocity error {:.1e} largest, {:.1e} of exchanged power",
+        prepared.method(),
+        stats.rays,
+        stats.seconds,
+        stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
+        stats.row_sums.min,
+        stats.row_sums.mean,
+        stats.row_sums.max,
+        stats.reciprocity.max_relative,
+        stats.reciprocity.total_relative
+    ));
+}
+
+/// Solves with `solver`: the dense solvers on the form factors (read from `file` or
+/// computed, then dropped), the others from the scene. Returns the form-factor statistics
+/// when they were computed.
+pub fn solve_scene(
+    prepared: &Prepared,
+    solver: Solver,
+    file: Option<&Path>,
+    observer: &mut Observer,
+    reporter: &Reporter,
+) -> Result<(Solution, Option<FormFactorStats>)> {
+    let form_factors = match file {
+        Some(path) => FormFactors::File(path),
+        None => FormFactors::Compute,
+    };
+    if solver.needs_matrix() {
+        match form_factors {
+            FormFactors::File(path) => {
+                reporter.note(&format!("form factors read from {}", path.display()))
+            }
+            _ => reporter.note(&format!(
+                "form factors by {}; occlusion: {}",
+                prepared.method(),
+                prepared.method().occlusion()
+            )),
+        }
+    }
+    let request = SolveRequest {
+        form_factors,
+        ..SolveRequest::new(solver)
+    };
+    let solution = pipeline::solve(prepared, &request, observer, reporter)?;
+    if let Some(stats) = &solution.form_factors {
+        note_form_factor_stats(prepared, stats, reporter);
+    }
+    let stats = solution.form_factors;
+    Ok((solution, stats))
+}
+
+/// Vertex radiosities (the shade stage), exposure, then the image (the render stage).
+pub fn shade_and_render(
+    prepared: &Prepared,
+    mesh: &Mesh,
+    element_b: &[[f64; 3]],
+    camera: &Camera,
+    settings: RenderSettings,
+    exposure: Exposure,
+    reporter: &Reporter,
+) -> RgbImage {
+    let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
+        shade::vertex_radiosity(mesh, element_b)
+    });
+    let scale = exposure.scale(&prepared.scene, mesh, element_b);
+    let settings = RenderSettings {
+        exposure_scale: scale,
+        ..settings
+    };
+    let renderer = Renderer::new(mesh);
+    radiosity::render::render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
+}

@@ -1,0 +1,104 @@
+//! `radiosity render`: solve a scene and render it to a PNG image (with snapshots of a progressive solve).
+
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use radiosity::progress::{run_stage, Stage};
+use radiosity::render::{self};
+use radiosity::solve::Step;
+
+use super::{shade_and_render, solve_scene};
+use crate::args::RenderArgs;
+use crate::progress_bar::Reporter;
+use crate::setup::{camera, prepare, render_settings};
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let settings = render_settings(&args)?;
+    if args.snapshot_every == 0 {
+        bail!("--snapshot-every must be at least 1");
+    }
+    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
+    if args.snapshots.is_some() && solver.needs_matrix() {
+        bail!("--snapshots needs --solver progressive");
+    }
+    let camera = camera(&args, &prepared.scene)?;
+    let exposure = args.exposure;
+    if let Some(dir) = &args.snapshots {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    // Snapshots render the display radiosity (B plus the ambient term) with a quiet
+    // reporter, so that their shading and rendering do not count in the stage times.
+    let mut snapshot_error = None;
+    let mut written = 0usize;
+    let mut observer = |step: &Step| {
+        let (Some(dir), Step::Shot(state)) = (&args.snapshots, step) else {
+            return ControlFlow::Continue(());
+        };
+        if state.shot % args.snapshot_every != 0 {
+            return ControlFlow::Continue(());
+        }
+        let quiet = Reporter::new(true);
+        let display = state.display_radiosity();
+        let image = shade_and_render(
+            &prepared,
+            &prepared.mesh,
+            radiosity::light::Rgb::as_arrays(&display),
+            &camera,
+            settings,
+            exposure,
+            &quiet,
+        );
+        let path = dir.join(format!("shot-{:05}.png", state.shot));
+        match render::write_png(&image, &path) {
+            Ok(()) => {
+                written += 1;
+                ControlFlow::Continue(())
+            }
+            Err(e) => {
+                snapshot_error =
+                    Some(anyhow::Error::new(e).context(format!("cannot write {}", path.display())));
+                ControlFlow::Break(())
+            }
+        }
+    };
+    let (solution, _) = solve_scene(
+        &prepared,
+        solver,
+        args.solve.form_factors.as_deref(),
+        &mut observer,
+        &reporter,
+    )?;
+    if let Some(e) = snapshot_error {
+        return Err(e);
+    }
+    if let Some(dir) = &args.snapshots {
+        reporter.note(&format!("wrote {written} snapshots to {}", dir.display()));
+    }
+    let image = shade_and_render(
+        &prepared,
+        &solution.mesh,
+        solution.element_rgb(),
+        &camera,
+        settings,
+        exposure,
+        &reporter,
+    );
+    let output = args
+        .output
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+    run_stage(&reporter, Stage::Write, 0, || {
+        render::write_png(&image, &output)
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!(
+        "wrote {} ({} x {})",
+        output.display(),
+        image.width(),
+        image.height()
+    ));
+    reporter.print_timings();
+    Ok(())
+}

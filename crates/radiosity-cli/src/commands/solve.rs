@@ -1,0 +1,44 @@
+//! `radiosity solve`: solve a scene and write the radiosity of every element as CSV or JSON.
+
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use radiosity::progress::{run_stage, Stage};
+
+use super::solve_scene;
+use crate::args::SolveArgs;
+use crate::progress_bar::Reporter;
+use crate::setup::prepare;
+
+pub fn run(args: SolveArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
+    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (solution, _) = solve_scene(
+        &prepared,
+        solver,
+        args.solve.form_factors.as_deref(),
+        &mut |_| ControlFlow::Continue(()),
+        &reporter,
+    )?;
+    let output = args
+        .output
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.csv")));
+    run_stage(&reporter, Stage::Write, 0, || {
+        radiosity::solution::write_solution(
+            &output,
+            &prepared.scene,
+            &solution.mesh,
+            solution.element_rgb(),
+        )
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!(
+        "wrote {} ({} elements)",
+        output.display(),
+        solution.mesh.len()
+    ));
+    reporter.print_timings();
+    Ok(())
+}

@@ -1,0 +1,81 @@
+//! `radiosity view`: the walkthrough window and modeller (crate `radiosity-viewer`, cargo
+//! feature `viewer`, on by default).
+
+use crate::args::ViewArgs;
+use anyhow::Result;
+
+#[cfg(feature = "viewer")]
+pub fn run(args: ViewArgs) -> Result<()> {
+    use anyhow::bail;
+    use radiosity::pipeline::Overrides;
+    use radiosity::solve::SolverKind;
+    use radiosity_viewer::{worker::ViewSolver, ViewerOptions};
+
+    if args.steps == Some(0) {
+        bail!("--steps must be at least 1");
+    }
+    if args.bench {
+        let table = radiosity_viewer::bench::run_all(
+            &args.bench_elements,
+            args.bench_triangles,
+            args.bench_frames,
+            &mut |line| errln!("{}", line.trim_end()),
+        )
+        .map_err(anyhow::Error::msg)?;
+        outln!("{table}");
+        return Ok(());
+    }
+    let scene = match &args.scene {
+        Some(path) => radiosity::scene::read_scene(path)?,
+        None => radiosity::scene::cornell_box(),
+    };
+    let mut options = ViewerOptions::new(scene, args.scene.clone());
+    options.overrides = Overrides {
+        max_patch_area: args.max_area,
+        integral_steps: args.steps,
+    };
+    // `--solver dense` arrives as Gauss-Seidel (on the cached matrix).
+    let mut kind = args.solver;
+    if args.progressive {
+        kind = SolverKind::Progressive;
+    } else if args.dense {
+        kind = SolverKind::GaussSeidel;
+    }
+    let mut hierarchical = None;
+    if kind == SolverKind::Hierarchical {
+        let max_area = args
+            .max_area
+            .unwrap_or(options.scene.settings.max_patch_area);
+        let min_area = args.min_area.unwrap_or(max_area / 16.0);
+        if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
+            bail!("--epsilon must be a positive number, got {}", args.epsilon);
+        }
+        if !(min_area > 0.0 && min_area.is_finite()) {
+            bail!("--min-area must be a positive number, got {min_area}");
+        }
+        hierarchical = Some(radiosity::solve::HierarchicalSettings {
+            epsilon: args.epsilon,
+            min_area,
+            ..radiosity::solve::HierarchicalSettings::defaults_for(max_area)
+        });
+    }
+    options.solver = ViewSolver { kind, hierarchical };
+    options.screenshot = args.screenshot;
+    options.frames = args.frames;
+    options.panel = args.panel;
+    options.select = args.select;
+    options.shading = args.shading;
+    for note in radiosity_viewer::run(options)? {
+        outln!("{note}");
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "viewer"))]
+pub fn run(_args: ViewArgs) -> Result<()> {
+    anyhow::bail!(
+        "this radiosity was built without the window (cargo feature `viewer`); rebuild with \
+         `cargo build --release --features viewer` (it is on by default unless \
+         --no-default-features was given)"
+    )
+}

@@ -1,0 +1,18 @@
+//! `errln!` and `outln!`: `eprintln!` and `println!` that ignore a closed or failing
+//! stream. Declared first in `main.rs` (`#[macro_use]`), so every module can use them.
+
+/// `eprintln!` that ignores a closed or failing stderr (a `| head` must not abort a run).
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
+/// `println!` that ignores a closed or failing stdout.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}

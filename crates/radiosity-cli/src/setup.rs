@@ -1,0 +1,243 @@
+//! The command line's flags, second stage: the library's objects built from the parsed
+//! flags of [`crate::args`] (the scene prepared for a method, the solver, the render
+//! settings and the camera), with the checks that need more than one flag or the scene.
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use radiosity::form_factor::FormFactorMethod;
+use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::progress::{run_stage, Stage};
+use radiosity::render::{Camera, RenderSettings, Shading};
+use radiosity::scene::{self, Scene};
+use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
+
+use crate::args::{MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions};
+use crate::progress_bar::Reporter;
+
+/// The scene (from its file or built in), meshed, with a short name for default outputs.
+/// Refuses, before any work, a problem whose matrices would not fit in memory (for
+/// `solver`, or the form factors alone when `None`).
+pub fn prepare(
+    args: &SceneArgs,
+    options: Option<&SolveOptions>,
+    reporter: &Reporter,
+) -> Result<(Prepared, String, Option<Solver>)> {
+    let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
+    let overrides = Overrides {
+        max_patch_area: args.max_area,
+        integral_steps: args.steps,
+    };
+    if let Some(k) = args.steps {
+        if k == 0 {
+            bail!("--steps must be at least 1");
+        }
+    }
+    let mut prepared = Prepared::new(scene, overrides, reporter)?;
+    let m = &args.method;
+    let steps = prepared.scene.settings.integral_steps;
+    prepared.method = match m.method {
+        MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
+        MethodArg::Contour => FormFactorMethod::Contour { steps },
+        MethodArg::Analytic => FormFactorMethod::Analytic { steps },
+        MethodArg::Hemicube => {
+            if m.resolution < 2 || m.resolution > 16_384 {
+                bail!(
+                    "--resolution must be between 2 and 16384, got {}",
+                    m.resolution
+                );
+            }
+            FormFactorMethod::Hemicube {
+                resolution: m.resolution,
+            }
+        }
+        MethodArg::Montecarlo => {
+            if m.samples == 0 {
+                bail!("--samples must be at least 1");
+            }
+            FormFactorMethod::MonteCarlo {
+                samples: m.samples,
+                seed: m.seed,
+            }
+        }
+    };
+    let solver = match options {
+        Some(options) => Some(solver(
+            options,
+            prepared.mesh.len(),
+            prepared.scene.settings.max_patch_area,
+            reporter,
+        )?),
+        None => None,
+    };
+    prepared.check_memory(solver.as_ref())?;
+    reporter.note(&format!(
+        "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
+        stem,
+        prepared.scene.surfaces.len(),
+        prepared.mesh.len(),
+        prepared.scene.settings.max_patch_area,
+        prepared.scene.settings.integral_steps
+    ));
+    Ok((prepared, stem, solver))
+}
+
+pub fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
+    match path {
+        None => Ok((
+            run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
+            "cornell".to_string(),
+        )),
+        Some(path) => {
+            let scene = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
+            let stem = path
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            Ok((scene, stem))
+        }
+    }
+}
+
+/// The solver the options ask for; `auto` is decided from the element count `n` and the
+/// memory available, and the choice and its reason are noted.
+pub fn solver(
+    options: &SolveOptions,
+    n: usize,
+    max_patch_area: f64,
+    reporter: &Reporter,
+) -> Result<Solver> {
+    if let Some(t) = options.tolerance {
+        if !(t > 0.0 && t.is_finite()) {
+            bail!("--tolerance must be a positive number, got {t}");
+        }
+    }
+    let choice = match options.solver.0 {
+        SolverKind::Auto if options.form_factors.is_some() => SolverKind::GaussSeidel,
+        SolverKind::Auto => {
+            let choice =
+                radiosity::solve::choose(n, radiosity::form_factor::available_memory_bytes());
+            reporter.note(&format!("solver auto: {choice}"));
+            choice.kind()
+        }
+        other => other,
+    };
+    Ok(match choice {
+        SolverKind::Auto => unreachable!("auto is resolved above"),
+        SolverKind::Lu => Solver::LU,
+        SolverKind::GaussSeidel => Solver::Dense(radiosity::solve::DenseSolver::GaussSeidel(
+            GaussSeidelSettings {
+                tolerance: options.tolerance.unwrap_or(1e-9),
+                ..GaussSeidelSettings::default()
+            },
+        )),
+        SolverKind::Progressive => {
+            if options.form_factors.is_some() {
+                bail!("--form-factors cannot be used with --solver progressive, which computes its rows as it shoots");
+            }
+            if options.max_shots == 0 {
+                bail!("--max-shots must be at least 1");
+            }
+            Solver::Progressive(ProgressiveSettings {
+                tolerance: options
+                    .tolerance
+                    .unwrap_or(radiosity::solve::DEFAULT_PROGRESSIVE_TOLERANCE),
+                max_shots: options.max_shots,
+            })
+        }
+        SolverKind::Hierarchical => {
+            if options.form_factors.is_some() {
+                bail!("--form-factors cannot be used with --solver hierarchical, which uses links, not a matrix");
+            }
+            let min_area = options.min_area.unwrap_or(max_patch_area / 16.0);
+            if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
+                bail!(
+                    "--epsilon must be a positive number, got {}",
+                    options.epsilon
+                );
+            }
+            if !(min_area > 0.0 && min_area.is_finite()) {
+                bail!("--min-area must be a positive number, got {min_area}");
+            }
+            let tolerance = options
+                .tolerance
+                .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
+            if !(tolerance > 0.0 && tolerance < 1.0) {
+                bail!("--tolerance must be a number in (0, 1) for --solver hierarchical, got {tolerance}");
+            }
+            Solver::Hierarchical(radiosity::solve::HierarchicalSettings {
+                epsilon: options.epsilon,
+                min_area,
+                tolerance,
+                max_memory_bytes: None,
+            })
+        }
+    })
+}
+
+pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
+    if let Some(out) = &args.output {
+        let png = out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !png {
+            bail!(
+                "{}: only PNG images are written; give the output a .png name",
+                out.display()
+            );
+        }
+    }
+    if args.width == 0 || args.height == 0 {
+        bail!("--width and --height must be at least 1");
+    }
+    if (args.width as u64) * (args.height as u64) > 100_000_000 {
+        bail!(
+            "an image of {} x {} pixels is too large (at most 100 megapixels)",
+            args.width,
+            args.height
+        );
+    }
+    if !(args.gamma > 0.0 && args.gamma.is_finite()) {
+        bail!("--gamma must be a positive number, got {}", args.gamma);
+    }
+    if args.supersample == 0 || args.supersample > 16 {
+        bail!("--supersample must be between 1 and 16");
+    }
+    let shading = match args.shading {
+        ShadingArg::Smooth => Shading::Smooth,
+        ShadingArg::Flat => Shading::Flat,
+        ShadingArg::Wireframe => Shading::Wireframe,
+    };
+    Ok(RenderSettings {
+        shading,
+        gamma: args.gamma,
+        supersample: args.supersample,
+        ..RenderSettings::default()
+    })
+}
+
+pub fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
+    let mut camera = Camera::for_scene(scene, args.width, args.height);
+    if let Some(eye) = args.eye {
+        camera.eye = eye;
+    }
+    if let Some(at) = args.look_at {
+        camera.look_at = at;
+    }
+    if let Some(up) = args.up {
+        camera.up = up;
+    }
+    if let Some(fov) = args.fov {
+        if !(fov > 0.0 && fov < 180.0) {
+            bail!("--fov must be between 0 and 180 degrees, got {fov}");
+        }
+        camera.fov_y_degrees = fov;
+    }
+    let forward = camera.look_at - camera.eye;
+    if forward.length() == 0.0 {
+        bail!("--eye and --look-at must differ");
+    }
+    if forward.cross(camera.up).length() <= 1e-12 * forward.length() * camera.up.length() {
+        bail!("--up must not be parallel to the viewing direction (or zero)");
+    }
+    Ok(camera)
+}
