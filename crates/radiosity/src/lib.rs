@@ -4,16 +4,16 @@
 //! (1998), built as a library. The pipeline, one module per stage:
 //!
 //! ```text
-//! scene file --scene--> Scene --mesh--> Mesh --form_factor--> FormFactorMatrix
+//! scene file --io--> Scene --mesh--> Mesh --form_factor--> FormFactorMatrix
 //!   --solve--> element radiosity B (per RGB band) --shade--> vertex radiosity
 //!   --render--> image
 //! ```
 //!
-//! * [`scene`]: the paper's Appendix A scene format (reader, writer, built-in Cornell box).
+//! * [`scene`]: the scene model: surfaces, the built-in Cornell box, generated buildings.
 //! * [`geometry`]: planar convex polygon helpers (normal, area, planarity, convexity).
 //! * [`mesh`]: area-based subdivision of surfaces into elements (paper 2.4).
 //! * [`visibility`]: BVH ray queries over triangles (occlusion and closest hit).
-//! * [`form_factor`]: form factors F_ij (paper 1.2, 2.3) and their file format (paper 2.8).
+//! * [`form_factor`]: form factors F_ij (paper 1.2, 2.3).
 //! * [`light`]: the RGB type of radiosity, emission and reflectance, checked per element.
 //! * [`solve`]: (I - rho F) B = E per band: [`Solver`] names every solver with its
 //!   settings (dense LU or Gauss-Seidel, paper figure 6; progressive refinement;
@@ -21,10 +21,10 @@
 //! * [`pipeline`]: a meshed scene ([`Prepared`]) and [`pipeline::solve`], the one entry
 //!   point that takes any [`Solver`] and returns a [`Solution`] on its own mesh.
 //! * [`shade`]: vertex radiosities for smooth shading (paper 2.5).
-//! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7), PNG
-//!   images.
+//! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7).
 //! * [`progress`]: the one interface long work reports through.
-//! * [`solution`]: the per-element solution as CSV or JSON.
+//! * [`io`]: every file read or written: the paper's Appendix A scene format, the
+//!   form-factor file (paper 2.8), the per-element solution as CSV or JSON, PNG images.
 //!
 //! The whole chain, from the built-in Cornell box to an image:
 //!
@@ -60,10 +60,10 @@
 //! (for example W/m^2), per red, green and blue band; reflectance rho is in [0, 1).
 #![deny(missing_docs)]
 
-mod atomic_write;
 pub mod compare;
 pub mod form_factor;
 pub mod geometry;
+pub mod io;
 pub mod light;
 pub mod mesh;
 pub mod pipeline;
@@ -71,11 +71,12 @@ pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod shade;
-pub mod solution;
 pub mod solve;
 pub mod visibility;
 
-pub use atomic_write::write_atomically;
+/// The solution writer's module at the path the command line uses; it lives in
+/// [`io::solution`].
+pub use io::solution;
 
 pub use light::{ElementLight, Rgb};
 pub use pipeline::{FormFactors, Overrides, PipelineError, Prepared, Solution, SolveRequest};

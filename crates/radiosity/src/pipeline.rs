@@ -9,9 +9,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use crate::form_factor::{
-    self, mesh_fingerprint, read_form_factors, write_form_factors, FormFactorContext,
-    FormFactorFileError, FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter, Reciprocity,
-    RowSums,
+    self, FormFactorContext, FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter,
+    Reciprocity, RowSums,
+};
+use crate::io::form_factor_file::{
+    mesh_fingerprint, read_form_factors, write_form_factors, FormFactorFileError,
 };
 use crate::light::{check_surface, ElementLight, LightError, Rgb};
 use crate::mesh::{mesh_scene, Mesh, MeshError};

@@ -3,22 +3,22 @@
 //!
 //! Properties that hold and are tested: F_ij >= 0; F_ii = 0 for planar elements; each row
 //! sums to at most 1 (to 1 in a closed scene); reciprocity A_i F_ij = A_j F_ji.
+//!
+//! The matrix is written to a file and read back by [`crate::io::form_factor_file`].
 
 pub mod accuracy;
 mod area;
 pub mod exact;
-mod file;
 mod hemicube;
 pub(crate) mod kernel;
 mod method;
 mod montecarlo;
 pub mod reference;
 
+/// The form-factor file's error, at the path the command line uses; the file's reader and
+/// writer live in [`crate::io::form_factor_file`].
+pub use crate::io::form_factor_file::FormFactorFileError;
 pub use area::area_integral_pair;
-pub use file::{
-    mesh_fingerprint, read_form_factors, write_form_factors, FormFactorFileError,
-    FORM_FACTOR_FILE_VERSION, FORM_FACTOR_MAGIC, MAX_METHOD_LEN,
-};
 pub use method::{FormFactorMethod, ParseMethodError};
 
 use std::ops::Range;

@@ -13,13 +13,11 @@
 //! * `film`: the linear film: f64 values per ray sample, no exposure or gamma yet.
 //! * [`tonemap`]: exposure, the paper's gamma correction (section 2.7) and 8-bit encoding,
 //!   from a film to an image.
-//! * [`render`] (here): film then tone map, the one call the CLI makes; and [`write_png`].
+//! * [`render`] (here): film then tone map, the one call the CLI makes. Images are written
+//!   by [`crate::io::png`] ([`write_png`] here is the same function).
 //!
 //! Rows are rendered in parallel with rayon; each finished row is reported to the
 //! [`Progress`] sink as one unit of [`Stage::Render`].
-
-use std::io;
-use std::path::Path;
 
 use image::RgbImage;
 
@@ -36,6 +34,9 @@ pub mod tonemap;
 pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
 pub use film::{sample_offset, Film, FilmContent};
 pub use renderer::{barycentric, inverse_bilinear, Renderer, Shading};
+
+/// The PNG writer, at the path the command line uses; it lives in [`crate::io::png`].
+pub use crate::io::png::write_png;
 
 /// Everything about how to render except the camera and the radiosities.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,22 +118,6 @@ pub fn render(
     RgbImage::from_raw(camera.width, camera.height, buf).expect("buffer has the image's size")
 }
 
-/// Writes `image` as a PNG file at `path`, atomically (a temporary file beside it, then a
-/// rename; see [`crate::write_atomically`]).
-pub fn write_png(image: &RgbImage, path: &Path) -> io::Result<()> {
-    use image::ImageEncoder;
-    crate::write_atomically(path, |w| {
-        image::codecs::png::PngEncoder::new(w)
-            .write_image(
-                image.as_raw(),
-                image.width(),
-                image.height(),
-                image::ExtendedColorType::Rgb8,
-            )
-            .map_err(io::Error::other)
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -155,7 +140,7 @@ mod tests {
     }
 
     #[test]
-    fn progress_counts_rows_and_png_round_trips() {
+    fn progress_counts_rows() {
         let s = scene(vec![surface(
             "a",
             0.0,
@@ -183,13 +168,6 @@ mod tests {
         assert_eq!(count.0.load(Ordering::SeqCst), 7);
         assert_eq!(count.1.load(Ordering::SeqCst), 7);
         assert_eq!(px(&img, 6, 3), [51, 102, 153]);
-        let dir = std::env::temp_dir().join(format!("radiosity-png-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("view.png");
-        write_png(&img, &path).unwrap();
-        let back = image::open(&path).unwrap().to_rgb8();
-        assert_eq!(back, img);
-        std::fs::remove_dir_all(&dir).unwrap();
         // Zero-sized requests give empty images.
         let empty = render(
             &r,

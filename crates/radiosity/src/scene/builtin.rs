@@ -2,7 +2,8 @@
 
 use glam::dvec3;
 
-use super::{parse_scene, CameraHint, Scene};
+use super::{CameraHint, Scene};
+use crate::io::scene_file::parse_scene;
 
 /// The text of `examples/cornell_box.scene`, compiled in.
 const CORNELL_BOX_SCENE: &str = include_str!("../../../../examples/cornell_box.scene");

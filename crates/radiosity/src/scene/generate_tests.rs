@@ -4,7 +4,8 @@ use glam::{DVec2, DVec3};
 
 use super::*;
 use crate::geometry;
-use crate::scene::{parse_scene, shape::check_polygon, write_scene};
+use crate::io::scene_file::{parse_scene, write_scene};
+use crate::scene::shape::check_polygon;
 
 fn small(furniture: bool) -> BuildingParams {
     BuildingParams {

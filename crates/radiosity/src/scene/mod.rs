@@ -1,92 +1,30 @@
-//! Scenes: surfaces with emission and reflectance, in the paper's Appendix A format.
+//! Scenes: surfaces with emission and reflectance, the model that the rest of the library
+//! works on.
 //!
 //! A [`Scene`] is what a scene file says, after parsing and checking: meshing settings and a
 //! list of planar convex [`Surface`]s. Each surface is one-sided: it emits and reflects only
 //! on its front, the side from which its vertices run counter-clockwise (the right-hand-rule
 //! normal points out of the front). Every surface occludes from both sides.
 //!
-//! [`read_scene`] and [`parse_scene`] read the format, [`write_scene`] and
-//! [`write_scene_file`] write it, and [`cornell_box`] is the built-in Cornell box
-//! (`examples/cornell_box.scene`, compiled in).
-//!
-//! # The scene format
-//!
-//! The format is the one of De Angelis, *Radiosity: A Study in Photorealistic Rendering*
-//! (1998), Appendix A, with one addition, the box primitive the paper proposes in section
-//! 3.1. Each value stands on its own labelled line, in this order:
-//!
-//! ```text
-//! MAX_PATCH_AREA 100        // meshing threshold, scene units squared; > 0, may be decimal
-//! INTEGRAL_STEPS 2          // k >= 1, a whole number ("2" or "2.0")
-//! SCENEBEGIN
-//! PATCHBEGIN
-//! #Floor                    // the name: the rest of the line after '#', trimmed
-//! VERTICES 4                // n >= 3
-//! Er 0.0                    // emission (exitance) per band, >= 0
-//! Eg 0.0
-//! Eb 0.0
-//! Rr 0.5                    // reflectance per band, in [0, 1)
-//! Rg 0.5
-//! Rb 0.5
-//! VERTEX0 0 0 0             // VERTEX0 .. VERTEX(n-1), in order: x y z
-//! VERTEX1 1 0 0
-//! VERTEX2 1 1 0
-//! VERTEX3 0 1 0
-//! PATCHEND
-//! BOXBEGIN                  // six 4-vertex surfaces NAME.base, NAME.top, NAME.side0..3
-//! #Table
-//! FACING OUT                // OUT: fronts look away from the box (an object); IN: into it
-//! Er 0                      // the same six colour lines as a patch
-//! Eg 0
-//! Eb 0
-//! Rr 0.5
-//! Rg 0.5
-//! Rb 0.5
-//! ORIGIN 1 0 2              // axis-aligned: the minimum corner ...
-//! SIZE 2 0.8 1              // ... and the extents (> 0); base = the y-min face
-//! BOXEND
-//! SCENEEND
-//! ```
-//!
-//! Instead of `ORIGIN` and `SIZE` a box may be given as one face and a height:
-//! `VERTICES 4`, `VERTEX0` .. `VERTEX3` (a planar convex quad, the base) and `HEIGHT h`
-//! (h > 0); the box is the prism swept from the base along its right-hand-rule normal by h.
-//!
-//! `//` starts a comment anywhere on a line, blank lines may go anywhere, and keywords are
-//! case-insensitive. Numbers are written as Rust reads an `f64` (`1`, `-0.5`, `.5`, `2.`,
-//! `1e-3`), and must be finite. Anything else on a line is an error. Every error in a file is
-//! reported with its line and column ([`ParseError`], collected in a [`SceneError`]); after an
-//! error inside a block the reader skips to the block's end and carries on. Problems with a
-//! polygon's shape are reported at its `VERTEX0` line.
-//!
-//! # Polygon checks and planarity
-//!
-//! Every polygon must have distinct corners and a non-zero area, be convex, and be planar: a
-//! polygon is accepted when no corner is further from its best-fit plane (Newell normal
-//! through the corner mean) than [`PLANARITY_TOLERANCE`] (0.2 %) of its diameter, and its
-//! corners are then projected onto that plane. Measured data needs the tolerance: the
-//! Cornell box's red (left) wall is 0.80 mm out of plane over a 783.5 mm diagonal (0.10 %).
-//! Flattening it would move each corner 0.80 mm off its neighbours' and open gaps that rays
-//! slip through, so the built-in box gives that wall as the two triangles of its measured
-//! corners instead (exactly planar, watertight). Corners are only moved when they are more than 1e-12 of the diameter
-//! off the plane, so reading a written scene changes nothing and `read(write(scene))`
-//! gives back `scene` bit for bit (for scenes whose coordinates are not many thousands of
-//! times larger than their polygons).
+//! Scene files (the paper's Appendix A format) are read and written by
+//! [`crate::io::scene_file`], which also describes the format and its polygon checks.
+//! [`cornell_box`] is the built-in Cornell box (`examples/cornell_box.scene`, compiled in),
+//! [`building`] generates furnished buildings of any size, and the box primitive's faces are
+//! made here (module `shape`).
 
 use glam::DVec3;
 
 mod builtin;
 pub mod generate;
-mod lex;
-mod parse;
-mod shape;
-mod write;
+pub(crate) mod shape;
 
 pub use builtin::cornell_box;
 pub use generate::{building, BuildingParams};
-pub use parse::{parse_scene, read_scene, ParseError, SceneError};
 pub use shape::PLANARITY_TOLERANCE;
-pub use write::{write_scene, write_scene_file};
+
+/// The scene file's reader, writer and error, at the paths the command line and the viewer
+/// use; they live in [`crate::io::scene_file`].
+pub use crate::io::scene_file::{read_scene, write_scene_file, SceneError};
 
 /// Colours of surfaces: see [`crate::light`].
 pub use crate::light::Rgb;

@@ -23,7 +23,7 @@ const ZERO_AREA: f64 = 1e-9;
 /// In order: no repeated corners, non-zero area, planar within [`PLANARITY_TOLERANCE`], convex
 /// (every corner turns the same way round the front normal, once round). The message names
 /// corners as `VERTEXk`.
-pub(super) fn check_polygon(vertices: &mut [DVec3]) -> Result<(), String> {
+pub(crate) fn check_polygon(vertices: &mut [DVec3]) -> Result<(), String> {
     let diameter = geometry::diameter(vertices);
     if let Some((i, j)) = repeated_corner(vertices, diameter) {
         return Err(format!(
@@ -132,7 +132,7 @@ fn significant(x: f64) -> String {
 
 /// Which way a box's faces look.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Facing {
+pub(crate) enum Facing {
     /// Away from the box: a solid object.
     Out,
     /// Into the box: a room.
@@ -140,12 +140,12 @@ pub(super) enum Facing {
 }
 
 /// The suffixes of a box's six faces, in the order [`box_faces`] returns them.
-pub(super) const FACE_NAMES: [&str; 6] = ["base", "top", "side0", "side1", "side2", "side3"];
+pub(crate) const FACE_NAMES: [&str; 6] = ["base", "top", "side0", "side1", "side2", "side3"];
 
 /// The base quad of the axis-aligned box with minimum corner `origin` and extents `size`: its
 /// y-min face, wound so that its normal is +y (into the box). The box is this base swept by
 /// `size.y`.
-pub(super) fn axis_aligned_base(origin: DVec3, size: DVec3) -> [DVec3; 4] {
+pub(crate) fn axis_aligned_base(origin: DVec3, size: DVec3) -> [DVec3; 4] {
     let (x0, y0, z0) = (origin.x, origin.y, origin.z);
     let (x1, z1) = (origin.x + size.x, origin.z + size.z);
     [
@@ -159,7 +159,7 @@ pub(super) fn axis_aligned_base(origin: DVec3, size: DVec3) -> [DVec3; 4] {
 /// The six faces of the prism swept from `base` along its right-hand-rule normal by `height`:
 /// base, top, then the side over each base edge `VERTEXk`-`VERTEXk+1`. Every face's front
 /// looks away from the prism for [`Facing::Out`] and into it for [`Facing::In`].
-pub(super) fn box_faces(base: &[DVec3; 4], height: f64, facing: Facing) -> [Vec<DVec3>; 6] {
+pub(crate) fn box_faces(base: &[DVec3; 4], height: f64, facing: Facing) -> [Vec<DVec3>; 6] {
     let normal = geometry::polygon_normal(base).unwrap_or(DVec3::Y);
     let top: [DVec3; 4] = base.map(|b| b + height * normal);
     let side = |i: usize| {

@@ -405,9 +405,9 @@ fn scene_convenience_uses_surface_properties() {
 #[test]
 fn closed_cube_with_computed_form_factors_stays_within_furnace_bounds() {
     use crate::form_factor::{
-        compute_matrix, mesh_fingerprint, occluder_bvh, read_form_factors, write_form_factors,
-        FormFactorContext, FormFactorMethod, RayCounter,
+        compute_matrix, occluder_bvh, FormFactorContext, FormFactorMethod, RayCounter,
     };
+    use crate::io::form_factor_file::{mesh_fingerprint, read_form_factors, write_form_factors};
     use crate::mesh::mesh_scene;
     use crate::scene::{MeshSettings, Rgb, Surface};
     use glam::{dvec3, DVec3};

@@ -216,12 +216,13 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::png::write_png;
     use crate::mesh::{mesh_scene, Mesh};
     use crate::progress::NoProgress;
     use crate::render::test_support::{
         cornell_camera, facing_minus_z, px, scene, surface, test_image_dir,
     };
-    use crate::render::{render, write_png, RenderSettings, Renderer, Shading};
+    use crate::render::{render, RenderSettings, Renderer, Shading};
     use crate::scene::Rgb;
     use crate::shade::vertex_radiosity;
     use glam::dvec3;

@@ -6,8 +6,9 @@ use glam::{dvec3, DVec3};
 use thiserror::Error;
 
 use super::lex::{lex, Keyword, Line, Token};
-use super::shape::{self, Facing};
-use super::{MeshSettings, Rgb, Scene, Surface};
+use crate::light::Rgb;
+use crate::scene::shape::{self, Facing};
+use crate::scene::{MeshSettings, Scene, Surface};
 
 /// After this many errors the reader stops looking for more.
 const MAX_ERRORS: usize = 100;
@@ -718,5 +719,5 @@ impl<'a> Parser<'a> {
 }
 
 #[cfg(test)]
-#[path = "parse_tests.rs"]
+#[path = "read_tests.rs"]
 mod tests;

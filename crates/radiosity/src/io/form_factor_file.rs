@@ -31,7 +31,7 @@ use std::hash::Hasher;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
-use super::{
+use crate::form_factor::{
     available_memory_bytes, check_dense_fits, FormFactorMatrix, FormFactorMethod, OutOfMemory,
     ParseMethodError,
 };
@@ -236,7 +236,7 @@ pub fn write_form_factors(
             ),
         ));
     }
-    crate::write_atomically(path, |out| {
+    crate::io::write_atomically(path, |out| {
         let mut w = CrcWriter {
             inner: out,
             crc: crc32fast::Hasher::new(),

@@ -87,7 +87,7 @@ fn csv_field(s: &str) -> std::borrow::Cow<'_, str> {
 /// element (numbers in Rust's `Display` form, the shortest that reads back exactly, never
 /// with an exponent: 1.5e-7 is written `0.00000015`; lines end in `\n`), or, when the file name ends in `.json` (any case), a JSON array of
 /// objects with the same fields (non-finite numbers become `null`). The file is written
-/// atomically (see [`crate::write_atomically`]).
+/// atomically (see [`crate::io::write_atomically`]).
 ///
 /// Returns an `InvalidInput` error, writing nothing, when `element_b` does not have one
 /// entry per element of `mesh`.
@@ -111,7 +111,7 @@ pub fn write_solution(
     let json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    crate::write_atomically(path, |w| {
+    crate::io::write_atomically(path, |w| {
         if json {
             serde_json::to_writer_pretty(&mut *w, &rows).map_err(io::Error::other)?;
             writeln!(w)

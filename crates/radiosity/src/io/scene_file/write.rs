@@ -8,7 +8,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::{Scene, Surface};
+use crate::scene::{Scene, Surface};
 
 /// Writes `scene` as scene-file text to `out`.
 ///
@@ -37,7 +37,7 @@ pub fn write_scene(scene: &Scene, out: &mut impl Write) -> io::Result<()> {
 
 /// Writes `scene` to the file at `path`, replacing it atomically (temporary file and rename).
 pub fn write_scene_file(scene: &Scene, path: &Path) -> io::Result<()> {
-    crate::write_atomically(path, |w| write_scene(scene, w))
+    crate::io::write_atomically(path, |w| write_scene(scene, w))
 }
 
 /// One `PATCHBEGIN` ... `PATCHEND` block.
@@ -74,31 +74,32 @@ fn check_name(index: usize, name: &str) -> io::Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{cornell_box, parse_scene, read_scene};
+    use super::super::{parse_scene, read_scene};
     use super::*;
     use crate::geometry;
+    use crate::scene::cornell_box;
 
     /// The example scene files at the repository root, by name.
     const EXAMPLES: [(&str, &str); 5] = [
         (
             "cornell_box.scene",
-            include_str!("../../../../examples/cornell_box.scene"),
+            include_str!("../../../../../examples/cornell_box.scene"),
         ),
         (
             "room.scene",
-            include_str!("../../../../examples/room.scene"),
+            include_str!("../../../../../examples/room.scene"),
         ),
         (
             "occluder.scene",
-            include_str!("../../../../examples/occluder.scene"),
+            include_str!("../../../../../examples/occluder.scene"),
         ),
         (
             "triangles.scene",
-            include_str!("../../../../examples/triangles.scene"),
+            include_str!("../../../../../examples/triangles.scene"),
         ),
         (
             "paper196.scene",
-            include_str!("../../../../examples/paper196.scene"),
+            include_str!("../../../../../examples/paper196.scene"),
         ),
     ];
 

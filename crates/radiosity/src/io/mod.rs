@@ -1,0 +1,21 @@
+//! Every file the library reads or writes, one module per format, so that the rest of the
+//! library deals only in its own types: a [`Scene`](crate::scene::Scene), a
+//! [`FormFactorMatrix`](crate::form_factor::FormFactorMatrix), a solution, an image.
+//!
+//! * [`scene_file`]: the paper's Appendix A scene format, reader and writer.
+//! * [`form_factor_file`]: the form-factor matrix, written once and read back (paper 2.8).
+//! * [`solution`]: the per-element solution as CSV or JSON, for scripts.
+//! * [`png`]: rendered images as PNG files.
+//! * [`write_atomically`]: how every writer here replaces a file, so that a reader sees the
+//!   old file or the whole new one, never half of one.
+//!
+//! Importers and exporters of other formats (OBJ, glTF, ...) belong here too, one module
+//! each beside [`scene_file`], converting to and from the scene model of [`crate::scene`].
+
+mod atomic_write;
+pub mod form_factor_file;
+pub mod png;
+pub mod scene_file;
+pub mod solution;
+
+pub use atomic_write::write_atomically;
