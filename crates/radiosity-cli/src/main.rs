@@ -9,6 +9,7 @@ mod commands;
 mod errors;
 mod peak_memory;
 mod progress_bar;
+mod report;
 mod setup;
 
 use std::process::ExitCode;

@@ -6,9 +6,9 @@ use anyhow::Result;
 use radiosity::form_factor::FormFactorMatrix;
 use radiosity::pipeline::{FormFactorStats, Prepared};
 
-use super::note_form_factor_stats;
 use crate::args::FormFactorArgs;
 use crate::progress_bar::Reporter;
+use crate::report;
 use crate::setup::prepare;
 
 pub fn run(args: FormFactorArgs) -> Result<()> {
@@ -48,6 +48,6 @@ fn form_factors(
         prepared.method().occlusion()
     ));
     let (f, stats) = prepared.form_factors(reporter)?;
-    note_form_factor_stats(prepared, &stats, reporter);
+    report::form_factor_stats(prepared, &stats, reporter);
     Ok((f, Some(stats)))
 }
