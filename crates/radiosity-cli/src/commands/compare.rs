@@ -59,7 +59,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 let difference = radiosity::compare::compare(
                     &prepared.mesh,
                     &exact.radiosity,
-                    &emission,
+                    emission,
                     &solution.mesh,
                     &solution.radiosity,
                 )?;
