@@ -13,7 +13,7 @@ use super::{shade_and_render, solve_scene};
 use crate::args::{BenchArgs, SceneArgs, SolveOptions};
 use crate::progress_bar::Reporter;
 use crate::report::{self, BenchRow};
-use crate::setup::prepare;
+use crate::setup::prepare_solve;
 
 pub fn run(args: BenchArgs) -> Result<()> {
     if args.repeat == 0 {
@@ -120,8 +120,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     };
     let reporter = Reporter::new(true);
     let start = std::time::Instant::now();
-    let (prepared, _, solver) = prepare(&scene_args, Some(&options), &reporter)?;
-    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (prepared, _, solver) = prepare_solve(&scene_args, &options, &reporter)?;
     let (solution, stats) = solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?;
     let rays = match (&stats, &solution.report) {
         (Some(s), _) => s.rays,

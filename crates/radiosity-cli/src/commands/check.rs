@@ -9,7 +9,7 @@ use super::solve_scene;
 use crate::args::CheckArgs;
 use crate::progress_bar::Reporter;
 use crate::report;
-use crate::setup::prepare;
+use crate::setup::prepare_solve;
 
 pub fn run(args: CheckArgs) -> Result<()> {
     if args.compare_methods {
@@ -18,8 +18,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
     }
     // `check` always prints its report; --quiet only silences the progress bars.
     let reporter = Reporter::new(true);
-    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
-    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let (solution, stats) = if solver.needs_matrix() {
         let (f, stats) = match args.solve.form_factors.as_deref() {
             Some(path) => {

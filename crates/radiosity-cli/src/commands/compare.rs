@@ -13,12 +13,11 @@ use crate::errors::hint;
 use crate::peak_memory::{peak_memory_bytes, reset_peak_memory};
 use crate::progress_bar::Reporter;
 use crate::report::{self, CompareRow, Peak, Reference};
-use crate::setup::prepare;
+use crate::setup::prepare_solve;
 
 pub fn run(args: CompareArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
-    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let reset = reset_peak_memory();
     let start = std::time::Instant::now();
     let (solution, _) = solve_scene(

@@ -13,7 +13,7 @@ use crate::setup::prepare;
 
 pub fn run(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, _) = prepare(&args.scene, None, &reporter)?;
+    let (prepared, stem) = prepare(&args.scene, &reporter)?;
     let (f, _) = form_factors(&prepared, None, &reporter)?;
     let output = args
         .output
