@@ -1,5 +1,8 @@
 //! `radiosity`: the command-line program. A thin layer over the `radiosity` library:
 //! parse the arguments, run the pipeline, report progress and timings.
+//!
+//! `args` holds the flags as clap parses them, `setup` builds the library's objects from
+//! them, `commands` has one file per command, `report` prints what they report.
 
 #[macro_use]
 mod macros;
@@ -9,6 +12,7 @@ mod commands;
 mod errors;
 mod peak_memory;
 mod progress_bar;
+mod report;
 mod setup;
 
 use std::process::ExitCode;

@@ -15,14 +15,37 @@ use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverK
 use crate::args::{MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions};
 use crate::progress_bar::Reporter;
 
-/// The scene (from its file or built in), meshed, with a short name for default outputs.
-/// Refuses, before any work, a problem whose matrices would not fit in memory (for
-/// `solver`, or the form factors alone when `None`).
-pub fn prepare(
+/// The scene (from its file or built in), meshed for the form-factor method of `args`,
+/// with a short name for default outputs. Refuses, before any work, a problem whose
+/// form-factor matrix would not fit in memory.
+pub fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
+    let (prepared, stem) = prepare_scene(args, reporter)?;
+    prepared.check_memory(None)?;
+    note_scene(&prepared, &stem, reporter);
+    Ok((prepared, stem))
+}
+
+/// [`prepare`], and the solver `options` ask for; refuses a problem whose matrices for that
+/// solver would not fit in memory.
+pub fn prepare_solve(
     args: &SceneArgs,
-    options: Option<&SolveOptions>,
+    options: &SolveOptions,
     reporter: &Reporter,
-) -> Result<(Prepared, String, Option<Solver>)> {
+) -> Result<(Prepared, String, Solver)> {
+    let (prepared, stem) = prepare_scene(args, reporter)?;
+    let solver = solver(
+        options,
+        prepared.mesh.len(),
+        prepared.scene.settings.max_patch_area,
+        reporter,
+    )?;
+    prepared.check_memory(Some(&solver))?;
+    note_scene(&prepared, &stem, reporter);
+    Ok((prepared, stem, solver))
+}
+
+/// The scene loaded, its settings overridden, meshed, and its form-factor method set.
+fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
     let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
     let overrides = Overrides {
         max_patch_area: args.max_area,
@@ -61,16 +84,10 @@ pub fn prepare(
             }
         }
     };
-    let solver = match options {
-        Some(options) => Some(solver(
-            options,
-            prepared.mesh.len(),
-            prepared.scene.settings.max_patch_area,
-            reporter,
-        )?),
-        None => None,
-    };
-    prepared.check_memory(solver.as_ref())?;
+    Ok((prepared, stem))
+}
+
+fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
     reporter.note(&format!(
         "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
         stem,
@@ -79,10 +96,9 @@ pub fn prepare(
         prepared.scene.settings.max_patch_area,
         prepared.scene.settings.integral_steps
     ));
-    Ok((prepared, stem, solver))
 }
 
-pub fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
+fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
     match path {
         None => Ok((
             run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
@@ -100,7 +116,7 @@ pub fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, St
 
 /// The solver the options ask for; `auto` is decided from the element count `n` and the
 /// memory available, and the choice and its reason are noted.
-pub fn solver(
+fn solver(
     options: &SolveOptions,
     n: usize,
     max_patch_area: f64,

@@ -7,12 +7,13 @@ use radiosity::pipeline::SolutionReport;
 use radiosity::progress::Stage;
 use radiosity::render::{Camera, RenderSettings};
 use radiosity::shade::Exposure;
-use radiosity::solve::{keep_going, SolverKind};
+use radiosity::solve::keep_going;
 
 use super::{shade_and_render, solve_scene};
 use crate::args::{BenchArgs, SceneArgs, SolveOptions};
 use crate::progress_bar::Reporter;
-use crate::setup::prepare;
+use crate::report::{self, BenchRow};
+use crate::setup::prepare_solve;
 
 pub fn run(args: BenchArgs) -> Result<()> {
     if args.repeat == 0 {
@@ -39,23 +40,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     } else {
         args.max_area.iter().copied().map(Some).collect()
     };
-    let solver_name = match args.solver.0 {
-        SolverKind::Auto => {
-            "auto (dense Gauss-Seidel up to 20,000 elements when it fits, else progressive)"
-        }
-        SolverKind::Lu => "LU",
-        SolverKind::GaussSeidel => "Gauss-Seidel",
-        SolverKind::Progressive => "progressive (form factors computed within the solve)",
-        SolverKind::Hierarchical => "hierarchical (links computed within the solve)",
-    };
-    errln!(
-        "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
-        args.repeat, args.size, args.supersample
-    );
-    outln!(
-        "| scene | max area | elements | k | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
-    );
-    outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    report::bench_header(args.repeat, args.size, args.supersample, args.solver.0);
     for max_area in areas {
         let runs = (0..args.repeat)
             .map(|_| bench_run(&args, max_area))
@@ -76,20 +61,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 .map(|r| r.total - r.stages[BENCH_STAGES.len() - 1])
                 .collect(),
         );
-        let ff = stage(3);
-        let area = max_area.map_or("scene's".to_string(), |a| a.to_string());
-        let stages: Vec<String> = (0..BENCH_STAGES.len()).map(|k| ms(stage(k))).collect();
-        outln!(
-            "| {name} | {area} | {} | {} | {} | {} | {} | {} | {} | {:.2} M |",
-            first.elements,
-            first.steps,
-            stages.join(" | "),
-            ms(other),
-            ms(total),
-            ms(no_render),
-            first.rays,
-            first.rays as f64 / ff.max(1e-9) / 1e6,
-        );
+        let row = BenchRow {
+            elements: first.elements,
+            steps: first.steps,
+            stages: (0..BENCH_STAGES.len()).map(stage).collect(),
+            form_factors: stage(3),
+            other,
+            total,
+            no_render,
+            rays: first.rays,
+        };
+        report::bench_row(&name, max_area, &row);
     }
     Ok(())
 }
@@ -138,8 +120,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     };
     let reporter = Reporter::new(true);
     let start = std::time::Instant::now();
-    let (prepared, _, solver) = prepare(&scene_args, Some(&options), &reporter)?;
-    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (prepared, _, solver) = prepare_solve(&scene_args, &options, &reporter)?;
     let (solution, stats) = solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?;
     let rays = match (&stats, &solution.report) {
         (Some(s), _) => s.rays,
@@ -181,17 +162,5 @@ fn median(mut values: Vec<f64>) -> f64 {
         values[n / 2]
     } else {
         0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
-}
-
-/// Milliseconds with three significant digits or so.
-fn ms(seconds: f64) -> String {
-    let ms = seconds * 1e3;
-    if ms >= 100.0 {
-        format!("{ms:.0}")
-    } else if ms >= 10.0 {
-        format!("{ms:.1}")
-    } else {
-        format!("{ms:.2}")
     }
 }

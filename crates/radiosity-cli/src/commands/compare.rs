@@ -12,12 +12,12 @@ use crate::args::CompareArgs;
 use crate::errors::hint;
 use crate::peak_memory::{peak_memory_bytes, reset_peak_memory};
 use crate::progress_bar::Reporter;
-use crate::setup::prepare;
+use crate::report::{self, CompareRow, Peak, Reference};
+use crate::setup::prepare_solve;
 
 pub fn run(args: CompareArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
-    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let reset = reset_peak_memory();
     let start = std::time::Instant::now();
     let (solution, _) = solve_scene(
@@ -27,11 +27,12 @@ pub fn run(args: CompareArgs) -> Result<()> {
         &mut |_| ControlFlow::Continue(()),
         &reporter,
     )?;
-    let time = start.elapsed().as_secs_f64();
-    let peak = peak_memory_bytes();
-    let elements = solution.mesh.len();
-    let mut reference = ("-".to_string(), "-".to_string(), "-".to_string());
-    let mut difference = ("-".to_string(), "-".to_string(), "-".to_string());
+    let seconds = start.elapsed().as_secs_f64();
+    let peak = Peak {
+        bytes: peak_memory_bytes(),
+        reset,
+    };
+    let mut reference = None;
     if !args.no_reference {
         let dense = Solver::DEFAULT_GAUSS_SEIDEL;
         match prepared.check_memory(Some(&dense)) {
@@ -48,53 +49,37 @@ pub fn run(args: CompareArgs) -> Result<()> {
                     &mut keep_going,
                     &reporter,
                 )?;
-                reference = (
-                    format!("{:.2}", start.elapsed().as_secs_f64()),
-                    mib(peak_memory_bytes(), reset),
-                    String::new(),
-                );
+                let seconds = start.elapsed().as_secs_f64();
+                let peak = Peak {
+                    bytes: peak_memory_bytes(),
+                    reset,
+                };
                 let emission = prepared.light.emission();
-                let c = radiosity::compare::compare(
+                let difference = radiosity::compare::compare(
                     &prepared.mesh,
                     &exact.radiosity,
-                    &emission,
+                    emission,
                     &solution.mesh,
                     &solution.radiosity,
                 )?;
-                difference = (
-                    format!("{:.2}", 100.0 * c.rms),
-                    format!("{:.1}", 100.0 * c.max),
-                    format!("{:+.2}", 100.0 * c.bias),
-                );
+                reference = Some(Reference {
+                    seconds,
+                    peak,
+                    difference,
+                });
             }
         }
     }
-    outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense reference | dense time (s) | dense peak (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
-    outln!("| --- | ---: | --- | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: |");
-    outln!(
-        "| {stem} | {} | {} | {elements} | {time:.2} | {} | {} | {} | {} | {} | {} | {} |",
-        prepared.mesh.len(),
-        solver.short_label(),
-        mib(peak, reset),
-        if args.no_reference {
-            "-".to_string()
-        } else {
-            prepared.method().to_string()
-        },
-        reference.0,
-        reference.1,
-        difference.0,
-        difference.1,
-        difference.2
-    );
+    report::compare(&CompareRow {
+        stem: &stem,
+        elements: prepared.mesh.len(),
+        solver: solver.short_label(),
+        solver_elements: solution.mesh.len(),
+        seconds,
+        peak,
+        reference_method: (!args.no_reference).then(|| prepared.method().to_string()),
+        reference,
+    });
     reporter.print_timings();
     Ok(())
-}
-
-fn mib(bytes: Option<u64>, reset: bool) -> String {
-    match bytes {
-        Some(b) if reset => format!("{:.0}", b as f64 / (1024.0 * 1024.0)),
-        Some(b) => format!("<= {:.0}", b as f64 / (1024.0 * 1024.0)),
-        None => "?".into(),
-    }
 }

@@ -1,20 +1,24 @@
 //! `radiosity formfactors`: compute the form-factor matrix and write it to a file.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Result;
-use radiosity::form_factor::FormFactorMatrix;
-use radiosity::pipeline::{FormFactorStats, Prepared};
 
-use super::note_form_factor_stats;
 use crate::args::FormFactorArgs;
 use crate::progress_bar::Reporter;
+use crate::report;
 use crate::setup::prepare;
 
 pub fn run(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, _) = prepare(&args.scene, None, &reporter)?;
-    let (f, _) = form_factors(&prepared, None, &reporter)?;
+    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    reporter.note(&format!(
+        "form factors by {}; occlusion: {}",
+        prepared.method(),
+        prepared.method().occlusion()
+    ));
+    let (f, stats) = prepared.form_factors(&reporter)?;
+    report::form_factor_stats(&prepared, &stats, &reporter);
     let output = args
         .output
         .unwrap_or_else(|| PathBuf::from(format!("{stem}.ff")));
@@ -28,26 +32,4 @@ pub fn run(args: FormFactorArgs) -> Result<()> {
     ));
     reporter.print_timings();
     Ok(())
-}
-
-/// Form factors from the file given, or computed (with their statistics reported and
-/// returned).
-fn form_factors(
-    prepared: &Prepared,
-    file: Option<&Path>,
-    reporter: &Reporter,
-) -> Result<(FormFactorMatrix, Option<FormFactorStats>)> {
-    if let Some(path) = file {
-        let f = prepared.load_form_factors(path, reporter)?;
-        reporter.note(&format!("form factors read from {}", path.display()));
-        return Ok((f, None));
-    }
-    reporter.note(&format!(
-        "form factors by {}; occlusion: {}",
-        prepared.method(),
-        prepared.method().occlusion()
-    ));
-    let (f, stats) = prepared.form_factors(reporter)?;
-    note_form_factor_stats(prepared, &stats, reporter);
-    Ok((f, Some(stats)))
 }

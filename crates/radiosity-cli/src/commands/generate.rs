@@ -4,6 +4,7 @@ use anyhow::{bail, Context, Result};
 use radiosity::scene;
 
 use crate::args::BuildingArgs;
+use crate::report;
 
 pub fn building(args: BuildingArgs) -> Result<()> {
     let params = scene::BuildingParams {
@@ -32,19 +33,6 @@ pub fn building(args: BuildingArgs) -> Result<()> {
         }
         Err(e) => return Err(e.into()),
     };
-    let (lo, hi) = built.bounds();
-    let size = hi - lo;
-    outln!(
-        "{}: {} rooms, {} surfaces, {:.0} m^2, {:.1} x {:.1} x {:.1} m; MAX_PATCH_AREA {}: {}",
-        args.output.display(),
-        params.floors * params.rooms_x * params.rooms_z,
-        built.surfaces.len(),
-        built.total_area(),
-        size.x,
-        size.y,
-        size.z,
-        params.max_patch_area,
-        elements
-    );
+    report::building(&args.output, &params, &built, &elements);
     Ok(())
 }

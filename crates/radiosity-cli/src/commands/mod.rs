@@ -24,23 +24,7 @@ use radiosity::shade::{self, Exposure};
 use radiosity::solve::{Observer, Solver};
 
 use crate::progress_bar::Reporter;
-
-/// Notes what computing the form factors found.
-pub fn note_form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter: &Reporter) {
-    reporter.note(&format!(
-        "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
-         reciprocity error {:.1e} largest, {:.1e} of exchanged power",
-        prepared.method(),
-        stats.rays,
-        stats.seconds,
-        stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
-        stats.row_sums.min,
-        stats.row_sums.mean,
-        stats.row_sums.max,
-        stats.reciprocity.max_relative,
-        stats.reciprocity.total_relative
-    ));
-}
+use crate::report;
 
 /// Solves with `solver`: the dense solvers on the form factors (read from `file` or
 /// computed, then dropped), the others from the scene. Returns the form-factor statistics
@@ -74,7 +58,7 @@ pub fn solve_scene(
     };
     let solution = pipeline::solve(prepared, &request, observer, reporter)?;
     if let Some(stats) = &solution.form_factors {
-        note_form_factor_stats(prepared, stats, reporter);
+        report::form_factor_stats(prepared, stats, reporter);
     }
     let stats = solution.form_factors;
     Ok((solution, stats))

@@ -11,7 +11,7 @@ use radiosity::solve::Step;
 use super::{shade_and_render, solve_scene};
 use crate::args::RenderArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{camera, prepare, render_settings};
+use crate::setup::{camera, prepare_solve, render_settings};
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
@@ -19,8 +19,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
-    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
-    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     if args.snapshots.is_some() && solver.needs_matrix() {
         bail!("--snapshots needs --solver progressive");
     }

@@ -9,12 +9,11 @@ use radiosity::progress::{run_stage, Stage};
 use super::solve_scene;
 use crate::args::SolveArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::prepare;
+use crate::setup::prepare_solve;
 
 pub fn run(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, solver) = prepare(&args.scene, Some(&args.solve), &reporter)?;
-    let solver = solver.expect("prepare resolves the solver it is given options for");
+    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let (solution, _) = solve_scene(
         &prepared,
         solver,

@@ -1,0 +1,306 @@
+//! Everything the commands print besides their progress notes: the `check` report, the
+//! note on computed form factors, the Markdown tables of `bench`, `compare` and
+//! `check --compare-methods`, and the summary of `generate building`.
+
+use std::path::Path;
+
+use radiosity::pipeline::{FormFactorStats, Prepared, Solution, SolutionReport};
+use radiosity::scene::{BuildingParams, Scene};
+use radiosity::solve::{Solver, SolverKind};
+
+use crate::progress_bar::{format_duration, Reporter};
+
+/// Notes what computing the form factors found.
+pub fn form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter: &Reporter) {
+    reporter.note(&format!(
+        "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
+         reciprocity error {:.1e} largest, {:.1e} of exchanged power",
+        prepared.method(),
+        stats.rays,
+        stats.seconds,
+        stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
+        stats.row_sums.min,
+        stats.row_sums.mean,
+        stats.row_sums.max,
+        stats.reciprocity.max_relative,
+        stats.reciprocity.total_relative
+    ));
+}
+
+/// Prints the `check` report of `solution` (the stage times from `reporter`); `stats` are
+/// the form factors' statistics when the solve used a matrix.
+pub fn check(
+    stem: &str,
+    prepared: &Prepared,
+    solver: &Solver,
+    solution: &Solution,
+    stats: Option<&FormFactorStats>,
+    reporter: &Reporter,
+) {
+    let scene = &prepared.scene;
+    outln!("scene             {stem}");
+    outln!("surfaces          {}", scene.surfaces.len());
+    outln!("elements          {}", solution.mesh.len());
+    outln!("total area        {:.6}", solution.mesh.total_area());
+    outln!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
+    outln!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
+    outln!("method            {}", prepared.method());
+    outln!("occlusion         {}", prepared.method().occlusion());
+    outln!("solver            {solver}");
+    if let Some(stats) = stats {
+        outln!(
+            "row sums          min {:.6}  mean {:.6}  max {:.6}",
+            stats.row_sums.min,
+            stats.row_sums.mean,
+            stats.row_sums.max
+        );
+        outln!(
+            "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max; {:.3e} of all exchanged power",
+            stats.reciprocity.max_relative, stats.reciprocity.total_relative
+        );
+        if stats.rays > 0 {
+            outln!(
+                "visibility rays   {} ({:.1} M rays/s)",
+                stats.rays,
+                stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+            );
+        }
+    }
+    match &solution.report {
+        SolutionReport::Matrix(report) => {
+            let r = report.residual;
+            outln!(
+                "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
+                r[0],
+                r[1],
+                r[2]
+            );
+        }
+        SolutionReport::Hierarchical(report) => {
+            outln!(
+                "hierarchical      {} leaves, {} clusters, {} links ({} before the first solve), about {:.0} MiB, {} rounds, {} sweeps (changing power {:.1e} of emitted), {} rays, {:.3} s",
+                report.leaves,
+                report.clusters,
+                report.links,
+                report.initial_links,
+                report.memory_bytes as f64 / (1024.0 * 1024.0),
+                report.rounds,
+                report.iterations,
+                report.residual,
+                report.rays,
+                report.elapsed.as_secs_f64()
+            );
+        }
+        SolutionReport::Progressive(report) => {
+            outln!(
+                "progressive       {} shots; unshot power {:.2e} of emitted; ambient {:.3e} / {:.3e} / {:.3e}",
+                report.shots,
+                report.unshot_fraction,
+                report.ambient[0],
+                report.ambient[1],
+                report.ambient[2]
+            );
+        }
+    }
+    let b = &solution.balance;
+    outln!(
+        "energy (R)        emitted {:.6e} = absorbed {:.6e} + escaped {:.6e} (relative error {:.1e})",
+        b.emitted[0],
+        b.absorbed[0],
+        b.escaped[0],
+        b.relative_error()
+    );
+    if let SolutionReport::Progressive(_) = solution.report {
+        outln!(
+            "                  (progressive: the unshot power is neither absorbed nor escaped yet)"
+        );
+    }
+    outln!("stage times:");
+    for (stage, d) in reporter.timings() {
+        outln!("  {:<14}{}", stage.name(), format_duration(d));
+    }
+}
+
+/// Prints the accuracy table of `form_factor::accuracy` as Markdown.
+pub fn method_accuracy(max_area: f64) {
+    use radiosity::form_factor::accuracy::{measure, standard_methods};
+    outln!(
+        "Elements of at most {max_area} (unit squares in {} elements); relative errors.",
+        (1.0 / max_area).round()
+    );
+    outln!();
+    outln!(
+        "| method | opposed squares | perpendicular squares | coaxial discs | element to rectangle | mean | closed box max abs(row sum - 1) | reciprocity | time (ms) | mean error x time |"
+    );
+    outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for method in standard_methods() {
+        let r = measure(method, max_area);
+        outln!(
+            "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.1} | {:.2e} |",
+            r.method,
+            r.opposed,
+            r.perpendicular,
+            r.discs,
+            r.differential,
+            r.mean_error(),
+            r.closed_box,
+            r.reciprocity,
+            r.seconds * 1e3,
+            r.mean_error() * r.seconds
+        );
+    }
+}
+
+/// A row of the `compare` table.
+pub struct CompareRow<'a> {
+    pub stem: &'a str,
+    /// Elements of the prepared mesh.
+    pub elements: usize,
+    /// The solver's short label.
+    pub solver: String,
+    /// Elements of the solver's solution (the hierarchical solver's leaves).
+    pub solver_elements: usize,
+    /// Seconds of the solve.
+    pub seconds: f64,
+    pub peak: Peak,
+    /// The dense reference's method; `None` with `--no-reference`.
+    pub reference_method: Option<String>,
+    /// The dense reference, when it was run.
+    pub reference: Option<Reference>,
+}
+
+/// The dense reference of a `compare` row.
+pub struct Reference {
+    pub seconds: f64,
+    pub peak: Peak,
+    /// The solver's radiosity against the reference's.
+    pub difference: radiosity::compare::Comparison,
+}
+
+/// Peak resident memory in bytes, where known; `reset`: measured from the start of the
+/// solve (else it is the process's peak so far, an upper bound).
+pub struct Peak {
+    pub bytes: Option<u64>,
+    pub reset: bool,
+}
+
+/// Prints the `compare` table: its header and `row`.
+pub fn compare(row: &CompareRow) {
+    let dash = || "-".to_string();
+    let (time, peak, rms, max, mean) = match &row.reference {
+        Some(r) => (
+            format!("{:.2}", r.seconds),
+            mib(&r.peak),
+            format!("{:.2}", 100.0 * r.difference.rms),
+            format!("{:.1}", 100.0 * r.difference.max),
+            format!("{:+.2}", 100.0 * r.difference.bias),
+        ),
+        None => (dash(), dash(), dash(), dash(), dash()),
+    };
+    outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense reference | dense time (s) | dense peak (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
+    outln!("| --- | ---: | --- | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: |");
+    outln!(
+        "| {} | {} | {} | {} | {:.2} | {} | {} | {time} | {peak} | {rms} | {max} | {mean} |",
+        row.stem,
+        row.elements,
+        row.solver,
+        row.solver_elements,
+        row.seconds,
+        mib(&row.peak),
+        row.reference_method.clone().unwrap_or_else(dash),
+    );
+}
+
+/// MiB; "<= N" where the peak could not be reset before the solve, "?" where unknown.
+fn mib(peak: &Peak) -> String {
+    match peak.bytes {
+        Some(b) if peak.reset => format!("{:.0}", b as f64 / (1024.0 * 1024.0)),
+        Some(b) => format!("<= {:.0}", b as f64 / (1024.0 * 1024.0)),
+        None => "?".into(),
+    }
+}
+
+/// Prints the note (stderr) and the header of the `bench` table.
+pub fn bench_header(repeat: usize, size: u32, supersample: u32, solver: SolverKind) {
+    let solver_name = match solver {
+        SolverKind::Auto => {
+            "auto (dense Gauss-Seidel up to 20,000 elements when it fits, else progressive)"
+        }
+        SolverKind::Lu => "LU",
+        SolverKind::GaussSeidel => "Gauss-Seidel",
+        SolverKind::Progressive => "progressive (form factors computed within the solve)",
+        SolverKind::Hierarchical => "hierarchical (links computed within the solve)",
+    };
+    errln!(
+        "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
+        repeat, size, supersample
+    );
+    outln!(
+        "| scene | max area | elements | k | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
+    );
+    outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+}
+
+/// A row of the `bench` table: medians over the runs of one configuration, in seconds.
+pub struct BenchRow {
+    pub elements: usize,
+    pub steps: u32,
+    /// Each stage, in the table's order (parse to render).
+    pub stages: Vec<f64>,
+    /// The form-factor stage (also in `stages`), for the ray rate.
+    pub form_factors: f64,
+    /// End to end less the stages.
+    pub other: f64,
+    pub total: f64,
+    /// End to end less the render stage.
+    pub no_render: f64,
+    pub rays: u64,
+}
+
+/// Prints a `bench` table row for `scene` at MAX_PATCH_AREA `max_area` (`None`: the
+/// scene's own).
+pub fn bench_row(scene: &str, max_area: Option<f64>, row: &BenchRow) {
+    let area = max_area.map_or("scene's".to_string(), |a| a.to_string());
+    let stages: Vec<String> = row.stages.iter().map(|s| ms(*s)).collect();
+    outln!(
+        "| {scene} | {area} | {} | {} | {} | {} | {} | {} | {} | {:.2} M |",
+        row.elements,
+        row.steps,
+        stages.join(" | "),
+        ms(row.other),
+        ms(row.total),
+        ms(row.no_render),
+        row.rays,
+        row.rays as f64 / row.form_factors.max(1e-9) / 1e6,
+    );
+}
+
+/// Milliseconds with three significant digits or so.
+fn ms(seconds: f64) -> String {
+    let ms = seconds * 1e3;
+    if ms >= 100.0 {
+        format!("{ms:.0}")
+    } else if ms >= 10.0 {
+        format!("{ms:.1}")
+    } else {
+        format!("{ms:.2}")
+    }
+}
+
+/// Prints what `generate building` wrote to `output`; `elements` is its element count.
+pub fn building(output: &Path, params: &BuildingParams, built: &Scene, elements: &str) {
+    let (lo, hi) = built.bounds();
+    let size = hi - lo;
+    outln!(
+        "{}: {} rooms, {} surfaces, {:.0} m^2, {:.1} x {:.1} x {:.1} m; MAX_PATCH_AREA {}: {}",
+        output.display(),
+        params.floors * params.rooms_x * params.rooms_z,
+        built.surfaces.len(),
+        built.total_area(),
+        size.x,
+        size.y,
+        size.z,
+        params.max_patch_area,
+        elements
+    );
+}
