@@ -1,0 +1,7 @@
+//! The library's integration tests, one binary (`cargo test -p radiosity --test suite`):
+//! one module per topic, the scenes and helpers they share in `fixtures`.
+
+mod form_factors;
+mod hierarchical;
+mod methods_on_examples;
+mod progressive;
