@@ -4,12 +4,11 @@
 use glam::{dvec3, DVec3};
 use radiosity::form_factor::accuracy::surface_to_surface;
 use radiosity::form_factor::{
-    area_integral_pair, compute_matrix, compute_rows, occluder_bvh, reference, FormFactorContext,
-    FormFactorMethod, RayCounter,
+    area_integral_pair, compute_rows, reference, FormFactorMatrix, FormFactorMethod, RayCounter,
 };
-use radiosity::mesh::mesh_scene;
-use radiosity::progress::NoProgress;
-use radiosity::scene::{MeshSettings, Rgb, Scene, Surface};
+use radiosity::scene::{MeshSettings, Scene};
+
+use crate::fixtures::{closed_cube, element_areas, matrix_for, surface, Meshed};
 
 fn unit_square_z0() -> Vec<DVec3> {
     vec![
@@ -95,18 +94,9 @@ fn perpendicular_unit_squares_converge_as_k() {
     }
 }
 
-fn surface(name: &str, vertices: Vec<DVec3>) -> Surface {
-    Surface {
-        name: name.into(),
-        emission: Rgb::BLACK,
-        reflectance: Rgb([0.5; 3]),
-        vertices,
-    }
-}
-
 /// A closed unit cube, every face facing in, 3 x 3 elements a face.
 fn unit_cube() -> Scene {
-    radiosity::form_factor::accuracy::closed_cube(1.0 / 9.0)
+    closed_cube(1.0 / 9.0)
 }
 
 // Closed cube, 3 x 3 elements per face, k = 8. Row sums equal 1 exactly for the true
@@ -118,15 +108,11 @@ fn unit_cube() -> Scene {
 #[test]
 fn closed_cube_rows_sum_to_one_and_reciprocity_holds() {
     let scene = unit_cube();
-    let mesh = mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+    let meshed = Meshed::new(&scene, scene.settings.max_patch_area);
+    let mesh = &meshed.mesh;
     assert_eq!(mesh.len(), 54);
-    let occluders = occluder_bvh(&scene);
-    let ctx = FormFactorContext {
-        mesh: &mesh,
-        occluders: &occluders,
-    };
     let method = FormFactorMethod::AreaIntegral { steps: 8 };
-    let f = compute_matrix(&ctx, method, &RayCounter::default(), &NoProgress).unwrap();
+    let f = meshed.matrix(method);
     for i in 0..mesh.len() {
         assert_eq!(f.get(i, i), 0.0, "F_ii must be 0 for planar elements");
         for j in 0..mesh.len() {
@@ -135,13 +121,12 @@ fn closed_cube_rows_sum_to_one_and_reciprocity_holds() {
         let sum = f.row_sum(i);
         assert!((sum - 1.0).abs() < 0.0175, "row {i} sums to {sum}");
     }
-    let areas: Vec<f64> = mesh.elements.iter().map(|e| e.area).collect();
     // f32 storage: 6e-8 relative rounding on each side.
-    assert!(f.max_reciprocity_error(&areas) < 1e-6);
+    assert!(f.max_reciprocity_error(&element_areas(mesh)) < 1e-6);
 
     // Rows computed one block at a time, without using reciprocity, agree with the
     // symmetric assembly: the integrand is symmetric, so they match to f32 rounding.
-    let block = compute_rows(&ctx, method, 10..20, &RayCounter::default());
+    let block = compute_rows(&meshed.ctx(), method, 10..20, &RayCounter::default());
     for (r, i) in block.rows.clone().enumerate() {
         for j in 0..mesh.len() {
             let a = block.data[r * mesh.len() + j] as f64;
@@ -181,19 +166,7 @@ fn occluder_blocks_opposed_squares() {
             ],
             camera: None,
         };
-        let mesh = mesh_scene(&scene, 2.0).unwrap();
-        let occ = occluder_bvh(&scene);
-        let ctx = FormFactorContext {
-            mesh: &mesh,
-            occluders: &occ,
-        };
-        let f = compute_matrix(
-            &ctx,
-            FormFactorMethod::AreaIntegral { steps: 8 },
-            &RayCounter::default(),
-            &NoProgress,
-        )
-        .unwrap();
+        let f = Meshed::new(&scene, 2.0).matrix(FormFactorMethod::AreaIntegral { steps: 8 });
         let unoccluded = reference::parallel_rectangles(1.0, 1.0, 1.0);
         if expect_zero {
             assert_eq!(f.get(0, 1), 0.0);
@@ -211,28 +184,11 @@ fn occluder_blocks_opposed_squares() {
 
 /// Asserts |row sum - 1| < `tolerance` for every row of `f` (a closed scene).
 #[track_caller]
-fn assert_rows_sum_to_one(f: &radiosity::form_factor::FormFactorMatrix, tolerance: f64) {
+fn assert_rows_sum_to_one(f: &FormFactorMatrix, tolerance: f64) {
     for i in 0..f.n() {
         let sum = f.row_sum(i);
         assert!((sum - 1.0).abs() < tolerance, "row {i} sums to {sum}");
     }
-}
-
-fn matrix_for(
-    scene: &Scene,
-    method: FormFactorMethod,
-) -> (
-    radiosity::form_factor::FormFactorMatrix,
-    radiosity::mesh::Mesh,
-) {
-    let mesh = mesh_scene(scene, scene.settings.max_patch_area).unwrap();
-    let occ = occluder_bvh(scene);
-    let ctx = FormFactorContext {
-        mesh: &mesh,
-        occluders: &occ,
-    };
-    let f = compute_matrix(&ctx, method, &RayCounter::default(), &NoProgress).unwrap();
-    (f, mesh)
 }
 
 fn opposed_squares_scene(max_area: f64) -> Scene {

@@ -3,33 +3,27 @@
 use std::ops::ControlFlow;
 
 use radiosity::form_factor::{
-    compute_matrix, compute_rows, occluder_bvh, FormFactorContext, FormFactorMatrix,
-    FormFactorMethod, RayCounter, RowComputer,
+    compute_rows, FormFactorContext, FormFactorMatrix, FormFactorMethod, RayCounter, RowComputer,
 };
 use radiosity::light::ElementLight;
-use radiosity::mesh::{mesh_scene, Mesh};
 use radiosity::progress::NoProgress;
 use radiosity::scene::{cornell_box, Rgb, Scene};
 use radiosity::solve::{
     energy_balance, keep_going, solve, solve_progressive, DenseSolver, GaussSeidelSettings,
     ProgressiveReport, ProgressiveSettings, Radiosity, SolveError, Step,
 };
-use radiosity::visibility::PolygonBvh;
 
-/// A closed unit cube, every face facing in, rho 0.5 everywhere; `emit` gives each face's
-/// emission.
+use crate::fixtures::{element_areas, lit_closed_cube, Meshed};
+
+/// A closed unit cube, every face facing in, rho (0.5, 0.3, 0.7) everywhere; `emit` gives
+/// each face's emission.
 fn unit_cube(max_area: f64, emit: impl Fn(usize) -> [f64; 3]) -> Scene {
-    let mut scene = radiosity::form_factor::accuracy::closed_cube(max_area);
-    for (i, s) in scene.surfaces.iter_mut().enumerate() {
-        s.emission = Rgb(emit(i));
-        s.reflectance = Rgb([0.5, 0.3, 0.7]);
-    }
-    scene
+    lit_closed_cube(max_area, emit, [0.5, 0.3, 0.7])
 }
 
+/// A meshed scene with its light, and the per-element values the tests check against.
 struct Setup {
-    mesh: Mesh,
-    bvh: PolygonBvh,
+    meshed: Meshed,
     light: ElementLight,
     rho: Vec<Rgb>,
     e: Vec<Rgb>,
@@ -37,14 +31,12 @@ struct Setup {
 }
 
 fn setup(scene: &Scene, max_area: f64) -> Setup {
-    let mesh = mesh_scene(scene, max_area).unwrap();
-    let bvh = occluder_bvh(scene);
-    let light = ElementLight::of_mesh(&mesh, scene).unwrap();
+    let meshed = Meshed::new(scene, max_area);
+    let light = ElementLight::of_mesh(&meshed.mesh, scene).unwrap();
     let (rho, e) = (light.reflectance().to_vec(), light.emission().to_vec());
-    let areas = mesh.elements.iter().map(|e| e.area).collect();
+    let areas = element_areas(&meshed.mesh);
     Setup {
-        mesh,
-        bvh,
+        meshed,
         light,
         rho,
         e,
@@ -54,10 +46,12 @@ fn setup(scene: &Scene, max_area: f64) -> Setup {
 
 impl Setup {
     fn ctx(&self) -> FormFactorContext<'_> {
-        FormFactorContext {
-            mesh: &self.mesh,
-            occluders: &self.bvh,
-        }
+        self.meshed.ctx()
+    }
+
+    /// The number of elements.
+    fn n(&self) -> usize {
+        self.meshed.mesh.len()
     }
 
     fn progressive(
@@ -87,7 +81,7 @@ impl Setup {
     }
 
     fn dense(&self, method: FormFactorMethod) -> FormFactorMatrix {
-        compute_matrix(&self.ctx(), method, &RayCounter::default(), &NoProgress).unwrap()
+        self.meshed.matrix(method)
     }
 
     fn gauss_seidel(&self, f: &FormFactorMatrix) -> Radiosity {
@@ -126,7 +120,7 @@ fn row_computer_matches_compute_rows() {
     // ~650 elements, so the pair methods take the chunked parallel path (chunks of 256).
     let scene = cornell_box();
     let s = setup(&scene, 3_000.0);
-    let n = s.mesh.len();
+    let n = s.n();
     assert!(n > 512, "{n}");
     let ctx = s.ctx();
     for method in [
@@ -165,7 +159,7 @@ fn row_computer_matches_compute_rows() {
 fn furnace_in_closed_cube() {
     let scene = unit_cube(0.25, |_| [1.0, 2.0, 0.5]);
     let s = setup(&scene, 0.25);
-    assert_eq!(s.mesh.len(), 24);
+    assert_eq!(s.n(), 24);
     for (method, tolerance) in [
         (FormFactorMethod::Contour { steps: 2 }, 1e-8),
         (FormFactorMethod::Hemicube { resolution: 64 }, 2e-2),
@@ -173,7 +167,7 @@ fn furnace_in_closed_cube() {
         let (b, report, _) = s.progressive(method, 1e-10);
         assert!(report.unshot_fraction < 1e-10, "{report:?}");
         let mut worst = 0.0f64;
-        for i in 0..s.mesh.len() {
+        for i in 0..s.n() {
             for k in 0..3 {
                 let expected = s.e[i][k] / (1.0 - s.rho[i][k]);
                 let got = b.0[i][k];
@@ -210,7 +204,7 @@ fn agrees_with_dense_gauss_seidel() {
     ];
     for (scene, max_area, method) in cases {
         let s = setup(&scene, max_area);
-        let n = s.mesh.len();
+        let n = s.n();
         let (b, report, _) = s.progressive(method, 1e-6);
         let f = s.dense(method);
         let reference = s.gauss_seidel(&f);
@@ -234,7 +228,7 @@ fn agrees_with_dense_gauss_seidel() {
 fn hemicube_solves_with_reciprocal_of_rows() {
     let (scene, max_area) = small_cornell();
     let s = setup(&scene, max_area);
-    let n = s.mesh.len();
+    let n = s.n();
     let method = FormFactorMethod::Hemicube { resolution: 64 };
     let f = s.dense(method);
     let mut transposed = vec![0.0f32; n * n];
@@ -365,7 +359,7 @@ fn ambient_is_for_display_only_and_observer_can_stop() {
     for k in 0..3 {
         assert!((report.ambient[k] - ambient[k]).abs() < 1e-12 * ambient[k]);
     }
-    for i in 0..s.mesh.len() {
+    for i in 0..s.n() {
         assert_eq!(b.element(i), last[i]);
     }
 }
@@ -406,7 +400,7 @@ fn refusals() {
     // (The matrix solver entry point takes a `DenseSolver`: it cannot be handed progressive
     // refinement at all.)
     // Nothing emitted: B = 0 after no shots.
-    let dark = ElementLight::new(s.rho.clone(), vec![Rgb::BLACK; s.mesh.len()]).unwrap();
+    let dark = ElementLight::new(s.rho.clone(), vec![Rgb::BLACK; s.n()]).unwrap();
     let (b, report) = solve_progressive(
         &s.ctx(),
         method,

@@ -1,12 +1,10 @@
 //! Every method on every example scene: form factors are non-negative, F_ii = 0, and rows
 //! sum to at most 1 plus the method's own error bound; sampled methods are deterministic.
 
-use radiosity::form_factor::{
-    compute_matrix, occluder_bvh, FormFactorContext, FormFactorMethod, RayCounter,
-};
-use radiosity::mesh::mesh_scene;
-use radiosity::progress::NoProgress;
+use radiosity::form_factor::FormFactorMethod;
 use radiosity::scene::read_scene;
+
+use crate::fixtures::Meshed;
 
 fn examples() -> Vec<std::path::PathBuf> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
@@ -60,14 +58,9 @@ fn every_method_on_every_example_keeps_rows_at_most_one() {
     for path in examples() {
         let scene = read_scene(&path).unwrap();
         // Coarser than the scene asks, to keep the test quick on two cores.
-        let mesh = mesh_scene(&scene, 8.0 * scene.settings.max_patch_area).unwrap();
-        let occ = occluder_bvh(&scene);
-        let ctx = FormFactorContext {
-            mesh: &mesh,
-            occluders: &occ,
-        };
+        let meshed = Meshed::new(&scene, 8.0 * scene.settings.max_patch_area);
         for (method, bound) in methods {
-            let f = compute_matrix(&ctx, method, &RayCounter::default(), &NoProgress).unwrap();
+            let f = meshed.matrix(method);
             let mut worst: f64 = 0.0;
             for i in 0..f.n() {
                 assert_eq!(f.get(i, i), 0.0, "{}: {method}: F_ii", path.display());
@@ -87,8 +80,7 @@ fn every_method_on_every_example_keeps_rows_at_most_one() {
                 method,
                 FormFactorMethod::MonteCarlo { .. } | FormFactorMethod::Hemicube { .. }
             ) {
-                let again =
-                    compute_matrix(&ctx, method, &RayCounter::default(), &NoProgress).unwrap();
+                let again = meshed.matrix(method);
                 assert_eq!(
                     f,
                     again,

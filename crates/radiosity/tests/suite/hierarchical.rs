@@ -4,22 +4,17 @@
 use radiosity::compare::compare;
 use radiosity::form_factor::occluder_bvh;
 use radiosity::light::Rgb as Light;
-use radiosity::pipeline::{self, Overrides, Prepared, SolveRequest};
 use radiosity::progress::NoProgress;
-use radiosity::scene::{cornell_box, Rgb, Scene};
+use radiosity::scene::{cornell_box, Scene};
 use radiosity::solve::{
-    keep_going, solve_hierarchical, HierarchicalSettings, HierarchicalSolution, Solver,
-    DEFAULT_HIERARCHICAL_TOLERANCE,
+    solve_hierarchical, HierarchicalSettings, HierarchicalSolution, DEFAULT_HIERARCHICAL_TOLERANCE,
 };
 
-/// A closed unit cube, every face facing in, E and rho uniform.
+use crate::fixtures::{dense_gauss_seidel, lit_closed_cube, prepared_cornell};
+
+/// A closed unit cube, one element a face, every face facing in, E and rho uniform.
 fn unit_cube(e: [f64; 3], rho: [f64; 3]) -> Scene {
-    let mut scene = radiosity::form_factor::accuracy::closed_cube(1.0);
-    for s in &mut scene.surfaces {
-        s.emission = Rgb(e);
-        s.reflectance = Rgb(rho);
-    }
-    scene
+    lit_closed_cube(1.0, |_| e, rho)
 }
 
 fn solve(scene: &Scene, epsilon: f64, min_area: f64) -> HierarchicalSolution {
@@ -62,22 +57,8 @@ struct Dense {
 }
 
 fn dense_cornell() -> Dense {
-    let prepared = Prepared::new(
-        cornell_box(),
-        Overrides {
-            max_patch_area: Some(2000.0),
-            integral_steps: Some(2),
-        },
-        &NoProgress,
-    )
-    .unwrap();
-    let dense = pipeline::solve(
-        &prepared,
-        &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
-        &mut keep_going,
-        &NoProgress,
-    )
-    .unwrap();
+    let prepared = prepared_cornell(2000.0, Some(2));
+    let dense = dense_gauss_seidel(&prepared);
     let emission = prepared.light.emission().to_vec();
     Dense {
         per_surface: per_surface(&prepared.mesh, &dense.radiosity),
@@ -326,23 +307,9 @@ fn against_exact_dense(
     max_area: f64,
     settings: &[(f64, f64)],
 ) -> Vec<radiosity::compare::Comparison> {
-    let mut prepared = Prepared::new(
-        cornell_box(),
-        Overrides {
-            max_patch_area: Some(max_area),
-            integral_steps: None,
-        },
-        &NoProgress,
-    )
-    .unwrap();
+    let mut prepared = prepared_cornell(max_area, None);
     prepared.method = radiosity::form_factor::FormFactorMethod::Contour { steps: 4 };
-    let dense = pipeline::solve(
-        &prepared,
-        &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
-        &mut keep_going,
-        &NoProgress,
-    )
-    .unwrap();
+    let dense = dense_gauss_seidel(&prepared);
     let emission = prepared.light.emission();
     settings
         .iter()
