@@ -5,8 +5,11 @@ use std::path::Path;
 
 /// Writes `path` by calling `write` on a temporary file beside it, then renaming it into place.
 ///
-/// The rename is atomic on POSIX file systems, so `path` either keeps its old content or gets
-/// the whole new content, never part of it. On error the temporary file is removed.
+/// The temporary file is [`tempfile`]'s, made in the directory of `path` (a rename within
+/// one directory is atomic on POSIX file systems), so `path` either keeps its old content or
+/// gets the whole new content, never part of it. On error the temporary file is removed and
+/// `path` is left as it was. The new file gets the permissions [`std::fs::File::create`]
+/// would give it (0666 less the umask), not the owner-only ones of a temporary file.
 ///
 /// A symbolic link is followed (its target is replaced, the link kept), and an existing
 /// path that is not a regular file (a device such as /dev/stdout, a named pipe) is written
@@ -31,30 +34,29 @@ pub fn write_atomically(
         _ => path,
     };
     let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
     };
     let name = path.file_name().ok_or_else(|| {
         io::Error::new(io::ErrorKind::InvalidInput, "output path has no file name")
     })?;
-    let tmp = dir.join(format!(
-        ".{}.tmp-{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let file = std::fs::File::create(&tmp)?;
-        let mut out = io::BufWriter::new(file);
-        write(&mut out)?;
-        out.flush()?;
-        out.get_ref().sync_all()?;
-        drop(out);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{}.", name.to_string_lossy());
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    result
+    // The file is written through its own handle; `tmp` removes it when dropped, which is
+    // what happens on every early return below.
+    let (file, tmp) = builder.tempfile_in(dir)?.into_parts();
+    let mut out = io::BufWriter::new(file);
+    write(&mut out)?;
+    out.flush()?;
+    out.get_ref().sync_all()?;
+    drop(out);
+    tmp.persist(path).map_err(|e| e.error)
 }
 
 #[cfg(test)]
@@ -79,6 +81,41 @@ mod tests {
         );
         write_atomically(&path, |w| w.write_all(b"whole")).unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "whole");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn failed_write_leaves_the_old_file_untouched() {
+        let dir = std::env::temp_dir().join(format!("radiosity-aw-old-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("out.txt");
+        std::fs::write(&path, "old").unwrap();
+        let err = write_atomically(&path, |w| {
+            w.write_all(&[b'x'; 100_000])?;
+            Err(io::Error::other("boom"))
+        });
+        assert_eq!(err.unwrap_err().to_string(), "boom");
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            1,
+            "temporary file left behind"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn new_file_has_the_permissions_of_file_create() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = std::env::temp_dir().join(format!("radiosity-aw-mode-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let created = dir.join("created.txt");
+        std::fs::File::create(&created).unwrap();
+        let written = dir.join("written.txt");
+        write_atomically(&written, |w| w.write_all(b"x")).unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode();
+        assert_eq!(mode(&written), mode(&created));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
