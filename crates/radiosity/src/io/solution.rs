@@ -73,14 +73,24 @@ pub fn records(scene: &Scene, mesh: &Mesh, element_b: &[[f64; 3]]) -> Vec<Elemen
         .collect()
 }
 
-/// A CSV field, quoted per RFC 4180 when it holds a comma, a double quote, a carriage
-/// return or a line feed (inner quotes doubled).
-fn csv_field(s: &str) -> std::borrow::Cow<'_, str> {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\"")).into()
-    } else {
-        s.into()
-    }
+/// The fields of one CSV row, in [`HEADER`] order, numbers as Rust's `Display` writes them.
+///
+/// The rows go through the `csv` crate, which quotes per RFC 4180 (a field holding a comma,
+/// a double quote, a carriage return or a line feed is quoted, inner quotes doubled), but
+/// not through its serde support: that writes floats its own way (`1.0`, `1.5e-7`), and
+/// the files keep the shortest exact form without an exponent (`1`, `0.00000015`).
+fn csv_fields(r: &ElementRecord) -> [String; 9] {
+    [
+        r.surface.clone(),
+        r.element.to_string(),
+        r.area.to_string(),
+        r.centroid_x.to_string(),
+        r.centroid_y.to_string(),
+        r.centroid_z.to_string(),
+        r.radiosity_r.to_string(),
+        r.radiosity_g.to_string(),
+        r.radiosity_b.to_string(),
+    ]
 }
 
 /// Writes the solution to `path`: CSV with the header line [`HEADER`] and one row per
@@ -116,23 +126,12 @@ pub fn write_solution(
             serde_json::to_writer_pretty(&mut *w, &rows).map_err(io::Error::other)?;
             writeln!(w)
         } else {
-            writeln!(w, "{HEADER}")?;
+            let mut csv = csv::Writer::from_writer(w);
+            csv.write_record(HEADER.split(','))?;
             for r in &rows {
-                writeln!(
-                    w,
-                    "{},{},{},{},{},{},{},{},{}",
-                    csv_field(&r.surface),
-                    r.element,
-                    r.area,
-                    r.centroid_x,
-                    r.centroid_y,
-                    r.centroid_z,
-                    r.radiosity_r,
-                    r.radiosity_g,
-                    r.radiosity_b
-                )?;
+                csv.write_record(csv_fields(r))?;
             }
-            Ok(())
+            csv.flush()
         }
     })
 }
@@ -210,6 +209,74 @@ mod tests {
             1.0 / 3.0
         );
         std::fs::remove_file(&path).unwrap();
+    }
+
+    /// The hand-written CSV of the writer before it used the `csv` crate.
+    fn old_csv(rows: &[ElementRecord]) -> String {
+        let field = |s: &str| {
+            if s.contains([',', '"', '\n', '\r']) {
+                format!("\"{}\"", s.replace('"', "\"\""))
+            } else {
+                s.to_string()
+            }
+        };
+        let mut out = format!("{HEADER}\n");
+        for r in rows {
+            out += &format!(
+                "{},{},{},{},{},{},{},{},{}\n",
+                field(&r.surface),
+                r.element,
+                r.area,
+                r.centroid_x,
+                r.centroid_y,
+                r.centroid_z,
+                r.radiosity_r,
+                r.radiosity_g,
+                r.radiosity_b
+            );
+        }
+        out
+    }
+
+    #[test]
+    fn csv_bytes_are_those_of_the_hand_written_writer() {
+        let mut s = scene();
+        let names = [
+            "",
+            " lead",
+            "tab\there",
+            "cr\rlf",
+            "q\"",
+            "#hash",
+            "é, ü",
+            "x",
+        ];
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            1e300,
+            -2.5e-300,
+            f64::MIN_POSITIVE / 3.0,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            1.0 / 3.0,
+            123456789.125,
+            -1.5e-7,
+        ];
+        for (k, name) in names.iter().enumerate() {
+            s.surfaces[k % 2].name = name.to_string();
+            let mesh = mesh_scene(&s, 1.0).unwrap();
+            let b: Vec<[f64; 3]> = (0..mesh.len())
+                .map(|e| [0, 1, 2].map(|i| values[(k + 3 * e + i) % values.len()]))
+                .collect();
+            let path = temp(&format!("bytes-{k}.csv"));
+            write_solution(&path, &s, &mesh, &b).unwrap();
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert_eq!(text, old_csv(&records(&s, &mesh, &b)), "{name:?}");
+            std::fs::remove_file(&path).unwrap();
+        }
     }
 
     #[test]
