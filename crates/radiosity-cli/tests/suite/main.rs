@@ -1,5 +1,7 @@
 //! The `radiosity` program's integration tests, one binary (`cargo test -p radiosity-cli
-//! --test suite`): one module per topic.
+//! --test suite`): one module per topic, what they share in `fixtures`.
+
+mod fixtures;
 
 mod commands;
 mod view;

@@ -1,11 +1,11 @@
 //! `radiosity view` where it cannot open a window: a message that says what is missing and
 //! what to do, exit status 1, no panic.
 
-use std::process::Command;
+use crate::fixtures::radiosity_command;
 
 #[test]
 fn view_without_a_display_says_what_to_do() {
-    let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+    let out = radiosity_command()
         .arg("view")
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")

@@ -120,8 +120,10 @@ fn disc(z: f64, up: bool) -> Vec<DVec3> {
     v
 }
 
-/// A closed unit cube with every face looking in.
-pub fn closed_cube(max_area: f64) -> Scene {
+/// A closed unit cube with every face looking in: the scene of the closed-box and
+/// reciprocity columns. (The integration tests build the same cube as a fixture of their
+/// own and check it against these columns.)
+fn closed_cube(max_area: f64) -> Scene {
     let c = |x: f64, y: f64, z: f64| dvec3(x, y, z);
     let faces = vec![
         vec![c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
@@ -259,5 +261,51 @@ pub fn measure(method: FormFactorMethod, max_area: f64) -> AccuracyRow {
         closed_box,
         reciprocity,
         seconds: start.elapsed().as_secs_f64(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closed_cube_is_six_unit_faces_looking_in() {
+        let scene = closed_cube(1.0 / 9.0);
+        assert_eq!(scene.surfaces.len(), 6);
+        let centre = dvec3(0.5, 0.5, 0.5);
+        for s in &scene.surfaces {
+            assert_eq!(
+                crate::geometry::polygon_area(&s.vertices),
+                1.0,
+                "{}",
+                s.name
+            );
+            let n = crate::geometry::polygon_normal(&s.vertices).unwrap();
+            let inward = centre - crate::geometry::polygon_centroid(&s.vertices);
+            assert!(
+                (n - 2.0 * inward).length() < 1e-15,
+                "{}: normal {n}",
+                s.name
+            );
+        }
+        let mesh = mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        assert_eq!(mesh.len(), 54);
+    }
+
+    // The contour method is exact for unoccluded pairs, so its row measures the scenes
+    // themselves: opposed and perpendicular squares to the f32 rounding of the stored
+    // matrix (2e-7, as in the integration tests); the 128-gon discs within their 4e-4 area
+    // deficit (measured 1.8e-4); the small square within about 1e-4 of the differential
+    // element's value (measured 1.5e-5: bound 2e-4); the closed cube's rows to the f32
+    // rounding of 54 entries (4e-6) and reciprocity to f32 rounding (1e-6).
+    #[test]
+    fn contour_row_measures_the_scenes_to_rounding() {
+        let row = measure(FormFactorMethod::Contour { steps: 2 }, 1.0 / 9.0);
+        assert!(row.opposed < 2e-7, "{row:?}");
+        assert!(row.perpendicular < 2e-7, "{row:?}");
+        assert!(row.discs < 4e-4, "{row:?}");
+        assert!(row.differential < 2e-4, "{row:?}");
+        assert!(row.closed_box < 4e-6, "{row:?}");
+        assert!(row.reciprocity < 1e-6, "{row:?}");
     }
 }

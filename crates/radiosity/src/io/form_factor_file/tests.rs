@@ -5,6 +5,8 @@ use super::*;
 use crate::mesh::mesh_scene;
 use crate::scene::{MeshSettings, Rgb, Scene, Surface};
 use glam::dvec3;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
 
 /// A fresh empty directory for one test.
 fn temp_dir(name: &str) -> PathBuf {
@@ -45,13 +47,8 @@ fn scene(lift: f64) -> Scene {
 
 /// A matrix with awkward f32 values (subnormal, -0, max, tiny) among ordinary ones.
 fn matrix(n: usize) -> FormFactorMatrix {
-    let mut state = 0x1234_5678u32;
-    let mut data: Vec<f32> = (0..n * n)
-        .map(|_| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1u32 << 24) as f32 / n as f32
-        })
-        .collect();
+    let mut rng = Pcg64Mcg::seed_from_u64(0x1234_5678);
+    let mut data: Vec<f32> = (0..n * n).map(|_| rng.random::<f32>() / n as f32).collect();
     data[1] = f32::MIN_POSITIVE / 8.0;
     data[2] = -0.0;
     data[3] = f32::MAX;

@@ -3,6 +3,8 @@
 
 use super::*;
 use crate::geometry;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
 
 /// A valid one-patch scene; the line numbers below refer to it.
 const VALID: &str = "MAX_PATCH_AREA 100
@@ -660,19 +662,6 @@ fn box_errors() {
 
 // ----- robustness -----
 
-/// A small deterministic generator for the garbling test.
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self, n: usize) -> usize {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 33) as usize) % n.max(1)
-    }
-}
-
 #[test]
 fn garbled_input_never_panics() {
     let source = format!(
@@ -710,17 +699,17 @@ fn garbled_input_never_panics() {
         .chars()
         .collect();
     let chars: Vec<char> = source.chars().collect();
-    let mut rng = Lcg(7);
+    let mut rng = Pcg64Mcg::seed_from_u64(7);
     for _ in 0..3000 {
         let mut edited = chars.clone();
-        for _ in 0..1 + rng.next(4) {
-            let at = rng.next(edited.len());
-            match rng.next(3) {
+        for _ in 0..1 + rng.random_range(0..4) {
+            let at = rng.random_range(0..edited.len());
+            match rng.random_range(0..3) {
                 0 => {
                     edited.remove(at);
                 }
-                1 => edited.insert(at, alphabet[rng.next(alphabet.len())]),
-                _ => edited[at] = alphabet[rng.next(alphabet.len())],
+                1 => edited.insert(at, alphabet[rng.random_range(0..alphabet.len())]),
+                _ => edited[at] = alphabet[rng.random_range(0..alphabet.len())],
             }
         }
         let text: String = edited.into_iter().collect();
