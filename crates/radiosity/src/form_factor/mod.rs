@@ -61,24 +61,28 @@ pub struct OutOfMemory {
     pub fits: usize,
 }
 
-/// Memory this process may use, in bytes: `MemAvailable` from /proc/meminfo (8 GiB where
-/// there is none), capped by the cgroup v2 limit (`/sys/fs/cgroup/memory.max`) when one is
-/// set. A `ulimit -v` address-space limit is not seen.
+/// Memory this process may use, in bytes: the memory the system reports available
+/// ([`sysinfo`]'s `available_memory`; on Linux `MemAvailable` from /proc/meminfo), capped by
+/// the memory limit of the cgroup when one is set (cgroup v2 `/sys/fs/cgroup/memory.max`, or
+/// v1 `memory.limit_in_bytes`); 8 GiB where the system reports nothing. A `ulimit -v`
+/// address-space limit is not seen.
+///
+/// This is the number the hand-written reader of /proc/meminfo and memory.max gave (MemAvailable
+/// in KiB times 1024, the smaller of it and memory.max), except that a cgroup v1 limit now
+/// counts too, and other systems report their own figure instead of the 8 GiB guess.
 pub fn available_memory_bytes() -> u64 {
-    let available = std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("MemAvailable:"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
-        })
-        .map(|kib| kib * 1024)
-        .unwrap_or(8 << 30);
-    let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
-        .ok()
-        .and_then(|s| s.trim().parse::<u64>().ok());
-    match cgroup {
-        Some(limit) => available.min(limit),
+    use sysinfo::{MemoryRefreshKind, RefreshKind, System};
+    let system = System::new_with_specifics(
+        RefreshKind::nothing().with_memory(MemoryRefreshKind::nothing().with_ram()),
+    );
+    let available = system.available_memory();
+    // cgroup_limits asserts that the memory was read (a non-zero total).
+    if available == 0 || system.total_memory() == 0 {
+        return 8 << 30;
+    }
+    // The limit's total is min(limit, total memory), so this is min(available, limit).
+    match system.cgroup_limits() {
+        Some(limits) => available.min(limits.total_memory),
         None => available,
     }
 }
@@ -482,4 +486,40 @@ pub fn compute_rows(
         .flatten_iter()
         .collect();
     RowBlock { rows, data }
+}
+
+#[cfg(test)]
+mod tests {
+    /// `MemAvailable` read by hand, capped by a cgroup limit read by hand, matches
+    /// [`super::available_memory_bytes`] up to what other processes change in between.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn available_memory_is_mem_available_capped_by_the_cgroup() {
+        let read = |path: &str| std::fs::read_to_string(path).ok();
+        let Some(meminfo) = read("/proc/meminfo") else {
+            return;
+        };
+        let kib = |key: &str| {
+            meminfo
+                .lines()
+                .find(|l| l.starts_with(key))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+                .map(|k| k * 1024)
+        };
+        let (Some(available), Some(total)) = (kib("MemAvailable:"), kib("MemTotal:")) else {
+            return;
+        };
+        let limit = [
+            "/sys/fs/cgroup/memory.max",
+            "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+        ]
+        .iter()
+        .find_map(|p| read(p)?.trim().parse::<u64>().ok())
+        .unwrap_or(u64::MAX);
+        let by_hand = available.min(limit) as f64;
+        let got = super::available_memory_bytes();
+        assert!(got <= total.min(limit), "{got} > {total} or {limit}");
+        let slack = (0.1 * by_hand).max((256 << 20) as f64);
+        assert!((got as f64 - by_hand).abs() <= slack, "{got} vs {by_hand}");
+    }
 }
