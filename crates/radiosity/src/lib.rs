@@ -23,6 +23,7 @@
 //! * [`shade`]: vertex radiosities for smooth shading (paper 2.5).
 //! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7), PNG
 //!   images.
+//! * [`pathtrace`]: an unbiased diffuse path tracer, the yardstick for radiosity images.
 //! * [`progress`]: the one interface long work reports through.
 //! * [`solution`]: the per-element solution as CSV or JSON.
 //!
@@ -66,6 +67,7 @@ pub mod form_factor;
 pub mod geometry;
 pub mod light;
 pub mod mesh;
+pub mod pathtrace;
 pub mod pipeline;
 pub mod progress;
 pub mod render;
