@@ -6,7 +6,7 @@
 //! diffusely; the back of a surface is black (it absorbs, emits nothing, reflects nothing).
 //! Each pixel's value is the radiosity B = pi L seen through it, in the scene's units: the
 //! quantity [`crate::render::render`] shows (a surface of uniform radiosity B renders as B),
-//! so the two films compare directly and tone-map alike
+//! so the two films compare directly ([`compare_films`]) and tone-map alike
 //! ([`crate::render::tonemap`], with the same exposure and gamma).
 //!
 //! The estimator is the plainest unbiased one, paths from the camera (Kajiya 1986, "The
@@ -30,6 +30,8 @@
 //!   a seed whatever the number of threads.
 //! * `estimate`: the result, [`PathTraced`]: the film of pixel means, each mean's standard
 //!   error (per band and on luminance), and the mask of pixels that show an emitter.
+//! * `compare`: two films compared on luminance ([`compare_films`],
+//!   [`PathTraced::compare`]) and the per-pixel error in false colour ([`ErrorMap`]).
 //!
 //! ```
 //! use radiosity::pathtrace::{self, PathTraceSettings};
@@ -46,6 +48,7 @@
 //! # Ok::<(), radiosity::pathtrace::PathTraceError>(())
 //! ```
 
+mod compare;
 mod estimate;
 mod integrator;
 mod lights;
@@ -53,6 +56,10 @@ mod sampling;
 mod settings;
 mod view;
 
+pub use compare::{
+    compare_films, false_colour, ErrorMap, FilmCompareError, FilmComparison,
+    DEFAULT_ERROR_FULL_SCALE,
+};
 pub use estimate::{NoiseSummary, PathTraced};
 pub use integrator::{PathSample, PathTracer, MAX_SURVIVAL_PROBABILITY};
 pub use settings::{PathTraceError, PathTraceSettings, MIN_SAMPLES_PER_PIXEL};
