@@ -54,6 +54,8 @@ mod integrator;
 mod lights;
 mod sampling;
 mod settings;
+#[cfg(test)]
+mod tests;
 mod view;
 
 pub use compare::{
