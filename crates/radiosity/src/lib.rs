@@ -22,6 +22,9 @@
 //!   point that takes any [`Solver`] and returns a [`Solution`] on its own mesh.
 //! * [`shade`]: vertex radiosities for smooth shading (paper 2.5).
 //! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7).
+//! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7), PNG
+//!   images.
+//! * [`pathtrace`]: an unbiased diffuse path tracer, the yardstick for radiosity images.
 //! * [`progress`]: the one interface long work reports through.
 //! * [`io`]: every file read or written: the paper's Appendix A scene format, the
 //!   form-factor file (paper 2.8), the per-element solution as CSV or JSON, PNG images.
@@ -66,6 +69,7 @@ pub mod geometry;
 pub mod io;
 pub mod light;
 pub mod mesh;
+pub mod pathtrace;
 pub mod pipeline;
 pub mod progress;
 pub mod render;
