@@ -75,9 +75,9 @@ fn rendering(c: &mut Criterion) {
     };
     let solution = run::solve(&p, &request, &mut keep_going, &NoProgress).unwrap();
     let element_b = solution.element_rgb();
-    let vertex_b = shade::vertex_radiosity(&p.mesh, &element_b);
+    let vertex_b = shade::vertex_radiosity(&p.mesh, element_b);
     let settings = RenderSettings {
-        exposure_scale: Exposure::Brightest.scale(&p.scene, &p.mesh, &element_b),
+        exposure_scale: Exposure::Brightest.scale(&p.scene, &p.mesh, element_b),
         ..RenderSettings::default()
     };
     let camera = Camera::for_scene(&p.scene, 256, 256);
@@ -88,7 +88,7 @@ fn rendering(c: &mut Criterion) {
             black_box(render::render(
                 &renderer,
                 &camera,
-                &element_b,
+                element_b,
                 &vertex_b,
                 &settings,
                 &NoProgress,

@@ -202,7 +202,7 @@ mod tests {
             width: 200,
             height: 200,
         };
-        assert!(200 * 200 * 64 > STRIP_SAMPLES && 200 * 64 < STRIP_SAMPLES);
+        const { assert!(200 * 200 * 64 > STRIP_SAMPLES && 200 * 64 < STRIP_SAMPLES) };
         for shading in [Shading::Smooth, Shading::Flat, Shading::Wireframe] {
             let settings = RenderSettings {
                 shading,
