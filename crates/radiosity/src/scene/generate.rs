@@ -45,8 +45,9 @@ use glam::{dvec3, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-use super::shape::{axis_aligned_base, box_faces, flatten, Facing};
+use super::shape::{axis_aligned_base, box_faces, Facing};
 use super::{MeshSettings, Rgb, Scene, Surface};
+use crate::geometry::flatten;
 
 /// Wall thickness (m).
 pub const WALL_THICKNESS: f64 = 0.15;

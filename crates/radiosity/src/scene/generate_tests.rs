@@ -5,7 +5,6 @@ use glam::{DVec2, DVec3};
 use super::*;
 use crate::geometry;
 use crate::io::scene_file::{parse_scene, write_scene};
-use crate::scene::shape::check_polygon;
 
 fn small(furniture: bool) -> BuildingParams {
     BuildingParams {
@@ -96,7 +95,8 @@ fn every_surface_is_a_valid_polygon() {
     });
     for s in &scene.surfaces {
         let mut v = s.vertices.clone();
-        check_polygon(&mut v).unwrap_or_else(|e| panic!("{}: {e}", s.name));
+        geometry::validate_polygon(&v).unwrap_or_else(|e| panic!("{}: {e}", s.name));
+        geometry::flatten(&mut v);
         assert_eq!(v, s.vertices, "{} was not flat", s.name);
         assert!(geometry::polygon_area(&v) > 1e-4, "{}", s.name);
     }

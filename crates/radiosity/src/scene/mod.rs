@@ -20,7 +20,6 @@ pub(crate) mod shape;
 
 pub use builtin::cornell_box;
 pub use generate::{building, BuildingParams};
-pub use shape::PLANARITY_TOLERANCE;
 
 /// The scene file's reader, writer and error, at the paths the command line and the viewer
 /// use; they live in [`crate::io::scene_file`].

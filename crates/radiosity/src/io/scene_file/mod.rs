@@ -53,13 +53,13 @@
 //! `1e-3`), and must be finite. Anything else on a line is an error. Every error in a file is
 //! reported with its line and column ([`ParseError`], collected in a [`SceneError`]); after an
 //! error inside a block the reader skips to the block's end and carries on. Problems with a
-//! polygon's shape are reported at its `VERTEX0` line.
+//! polygon's shape ([`crate::geometry::PolygonError`]) are reported at its `VERTEX0` line.
 //!
 //! # Polygon checks and planarity
 //!
 //! Every polygon must have distinct corners and a non-zero area, be convex, and be planar: a
 //! polygon is accepted when no corner is further from its best-fit plane (Newell normal
-//! through the corner mean) than [`PLANARITY_TOLERANCE`](crate::scene::PLANARITY_TOLERANCE) (0.2 %) of its diameter, and its
+//! through the corner mean) than [`PLANARITY_TOLERANCE`](crate::geometry::PLANARITY_TOLERANCE) (0.2 %) of its diameter, and its
 //! corners are then projected onto that plane. Measured data needs the tolerance: the
 //! Cornell box's red (left) wall is 0.80 mm out of plane over a 783.5 mm diagonal (0.10 %).
 //! Flattening it would move each corner 0.80 mm off its neighbours' and open gaps that rays
@@ -70,6 +70,7 @@
 //! times larger than their polygons).
 
 mod lex;
+mod polygon;
 mod read;
 mod write;
 

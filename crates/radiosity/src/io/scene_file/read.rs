@@ -6,6 +6,8 @@ use glam::{dvec3, DVec3};
 use thiserror::Error;
 
 use super::lex::{lex, Keyword, Line, Token};
+use super::polygon;
+use crate::geometry;
 use crate::light::Rgb;
 use crate::scene::shape::{self, Facing};
 use crate::scene::{MeshSettings, Scene, Surface};
@@ -525,12 +527,16 @@ impl<'a> Parser<'a> {
         })
     }
 
-    /// Checks and flattens a polygon, reporting a problem at its `VERTEX0` line.
+    /// Checks and flattens a polygon ([`geometry::validate_polygon`], [`geometry::flatten`]),
+    /// reporting a problem at its `VERTEX0` line.
     fn check_polygon(&mut self, corners: &mut Corners) -> Option<()> {
-        match shape::check_polygon(&mut corners.vertices) {
-            Ok(()) => Some(()),
-            Err(msg) => {
-                self.error(corners.line, corners.column, msg);
+        match geometry::validate_polygon(&corners.vertices) {
+            Ok(()) => {
+                geometry::flatten(&mut corners.vertices);
+                Some(())
+            }
+            Err(e) => {
+                self.error(corners.line, corners.column, polygon::message(&e));
                 None
             }
         }
