@@ -25,19 +25,11 @@ pub use generate::{building, BuildingParams};
 /// use; they live in [`crate::io::scene_file`].
 pub use crate::io::scene_file::{read_scene, write_scene_file, SceneError};
 
+/// The meshing settings of a scene file: see [`crate::mesh::MeshSettings`].
+pub use crate::mesh::MeshSettings;
+
 /// Colours of surfaces: see [`crate::light`].
 pub use crate::light::Rgb;
-
-/// The meshing and integration settings at the top of a scene file.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MeshSettings {
-    /// `MAX_PATCH_AREA`: surfaces larger than this (scene units squared) are subdivided into
-    /// elements of at most this area.
-    pub max_patch_area: f64,
-    /// `INTEGRAL_STEPS`: k, the number of sample points along each axis of each element in
-    /// the double area integral (paper 2.8; 1 means one point per element).
-    pub integral_steps: u32,
-}
 
 /// One planar convex polygon of the scene, as written in a `PATCHBEGIN` ... `PATCHEND` block.
 #[derive(Clone, Debug, PartialEq)]
