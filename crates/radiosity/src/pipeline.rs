@@ -403,6 +403,7 @@ pub fn solve(
         Solver::Hierarchical(settings) => {
             let h = solve::solve_hierarchical(
                 &prepared.scene,
+                prepared.scene.settings.max_patch_area,
                 &prepared.occluders,
                 settings,
                 progress,

@@ -25,7 +25,14 @@ fn solve(scene: &Scene, epsilon: f64, min_area: f64) -> HierarchicalSolution {
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: None,
     };
-    solve_hierarchical(scene, &bvh, &settings, &NoProgress).unwrap()
+    solve_hierarchical(
+        scene,
+        scene.settings.max_patch_area,
+        &bvh,
+        &settings,
+        &NoProgress,
+    )
+    .unwrap()
 }
 
 /// Area-weighted mean B of every input surface, per band.
@@ -270,7 +277,8 @@ fn refuses_bad_settings() {
             tolerance,
             max_memory_bytes: None,
         };
-        assert!(solve_hierarchical(&scene, &bvh, &settings, &NoProgress).is_err());
+        let max_area = scene.settings.max_patch_area;
+        assert!(solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).is_err());
     }
 }
 
@@ -286,7 +294,8 @@ fn refuses_to_outgrow_its_memory_limit() {
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: Some(4 << 20),
     };
-    let err = solve_hierarchical(&scene, &bvh, &settings, &NoProgress).unwrap_err();
+    let max_area = scene.settings.max_patch_area;
+    let err = solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).unwrap_err();
     let text = err.to_string();
     assert!(text.contains("larger epsilon or minimum area"), "{text}");
     assert!(
