@@ -11,7 +11,8 @@
 //!
 //! [`MeshSettings`] are the two numbers at the top of a scene file that say how finely a
 //! scene is discretised: `MAX_PATCH_AREA` for this subdivision, `INTEGRAL_STEPS` for the
-//! area integral over the elements.
+//! area integral over the elements. They travel beside the [`Scene`], not in it: the scene
+//! is geometry and materials only.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -518,15 +519,11 @@ pub fn for_each_subtriangle(t: [DVec3; 3], k: u32, mut f: impl FnMut([DVec3; 3])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{MeshSettings, Rgb, Surface};
+    use crate::scene::{Rgb, Surface};
     use glam::dvec3;
 
     fn scene_of(polys: Vec<Vec<DVec3>>) -> Scene {
         Scene {
-            settings: MeshSettings {
-                max_patch_area: 1.0,
-                integral_steps: 1,
-            },
             surfaces: polys
                 .into_iter()
                 .enumerate()
