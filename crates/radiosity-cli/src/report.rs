@@ -42,8 +42,8 @@ pub fn check(
     outln!("surfaces          {}", scene.surfaces.len());
     outln!("elements          {}", solution.mesh.len());
     outln!("total area        {:.6}", solution.mesh.total_area());
-    outln!("MAX_PATCH_AREA    {}", scene.settings.max_patch_area);
-    outln!("INTEGRAL_STEPS    {}", scene.settings.integral_steps);
+    outln!("MAX_PATCH_AREA    {}", prepared.settings.max_patch_area);
+    outln!("INTEGRAL_STEPS    {}", prepared.settings.integral_steps);
     outln!("method            {}", prepared.method());
     outln!("occlusion         {}", prepared.method().occlusion());
     outln!("solver            {solver}");

@@ -9,7 +9,7 @@ use radiosity::form_factor::FormFactorMethod;
 use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{Camera, RenderSettings, Shading};
-use radiosity::scene::{self, Scene};
+use radiosity::scene::{self, Scene, SceneFile};
 use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
 
 use crate::args::{MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions};
@@ -36,7 +36,7 @@ pub fn prepare_solve(
     let solver = solver(
         options,
         prepared.mesh.len(),
-        prepared.scene.settings.max_patch_area,
+        prepared.settings.max_patch_area,
         reporter,
     )?;
     prepared.check_memory(Some(&solver))?;
@@ -44,9 +44,10 @@ pub fn prepare_solve(
     Ok((prepared, stem, solver))
 }
 
-/// The scene loaded, its settings overridden, meshed, and its form-factor method set.
+/// The scene loaded, meshed with its file's settings overridden by the flags, and its
+/// form-factor method set.
 fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
-    let (scene, stem) = load_scene(args.scene.as_deref(), reporter)?;
+    let (file, stem) = load_scene(args.scene.as_deref(), reporter)?;
     let overrides = Overrides {
         max_patch_area: args.max_area,
         integral_steps: args.steps,
@@ -56,9 +57,10 @@ fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, Str
             bail!("--steps must be at least 1");
         }
     }
-    let mut prepared = Prepared::new(scene, overrides, reporter)?;
+    let settings = overrides.apply(file.settings);
+    let mut prepared = Prepared::new(file.scene, settings, reporter)?;
     let m = &args.method;
-    let steps = prepared.scene.settings.integral_steps;
+    let steps = prepared.settings.integral_steps;
     prepared.method = match m.method {
         MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
         MethodArg::Contour => FormFactorMethod::Contour { steps },
@@ -93,23 +95,23 @@ fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
         stem,
         prepared.scene.surfaces.len(),
         prepared.mesh.len(),
-        prepared.scene.settings.max_patch_area,
-        prepared.scene.settings.integral_steps
+        prepared.settings.max_patch_area,
+        prepared.settings.integral_steps
     ));
 }
 
-fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(Scene, String)> {
+fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(SceneFile, String)> {
     match path {
         None => Ok((
             run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
             "cornell".to_string(),
         )),
         Some(path) => {
-            let scene = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
+            let file = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
             let stem = path
                 .file_stem()
                 .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-            Ok((scene, stem))
+            Ok((file, stem))
         }
     }
 }

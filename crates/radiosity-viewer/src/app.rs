@@ -128,7 +128,7 @@ impl ViewerApp {
         let wake: Arc<dyn Fn() + Send + Sync> = Arc::new(move || ctx.request_repaint());
         let (edits, updates, progress) = worker::spawn(
             options.scene.clone(),
-            options.overrides,
+            options.overrides.apply(options.settings),
             options.solver,
             wake,
         );
@@ -314,15 +314,18 @@ impl ViewerApp {
         }
     }
 
+    /// Writes the edited scene with its file's own settings (not the overrides).
     fn save_scene(&mut self) {
         let path = PathBuf::from(self.save_path.trim());
-        self.status = match radiosity::scene::write_scene_file(&self.modeller.scene, &path) {
-            Ok(()) => {
-                self.modeller.unsaved = 0;
-                format!("saved {}", path.display())
-            }
-            Err(e) => format!("cannot save {}: {e}", path.display()),
-        };
+        let settings = self.options.settings;
+        self.status =
+            match radiosity::scene::write_scene_file(&self.modeller.scene, settings, &path) {
+                Ok(()) => {
+                    self.modeller.unsaved = 0;
+                    format!("saved {}", path.display())
+                }
+                Err(e) => format!("cannot save {}: {e}", path.display()),
+            };
     }
 
     fn save_view_screenshot(&mut self, frame: &eframe::Frame) {

@@ -5,8 +5,8 @@
 use std::time::Instant;
 
 use glam::DVec3;
-use radiosity::mesh::{mesh_scene, Mesh};
-use radiosity::pipeline::{self, FormFactors, Overrides, Prepared, SolutionReport, SolveRequest};
+use radiosity::mesh::{mesh_scene, Mesh, MeshSettings};
+use radiosity::pipeline::{self, FormFactors, Prepared, SolutionReport, SolveRequest};
 use radiosity::progress::NoProgress;
 use radiosity::render::Camera;
 use radiosity::scene::{cornell_box, Rgb, Scene};
@@ -81,15 +81,12 @@ pub type Solved = (Scene, Mesh, Vec<[f64; 3]>, f64);
 /// The Cornell box's mesh at `max_area` with its solution (dense Gauss-Seidel) and the
 /// exposure scale of its default view.
 pub fn solved_cornell(max_area: f64) -> Result<Solved, String> {
-    let prepared = Prepared::new(
-        cornell_box(),
-        Overrides {
-            max_patch_area: Some(max_area),
-            integral_steps: None,
-        },
-        &NoProgress,
-    )
-    .map_err(|e| e.to_string())?;
+    let file = cornell_box();
+    let settings = MeshSettings {
+        max_patch_area: max_area,
+        ..file.settings
+    };
+    let prepared = Prepared::new(file.scene, settings, &NoProgress).map_err(|e| e.to_string())?;
     let solution = pipeline::solve(
         &prepared,
         &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
@@ -140,7 +137,7 @@ pub fn tiled(
 
 /// The `MAX_PATCH_AREA` at which the Cornell box has about `target` elements.
 pub fn cornell_max_area_for(target: usize) -> f64 {
-    let scene = cornell_box();
+    let scene = cornell_box().scene;
     let count = |a: f64| mesh_scene(&scene, a).map(|m| m.len()).unwrap_or(usize::MAX);
     let mut area = 1000.0 * count(1000.0) as f64 / target as f64;
     for _ in 0..6 {
@@ -174,15 +171,12 @@ pub struct EditTiming {
 /// times the way to the new picture, as the window does it (1280 x 800).
 pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, String> {
     let max_area = cornell_max_area_for(target);
-    let prepared = Prepared::new(
-        cornell_box(),
-        Overrides {
-            max_patch_area: Some(max_area),
-            integral_steps: None,
-        },
-        &NoProgress,
-    )
-    .map_err(|e| e.to_string())?;
+    let file = cornell_box();
+    let settings = MeshSettings {
+        max_patch_area: max_area,
+        ..file.settings
+    };
+    let prepared = Prepared::new(file.scene, settings, &NoProgress).map_err(|e| e.to_string())?;
     let t = Instant::now();
     let (f, _) = prepared
         .form_factors(&NoProgress)

@@ -208,7 +208,7 @@ mod tests {
 
     #[test]
     fn starts_where_renders_default_camera_is() {
-        let scene = radiosity::scene::cornell_box();
+        let scene = radiosity::scene::cornell_box().scene;
         let cam = Camera::for_scene(&scene, 640, 480);
         let c = CameraController::new(&cam, 1000.0);
         let back = c.camera(640, 480);

@@ -703,8 +703,8 @@ mod tests {
 
     #[test]
     fn quads_are_two_triangles_without_the_diagonal_in_wireframe() {
-        let scene = cornell_box();
-        let mesh = radiosity::mesh::mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        let file = cornell_box();
+        let mesh = radiosity::mesh::mesh_scene(&file.scene, file.settings.max_patch_area).unwrap();
         let v = geometry_vertices(&mesh);
         assert_eq!(v.len(), 3 * triangle_elements(&mesh).len());
         let quads = mesh.elements.iter().filter(|e| e.is_quad()).count();

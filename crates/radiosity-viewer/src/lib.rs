@@ -19,7 +19,7 @@
 //! is here.
 //!
 //! ```no_run
-//! let scene = radiosity::scene::cornell_box();
+//! let scene = radiosity::scene::cornell_box().scene;
 //! let mesh = radiosity::mesh::mesh_scene(&scene, 1000.0).unwrap();
 //! let e: Vec<[f64; 3]> = mesh
 //!     .elements
@@ -43,18 +43,22 @@ pub mod worker;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
+use radiosity::mesh::MeshSettings;
 use radiosity::pipeline::Overrides;
-use radiosity::scene::Scene;
+use radiosity::scene::{Scene, SceneFile};
 
 /// What to show and how.
 #[derive(Clone, Debug)]
 pub struct ViewerOptions {
     /// The scene.
     pub scene: Scene,
+    /// Its file's settings: the scene is meshed with them (overrides applied) and saved
+    /// with them (as they are).
+    pub settings: MeshSettings,
     /// Its file (where "save" writes; `None` for the built-in Cornell box, which is saved to
     /// `cornell_box.scene`).
     pub path: Option<PathBuf>,
-    /// `--max-area` and `--steps`.
+    /// `--max-area` and `--steps`, applied to `settings` for meshing, never saved.
     pub overrides: Overrides,
     /// The solver (see [`worker::ViewSolver`] for the window's `auto`).
     pub solver: worker::ViewSolver,
@@ -75,10 +79,12 @@ pub struct ViewerOptions {
 }
 
 impl ViewerOptions {
-    /// The defaults for `scene`: the window's auto solver, no screenshot, 1280 x 800.
-    pub fn new(scene: Scene, path: Option<PathBuf>) -> ViewerOptions {
+    /// The defaults for the scene and settings of `file` (read from `path`): the window's
+    /// auto solver, no overrides, no screenshot, 1280 x 800.
+    pub fn new(file: SceneFile, path: Option<PathBuf>) -> ViewerOptions {
         ViewerOptions {
-            scene,
+            scene: file.scene,
+            settings: file.settings,
             path,
             overrides: Overrides::default(),
             solver: worker::ViewSolver::auto(),

@@ -136,7 +136,7 @@ mod tests {
 
     #[test]
     fn edits_undo_in_order_and_a_drag_is_one_step() {
-        let mut m = Modeller::new(cornell_box());
+        let mut m = Modeller::new(cornell_box().scene);
         let original = m.colours(0);
         let red = SurfaceColours {
             reflectance: Rgb([0.9, 0.1, 0.1]),
@@ -161,7 +161,8 @@ mod tests {
 
     #[test]
     fn saved_edits_read_back_in_the_papers_format() {
-        let mut m = Modeller::new(cornell_box());
+        let file = cornell_box();
+        let mut m = Modeller::new(file.scene);
         let s = m
             .scene
             .surfaces
@@ -175,9 +176,11 @@ mod tests {
         m.set(s, colours, false);
         let path =
             std::env::temp_dir().join(format!("radiosity-modeller-{}.scene", std::process::id()));
-        radiosity::scene::write_scene_file(&m.scene, &path).unwrap();
+        radiosity::scene::write_scene_file(&m.scene, file.settings, &path).unwrap();
         let back = radiosity::scene::read_scene(&path).unwrap();
         let _ = std::fs::remove_file(&path);
+        assert_eq!(back.settings, file.settings);
+        let back = back.scene;
         assert_eq!(back.surfaces[s].reflectance, colours.reflectance);
         assert_eq!(back.surfaces[s].emission, colours.emission);
         assert_eq!(back.surfaces.len(), m.scene.surfaces.len());
@@ -192,12 +195,14 @@ mod tests {
     /// way by both, so no other error enters).
     #[test]
     fn resolve_after_a_reflectance_edit_equals_a_fresh_solve() {
-        let mut scene = cornell_box();
+        let file = cornell_box();
+        let mut scene = file.scene;
         let overrides = Overrides {
             max_patch_area: Some(8000.0),
             integral_steps: Some(2),
         };
-        let mut prepared = Prepared::new(scene.clone(), overrides, &NoProgress).unwrap();
+        let settings = overrides.apply(file.settings);
+        let mut prepared = Prepared::new(scene.clone(), settings, &NoProgress).unwrap();
         let (f, _) = prepared.form_factors(&NoProgress).unwrap();
         let (first, _) = gauss_seidel(&prepared, &f, None);
 
@@ -232,7 +237,7 @@ mod tests {
         let (b, warm_sweeps) = gauss_seidel(&prepared, &f, Some(&first));
 
         // A fresh full solve of the edited scene, form factors computed anew.
-        let fresh_prepared = Prepared::new(scene, overrides, &NoProgress).unwrap();
+        let fresh_prepared = Prepared::new(scene, settings, &NoProgress).unwrap();
         let (f2, _) = fresh_prepared.form_factors(&NoProgress).unwrap();
         assert_eq!(
             f2.as_slice(),

@@ -16,7 +16,8 @@ use std::time::{Duration, Instant};
 
 use radiosity::form_factor::FormFactorMatrix;
 use radiosity::mesh::Mesh;
-use radiosity::pipeline::{self, FormFactors, Overrides, Prepared, SolutionReport, SolveRequest};
+use radiosity::mesh::MeshSettings;
+use radiosity::pipeline::{self, FormFactors, Prepared, SolutionReport, SolveRequest};
 use radiosity::progress::{Progress, Stage};
 use radiosity::scene::{Rgb, Scene};
 use radiosity::solve::{
@@ -124,8 +125,8 @@ pub const VIEW_DENSE_MAX_ELEMENTS: usize = 6_000;
 pub struct ViewSolver {
     /// The solver's kind.
     pub kind: SolverKind,
-    /// Used when `kind` is hierarchical; `None`: the defaults for the scene's
-    /// `MAX_PATCH_AREA` ([`HierarchicalSettings::defaults_for`]).
+    /// Used when `kind` is hierarchical; `None`: the defaults for the `MAX_PATCH_AREA` the
+    /// scene is meshed at ([`HierarchicalSettings::defaults_for`]).
     pub hierarchical: Option<HierarchicalSettings>,
 }
 
@@ -139,11 +140,12 @@ impl ViewSolver {
     }
 }
 
-/// Starts the worker on `scene`; `wake` is called whenever there is news (the window asks
-/// for a repaint).
+/// Starts the worker on `scene`, meshed with `settings` (the scene file's with the
+/// command line's overrides applied); `wake` is called whenever there is news (the window
+/// asks for a repaint).
 pub fn spawn(
     scene: Scene,
-    overrides: Overrides,
+    settings: MeshSettings,
     solver: ViewSolver,
     wake: Arc<dyn Fn() + Send + Sync>,
 ) -> (Sender<Recolour>, Receiver<Update>, Arc<StageProgress>) {
@@ -162,7 +164,7 @@ pub fn spawn(
                 let _ = tx.send(u);
                 wake();
             };
-            if let Err(message) = run(scene, overrides, solver, &reporter, &edit_rx, &send) {
+            if let Err(message) = run(scene, settings, solver, &reporter, &edit_rx, &send) {
                 send(Update::Error(message));
             }
         })
@@ -197,7 +199,7 @@ fn decide(prepared: &Prepared, choice: ViewSolver, progress: &Reporter) -> Solve
     let dense = match choice.kind {
         SolverKind::Hierarchical => {
             return Solver::Hierarchical(choice.hierarchical.unwrap_or_else(|| {
-                HierarchicalSettings::defaults_for(prepared.scene.settings.max_patch_area)
+                HierarchicalSettings::defaults_for(prepared.settings.max_patch_area)
             }))
         }
         SolverKind::Progressive => return progressive,
@@ -226,13 +228,13 @@ fn decide(prepared: &Prepared, choice: ViewSolver, progress: &Reporter) -> Solve
 
 fn run(
     scene: Scene,
-    overrides: Overrides,
+    settings: MeshSettings,
     choice: ViewSolver,
     progress: &Reporter,
     edits: &Receiver<Recolour>,
     send: &dyn Fn(Update),
 ) -> Result<(), String> {
-    let mut prepared = Prepared::new(scene, overrides, progress).map_err(|e| e.to_string())?;
+    let mut prepared = Prepared::new(scene, settings, progress).map_err(|e| e.to_string())?;
     send(Update::Mesh(
         prepared.mesh.clone(),
         Arc::new(PolygonBvh::over_elements(&prepared.mesh)),
@@ -413,17 +415,13 @@ mod tests {
     /// 1e-6 / (1 - 0.8) = 5e-6 of max E with rho <= 0.8; checked at 1e-5).
     #[test]
     fn worker_resolves_an_edit_like_a_fresh_solve() {
-        let overrides = Overrides {
-            max_patch_area: Some(8000.0),
-            integral_steps: Some(2),
+        let meshing = MeshSettings {
+            max_patch_area: 8000.0,
+            integral_steps: 2,
         };
-        let scene = cornell_box();
-        let (edits, updates, _) = spawn(
-            scene.clone(),
-            overrides,
-            ViewSolver::auto(),
-            Arc::new(|| {}),
-        );
+        let scene = cornell_box().scene;
+        let (edits, updates, _) =
+            spawn(scene.clone(), meshing, ViewSolver::auto(), Arc::new(|| {}));
         converged(&updates, 0);
         let mut edited = scene.clone();
         for s in edited
@@ -436,7 +434,7 @@ mod tests {
         send_colours(&edits, &edited, 1);
         let b = converged(&updates, 1);
 
-        let fresh = Prepared::new(edited, overrides, &NoProgress).unwrap();
+        let fresh = Prepared::new(edited, meshing, &NoProgress).unwrap();
         let solution = pipeline::solve(
             &fresh,
             &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),
@@ -465,9 +463,9 @@ mod tests {
     /// the edited scene (the solve is deterministic, so they are equal).
     #[test]
     fn worker_resolves_hierarchically_like_a_fresh_solve() {
-        let overrides = Overrides {
-            max_patch_area: Some(8000.0),
-            integral_steps: Some(2),
+        let meshing = MeshSettings {
+            max_patch_area: 8000.0,
+            integral_steps: 2,
         };
         let settings = radiosity::solve::HierarchicalSettings {
             epsilon: 0.2,
@@ -475,10 +473,10 @@ mod tests {
             tolerance: 1e-6,
             max_memory_bytes: None,
         };
-        let scene = cornell_box();
+        let scene = cornell_box().scene;
         let (edits, updates, _) = spawn(
             scene.clone(),
-            overrides,
+            meshing,
             ViewSolver {
                 kind: SolverKind::Hierarchical,
                 hierarchical: Some(settings),
@@ -509,7 +507,7 @@ mod tests {
                 _ => {}
             }
         };
-        let fresh = Prepared::new(edited, overrides, &NoProgress).unwrap();
+        let fresh = Prepared::new(edited, meshing, &NoProgress).unwrap();
         let solution = pipeline::solve(
             &fresh,
             &SolveRequest::new(Solver::Hierarchical(settings)),

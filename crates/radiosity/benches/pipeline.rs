@@ -9,11 +9,11 @@ use std::time::Duration;
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
+use radiosity::pipeline::Prepared;
 use radiosity::pipeline::{self as run, FormFactors, SolveRequest};
-use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::NoProgress;
 use radiosity::render::{self, Camera, RenderSettings, Renderer};
-use radiosity::scene::cornell_box;
+use radiosity::scene::{cornell_box, MeshSettings};
 use radiosity::shade::{self, Exposure};
 use radiosity::solve::{self, keep_going, DenseSolver, GaussSeidelSettings, Solver};
 
@@ -21,11 +21,11 @@ use radiosity::solve::{self, keep_going, DenseSolver, GaussSeidelSettings, Solve
 const MAX_AREA: f64 = 4000.0;
 
 fn prepared() -> Prepared {
-    let overrides = Overrides {
-        max_patch_area: Some(MAX_AREA),
-        integral_steps: Some(2),
+    let settings = MeshSettings {
+        max_patch_area: MAX_AREA,
+        integral_steps: 2,
     };
-    Prepared::new(cornell_box(), overrides, &NoProgress).expect("the Cornell box meshes")
+    Prepared::new(cornell_box().scene, settings, &NoProgress).expect("the Cornell box meshes")
 }
 
 fn configure<'c>(c: &'c mut Criterion, name: &str) -> BenchmarkGroup<'c, WallTime> {

@@ -139,7 +139,7 @@ mod tests {
         // B = 1 + surface index on every element of both meshes: identical fields, so
         // zero difference whatever the meshes; B = 2 (1 + index) doubles the reflected part
         // (E = 0): relative RMS and mean exactly 1.
-        let scene = cornell_box();
+        let scene = cornell_box().scene;
         let coarse = mesh_scene(&scene, 20_000.0).unwrap();
         let fine = mesh_scene(&scene, 2_000.0).unwrap();
         assert!(fine.len() > 4 * coarse.len());
@@ -157,8 +157,8 @@ mod tests {
 
     #[test]
     fn meshes_of_other_scenes_are_refused() {
-        let a = cornell_box();
-        let mut b = cornell_box();
+        let a = cornell_box().scene;
+        let mut b = cornell_box().scene;
         b.surfaces.truncate(5);
         let (ma, mb) = (
             mesh_scene(&a, 20_000.0).unwrap(),

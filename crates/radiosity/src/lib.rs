@@ -4,12 +4,13 @@
 //! (1998), built as a library. The pipeline, one module per stage:
 //!
 //! ```text
-//! scene file --io--> Scene --mesh--> Mesh --form_factor--> FormFactorMatrix
+//! scene file --io--> Scene + MeshSettings --mesh--> Mesh --form_factor--> FormFactorMatrix
 //!   --solve--> element radiosity B (per RGB band) --shade--> vertex radiosity
 //!   --render--> image
 //! ```
 //!
-//! * [`scene`]: the scene model: surfaces, the built-in Cornell box, generated buildings.
+//! * [`scene`]: the scene model: surfaces, the built-in Cornell box, generated buildings
+//!   (each with its [`MeshSettings`], as a [`SceneFile`]).
 //! * [`geometry`]: planar convex polygon helpers (normal, area, planarity, convexity).
 //! * [`mesh`]: area-based subdivision of surfaces into elements (paper 2.4).
 //! * [`visibility`]: BVH ray queries over triangles (occlusion and closest hit).
@@ -37,9 +38,10 @@
 //! use radiosity::shade::{self, Exposure};
 //! use radiosity::{pipeline, Overrides, Prepared, SolveRequest, Solver};
 //!
-//! // A coarse mesh keeps the example quick.
+//! // The box and its file's settings; a coarse mesh keeps the example quick.
+//! let file = radiosity::scene::cornell_box();
 //! let coarse = Overrides { max_patch_area: Some(20_000.0), integral_steps: Some(1) };
-//! let prepared = Prepared::new(radiosity::scene::cornell_box(), coarse, &NoProgress)?;
+//! let prepared = Prepared::new(file.scene, coarse.apply(file.settings), &NoProgress)?;
 //! let request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
 //! let solution = pipeline::solve(&prepared, &request, &mut radiosity::solve::keep_going, &NoProgress)?;
 //! // Energy is conserved: what is emitted is absorbed or escapes (the box is closed but
@@ -83,6 +85,7 @@ pub mod visibility;
 pub use io::solution;
 
 pub use light::{ElementLight, Rgb};
+pub use mesh::MeshSettings;
 pub use pipeline::{FormFactors, Overrides, PipelineError, Prepared, Solution, SolveRequest};
-pub use scene::Scene;
+pub use scene::{Scene, SceneFile};
 pub use solve::{DenseSolver, Radiosity, Solver, SolverKind};

@@ -8,6 +8,11 @@
 //! conforming within a surface; surfaces never share vertices (shading does not cross
 //! surface boundaries, as in the paper). Neighbours (elements sharing an edge on the same
 //! surface) are recorded for shading.
+//!
+//! [`MeshSettings`] are the two numbers at the top of a scene file that say how finely a
+//! scene is discretised: `MAX_PATCH_AREA` for this subdivision, `INTEGRAL_STEPS` for the
+//! area integral over the elements. They travel beside the [`Scene`], not in it: the scene
+//! is geometry and materials only.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -16,6 +21,18 @@ use glam::DVec3;
 
 use crate::geometry;
 use crate::scene::Scene;
+
+/// The meshing and integration settings at the top of a scene file (`MAX_PATCH_AREA` and
+/// `INTEGRAL_STEPS`), which the command line and the window may override.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshSettings {
+    /// `MAX_PATCH_AREA`: surfaces larger than this (scene units squared) are subdivided into
+    /// elements of at most this area.
+    pub max_patch_area: f64,
+    /// `INTEGRAL_STEPS`: k, the number of sample points along each axis of each element in
+    /// the double area integral (paper 2.8; 1 means one point per element).
+    pub integral_steps: u32,
+}
 
 /// One element: a planar convex triangle or quadrilateral, a piece of one surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -502,15 +519,11 @@ pub fn for_each_subtriangle(t: [DVec3; 3], k: u32, mut f: impl FnMut([DVec3; 3])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{MeshSettings, Rgb, Surface};
+    use crate::scene::{Rgb, Surface};
     use glam::dvec3;
 
     fn scene_of(polys: Vec<Vec<DVec3>>) -> Scene {
         Scene {
-            settings: MeshSettings {
-                max_patch_area: 1.0,
-                integral_steps: 1,
-            },
             surfaces: polys
                 .into_iter()
                 .enumerate()

@@ -16,7 +16,7 @@ use crate::io::form_factor_file::{
     mesh_fingerprint, read_form_factors, write_form_factors, FormFactorFileError,
 };
 use crate::light::{check_surface, ElementLight, LightError, Rgb};
-use crate::mesh::{mesh_scene, Mesh, MeshError};
+use crate::mesh::{mesh_scene, Mesh, MeshError, MeshSettings};
 use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::Scene;
 use crate::solve::{
@@ -88,17 +88,30 @@ pub struct Overrides {
     pub integral_steps: Option<u32>,
 }
 
+impl Overrides {
+    /// `settings` with every override that is given in place of its value.
+    pub fn apply(self, settings: MeshSettings) -> MeshSettings {
+        MeshSettings {
+            max_patch_area: self.max_patch_area.unwrap_or(settings.max_patch_area),
+            integral_steps: self.integral_steps.unwrap_or(settings.integral_steps),
+        }
+    }
+}
+
 /// A meshed scene with its occluder BVH: everything form factors need.
 pub struct Prepared {
-    /// The scene, with overrides applied to its settings.
+    /// The scene.
     pub scene: Scene,
+    /// The settings it was meshed with (the scene file's, overrides applied); the default
+    /// `method` integrates with their `INTEGRAL_STEPS`.
+    pub settings: MeshSettings,
     /// Its elements.
     pub mesh: Arc<Mesh>,
     /// Reflectance and emission of every element, checked.
     pub light: ElementLight,
     /// The input surfaces in a BVH, for occlusion.
     pub occluders: PolygonBvh,
-    /// How form factors are computed (by default the area integral with the scene's
+    /// How form factors are computed (by default the area integral with the settings'
     /// `INTEGRAL_STEPS`).
     pub method: FormFactorMethod,
 }
@@ -182,34 +195,32 @@ impl<'a> SolveRequest<'a> {
 }
 
 impl Prepared {
-    /// Applies `overrides`, checks every surface's reflectance and emission, meshes the
-    /// scene and builds the occluder BVH.
+    /// Checks every surface's reflectance and emission, meshes the scene at the
+    /// `MAX_PATCH_AREA` of `settings` and builds the occluder BVH. Form factors will be the
+    /// area integral at their `INTEGRAL_STEPS` unless `method` is set otherwise. A scene
+    /// file's settings with the command line's in their place are
+    /// [`Overrides::apply`]`(file.settings)`.
     pub fn new(
-        mut scene: Scene,
-        overrides: Overrides,
+        scene: Scene,
+        settings: MeshSettings,
         progress: &dyn Progress,
     ) -> Result<Prepared, PipelineError> {
-        if let Some(a) = overrides.max_patch_area {
-            scene.settings.max_patch_area = a;
-        }
-        if let Some(k) = overrides.integral_steps {
-            scene.settings.integral_steps = k;
-        }
         for (i, s) in scene.surfaces.iter().enumerate() {
             check_surface(i, s.reflectance, s.emission).map_err(LightError::from)?;
         }
         let mesh = run_stage(progress, Stage::Mesh, 0, || {
-            mesh_scene(&scene, scene.settings.max_patch_area)
+            mesh_scene(&scene, settings.max_patch_area)
         })?;
         let light = ElementLight::of_mesh(&mesh, &scene)?;
         let occluders = run_stage(progress, Stage::Bvh, 0, || {
             form_factor::occluder_bvh(&scene)
         });
         let method = FormFactorMethod::AreaIntegral {
-            steps: scene.settings.integral_steps,
+            steps: settings.integral_steps,
         };
         Ok(Prepared {
             scene,
+            settings,
             mesh: Arc::new(mesh),
             light,
             occluders,
@@ -403,6 +414,7 @@ pub fn solve(
         Solver::Hierarchical(settings) => {
             let h = solve::solve_hierarchical(
                 &prepared.scene,
+                prepared.settings.max_patch_area,
                 &prepared.occluders,
                 settings,
                 progress,
@@ -452,7 +464,9 @@ mod tests {
             max_patch_area: Some(20_000.0),
             integral_steps: Some(1000),
         };
-        let prepared = Prepared::new(crate::scene::cornell_box(), overrides, &NoProgress).unwrap();
+        let file = crate::scene::cornell_box();
+        let prepared =
+            Prepared::new(file.scene, overrides.apply(file.settings), &NoProgress).unwrap();
         let n = prepared.mesh.len();
         let err = prepared.check_memory(None).unwrap_err();
         let PipelineError::TooManyIntegrationPoints {

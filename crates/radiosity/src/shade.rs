@@ -58,7 +58,7 @@ pub fn vertex_radiosity(mesh: &Mesh, element_b: &[[f64; 3]]) -> Vec<[f64; 3]> {
 mod tests {
     use super::*;
     use crate::mesh::mesh_scene;
-    use crate::scene::{MeshSettings, Rgb, Scene, Surface};
+    use crate::scene::{Rgb, Scene, Surface};
     use glam::{dvec3, DVec3};
 
     fn surface(name: &str, emission: f64, vertices: Vec<DVec3>) -> Surface {
@@ -72,10 +72,6 @@ mod tests {
 
     fn scene(surfaces: Vec<Surface>) -> Scene {
         Scene {
-            settings: MeshSettings {
-                max_patch_area: 1.0,
-                integral_steps: 1,
-            },
             surfaces,
             camera: None,
         }

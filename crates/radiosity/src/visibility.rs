@@ -395,7 +395,7 @@ mod tests {
 
     #[test]
     fn element_and_surface_hierarchies_carry_their_indices() {
-        use crate::scene::{MeshSettings, Rgb, Surface};
+        use crate::scene::{Rgb, Surface};
         // Two unit squares facing -z at z = 1 and z = 2, the second cut into 4 elements.
         let surface = |name: &str, z: f64| Surface {
             name: name.into(),
@@ -404,10 +404,6 @@ mod tests {
             vertices: square_at_z(z, 0).0.remove(0).into_iter().rev().collect(),
         };
         let scene = Scene {
-            settings: MeshSettings {
-                max_patch_area: 1.0,
-                integral_steps: 1,
-            },
             surfaces: vec![surface("near", 1.0), surface("far", 2.0)],
             camera: None,
         };

@@ -148,7 +148,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     }
     Ok(BenchRun {
         elements: solution.mesh.len(),
-        steps: prepared.scene.settings.integral_steps,
+        steps: prepared.settings.integral_steps,
         stages,
         total,
         rays,

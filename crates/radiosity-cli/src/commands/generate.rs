@@ -23,16 +23,16 @@ pub fn building(args: BuildingArgs) -> Result<()> {
         bail!("{e}");
     }
     let built = scene::building(&params);
-    scene::write_scene_file(&built, &args.output)
+    scene::write_scene_file(&built.scene, built.settings, &args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     // The element count, also where meshing would refuse it (more than MAX_ELEMENTS).
-    let elements = match radiosity::mesh::mesh_scene(&built, params.max_patch_area) {
+    let elements = match radiosity::mesh::mesh_scene(&built.scene, built.settings.max_patch_area) {
         Ok(mesh) => format!("{} elements", mesh.len()),
         Err(radiosity::mesh::MeshError::TooManyElements { count, limit, .. }) => {
             format!("{count} elements (more than the meshing limit of {limit})")
         }
         Err(e) => return Err(e.into()),
     };
-    report::building(&args.output, &params, &built, &elements);
+    report::building(&args.output, &params, &built.scene, &elements);
     Ok(())
 }

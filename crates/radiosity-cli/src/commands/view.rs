@@ -25,11 +25,11 @@ pub fn run(args: ViewArgs) -> Result<()> {
         outln!("{table}");
         return Ok(());
     }
-    let scene = match &args.scene {
+    let file = match &args.scene {
         Some(path) => radiosity::scene::read_scene(path)?,
         None => radiosity::scene::cornell_box(),
     };
-    let mut options = ViewerOptions::new(scene, args.scene.clone());
+    let mut options = ViewerOptions::new(file, args.scene.clone());
     options.overrides = Overrides {
         max_patch_area: args.max_area,
         integral_steps: args.steps,
@@ -43,9 +43,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
     }
     let mut hierarchical = None;
     if kind == SolverKind::Hierarchical {
-        let max_area = args
-            .max_area
-            .unwrap_or(options.scene.settings.max_patch_area);
+        let max_area = args.max_area.unwrap_or(options.settings.max_patch_area);
         let min_area = args.min_area.unwrap_or(max_area / 16.0);
         if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
             bail!("--epsilon must be a positive number, got {}", args.epsilon);

@@ -394,9 +394,9 @@ fn generate_building_writes_a_scene_that_reads_back() {
     // 2 rooms x (6 + 294) + 6 windows x 9 + 1 door x 10.
     assert!(stdout.contains("664 surfaces"), "{stdout}");
     assert!(stdout.contains("elements"), "{stdout}");
-    let scene = radiosity::scene::read_scene(&dir.join("b.scene")).unwrap();
-    assert_eq!(scene.surfaces.len(), 664);
-    assert_eq!(scene.settings.max_patch_area, 4.0);
+    let file = radiosity::scene::read_scene(&dir.join("b.scene")).unwrap();
+    assert_eq!(file.scene.surfaces.len(), 664);
+    assert_eq!(file.settings.max_patch_area, 4.0);
     // The committed examples are what the documented commands write.
     for (file, args) in [
         (

@@ -5,8 +5,8 @@
 //! Where no adapter exists the test says it was skipped and why; with the environment
 //! variable `CI` set it fails instead (CI installs lavapipe, so an adapter must be there).
 
+use radiosity::pipeline::Prepared;
 use radiosity::pipeline::{self, SolveRequest};
-use radiosity::pipeline::{Overrides, Prepared};
 use radiosity::progress::NoProgress;
 use radiosity::render::{self, Camera, RenderSettings, Renderer, Shading};
 use radiosity::scene::cornell_box;
@@ -54,7 +54,8 @@ fn offscreen_cornell_box_matches_the_cpu_render() {
         }
     };
     eprintln!("adapter: {}", gpu.adapter);
-    let prepared = Prepared::new(cornell_box(), Overrides::default(), &NoProgress).unwrap();
+    let file = cornell_box();
+    let prepared = Prepared::new(file.scene, file.settings, &NoProgress).unwrap();
     let solution = pipeline::solve(
         &prepared,
         &SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL),

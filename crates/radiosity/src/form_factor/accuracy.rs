@@ -16,7 +16,7 @@ use super::{
 };
 use crate::mesh::{mesh_scene, Mesh};
 use crate::progress::NoProgress;
-use crate::scene::{MeshSettings, Rgb, Scene, Surface};
+use crate::scene::{Rgb, Scene, Surface};
 
 /// One method's row of the accuracy table.
 #[derive(Clone, Debug, PartialEq)]
@@ -82,12 +82,8 @@ fn surface(name: &str, vertices: Vec<DVec3>) -> Surface {
     }
 }
 
-fn scene(max_area: f64, surfaces: Vec<Surface>) -> Scene {
+fn scene(surfaces: Vec<Surface>) -> Scene {
     Scene {
-        settings: MeshSettings {
-            max_patch_area: max_area,
-            integral_steps: 2,
-        },
         surfaces,
         camera: None,
     }
@@ -123,7 +119,7 @@ fn disc(z: f64, up: bool) -> Vec<DVec3> {
 /// A closed unit cube with every face looking in: the scene of the closed-box and
 /// reciprocity columns. (The integration tests build the same cube as a fixture of their
 /// own and check it against these columns.)
-fn closed_cube(max_area: f64) -> Scene {
+fn closed_cube() -> Scene {
     let c = |x: f64, y: f64, z: f64| dvec3(x, y, z);
     let faces = vec![
         vec![c(0., 0., 0.), c(0., 1., 0.), c(1., 1., 0.), c(1., 0., 0.)],
@@ -142,7 +138,6 @@ fn closed_cube(max_area: f64) -> Scene {
         v
     };
     scene(
-        max_area,
         faces
             .into_iter()
             .enumerate()
@@ -151,8 +146,9 @@ fn closed_cube(max_area: f64) -> Scene {
     )
 }
 
-fn matrix(scene: &Scene, method: FormFactorMethod) -> (FormFactorMatrix, Mesh) {
-    let mesh = mesh_scene(scene, scene.settings.max_patch_area).expect("test scenes mesh");
+/// `scene` meshed into elements of at most `max_area`, and its matrix by `method`.
+fn matrix(scene: &Scene, max_area: f64, method: FormFactorMethod) -> (FormFactorMatrix, Mesh) {
+    let mesh = mesh_scene(scene, max_area).expect("test scenes mesh");
     let occluders = occluder_bvh(scene);
     let ctx = FormFactorContext {
         mesh: &mesh,
@@ -182,13 +178,11 @@ pub fn measure(method: FormFactorMethod, max_area: f64) -> AccuracyRow {
     let relative = |est: f64, exact: f64| (est - exact).abs() / exact;
     let start = Instant::now();
     let (f, m) = matrix(
-        &scene(
-            max_area,
-            vec![
-                surface("a", square(0.0, true)),
-                surface("b", square(1.0, false)),
-            ],
-        ),
+        &scene(vec![
+            surface("a", square(0.0, true)),
+            surface("b", square(1.0, false)),
+        ]),
+        max_area,
         method,
     );
     let opposed = relative(
@@ -202,10 +196,8 @@ pub fn measure(method: FormFactorMethod, max_area: f64) -> AccuracyRow {
         dvec3(0., 0., 1.),
     ];
     let (f, m) = matrix(
-        &scene(
-            max_area,
-            vec![surface("a", square(0.0, true)), surface("b", wall)],
-        ),
+        &scene(vec![surface("a", square(0.0, true)), surface("b", wall)]),
+        max_area,
         method,
     );
     let perpendicular = relative(
@@ -213,13 +205,11 @@ pub fn measure(method: FormFactorMethod, max_area: f64) -> AccuracyRow {
         reference::perpendicular_rectangles(1.0, 1.0, 1.0),
     );
     let (f, m) = matrix(
-        &scene(
-            max_area,
-            vec![
-                surface("a", disc(0.0, true)),
-                surface("b", disc(1.0, false)),
-            ],
-        ),
+        &scene(vec![
+            surface("a", disc(0.0, true)),
+            surface("b", disc(1.0, false)),
+        ]),
+        max_area,
         method,
     );
     let discs = relative(
@@ -239,14 +229,15 @@ pub fn measure(method: FormFactorMethod, max_area: f64) -> AccuracyRow {
         dvec3(1., 0., 1.),
     ];
     let (f, m) = matrix(
-        &scene(max_area, vec![surface("dA", small), surface("rect", rect)]),
+        &scene(vec![surface("dA", small), surface("rect", rect)]),
+        max_area,
         method,
     );
     let differential = relative(
         surface_to_surface(&f, &m, 0, 1),
         reference::differential_to_parallel_rectangle(1.0, 2.0, 1.0),
     );
-    let (f, mesh) = matrix(&closed_cube(max_area), method);
+    let (f, mesh) = matrix(&closed_cube(), max_area, method);
     let closed_box = (0..f.n())
         .map(|i| (f.row_sum(i) - 1.0).abs())
         .fold(0.0, f64::max);
@@ -270,7 +261,7 @@ mod tests {
 
     #[test]
     fn closed_cube_is_six_unit_faces_looking_in() {
-        let scene = closed_cube(1.0 / 9.0);
+        let scene = closed_cube();
         assert_eq!(scene.surfaces.len(), 6);
         let centre = dvec3(0.5, 0.5, 0.5);
         for s in &scene.surfaces {
@@ -288,7 +279,7 @@ mod tests {
                 s.name
             );
         }
-        let mesh = mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        let mesh = mesh_scene(&scene, 1.0 / 9.0).unwrap();
         assert_eq!(mesh.len(), 54);
     }
 

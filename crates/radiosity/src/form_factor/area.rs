@@ -318,7 +318,7 @@ impl<'a> AreaIntegrator<'a> {
 /// tests and accuracy tables: it meshes nothing and casts no rays.
 pub fn area_integral_pair(poly1: &[DVec3], poly2: &[DVec3], k: u32) -> f64 {
     use crate::mesh::mesh_scene;
-    use crate::scene::{MeshSettings, Rgb, Scene, Surface};
+    use crate::scene::{Rgb, Scene, Surface};
     let surface = |v: &[DVec3]| Surface {
         name: String::new(),
         emission: Rgb::BLACK,
@@ -326,10 +326,6 @@ pub fn area_integral_pair(poly1: &[DVec3], poly2: &[DVec3], k: u32) -> f64 {
         vertices: v.to_vec(),
     };
     let scene = Scene {
-        settings: MeshSettings {
-            max_patch_area: f64::MAX,
-            integral_steps: k,
-        },
         surfaces: vec![surface(poly1), surface(poly2)],
         camera: None,
     };

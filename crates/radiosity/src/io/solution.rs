@@ -140,7 +140,7 @@ pub fn write_solution(
 mod tests {
     use super::*;
     use crate::mesh::mesh_scene;
-    use crate::scene::{MeshSettings, Rgb, Surface};
+    use crate::scene::{Rgb, Surface};
     use glam::dvec3;
 
     fn scene() -> Scene {
@@ -159,10 +159,6 @@ mod tests {
             vertices: rect(z),
         };
         Scene {
-            settings: MeshSettings {
-                max_patch_area: 1.0,
-                integral_steps: 1,
-            },
             surfaces: vec![surface("plain", 0.0), surface("a, \"b\"\nc", 1.0)],
             camera: None,
         }

@@ -116,7 +116,7 @@ impl Lights {
 mod tests {
     use super::*;
     use crate::light::Rgb;
-    use crate::scene::{MeshSettings, Surface};
+    use crate::scene::Surface;
     use glam::dvec3;
 
     #[test]
@@ -140,10 +140,6 @@ mod tests {
             vertices,
         };
         let scene = Scene {
-            settings: MeshSettings {
-                max_patch_area: 1.0,
-                integral_steps: 1,
-            },
             surfaces: vec![
                 surface(Rgb([0.5, 0.25, 0.25]), rect(0.0, 2.0)),
                 surface(Rgb::BLACK, rect(5.0, 1.0)),

@@ -38,7 +38,7 @@
 //! use radiosity::progress::NoProgress;
 //! use radiosity::render::{tonemap, Camera};
 //!
-//! let scene = radiosity::scene::cornell_box();
+//! let scene = radiosity::scene::cornell_box().scene;
 //! let camera = Camera::for_scene(&scene, 8, 8);
 //! let settings = PathTraceSettings::DEFAULT.with_samples(4);
 //! let view = pathtrace::path_trace(&scene, &camera, &settings, &NoProgress)?;

@@ -7,14 +7,10 @@ use super::*;
 use crate::form_factor::{exact, reference};
 use crate::light::Rgb;
 use crate::progress::NoProgress;
-use crate::scene::{MeshSettings, Surface};
+use crate::scene::Surface;
 
 fn scene(surfaces: Vec<Surface>) -> Scene {
     Scene {
-        settings: MeshSettings {
-            max_patch_area: 1.0,
-            integral_steps: 1,
-        },
         surfaces,
         camera: None,
     }
@@ -242,7 +238,7 @@ fn light_samples_and_bounces_estimate_the_same_image() {
     let mut s = receiver_under_light();
     s.surfaces[1].reflectance = Rgb([0.5, 0.3, 0.1]);
     let side = camera(dvec3(0.0, -0.9, 0.5), dvec3(0.0, 0.0, 0.5), 90.0, 4);
-    let cornell = crate::scene::cornell_box();
+    let cornell = crate::scene::cornell_box().scene;
     let cornell_cam = Camera::for_scene(&cornell, 6, 6);
     for (scene, cam, plain_samples) in [(&s, side, 20_000), (&cornell, cornell_cam, 4_000)] {
         let mut settings = PathTraceSettings::DEFAULT.with_samples(plain_samples);
@@ -315,7 +311,7 @@ fn backs_are_black_and_escaping_rays_return_nothing() {
 
 #[test]
 fn a_seed_gives_the_same_image_on_any_number_of_threads() {
-    let s = crate::scene::cornell_box();
+    let s = crate::scene::cornell_box().scene;
     let cam = Camera::for_scene(&s, 12, 10);
     let settings = PathTraceSettings::DEFAULT.with_samples(6).with_seed(42);
     let on = |threads: usize, settings: &PathTraceSettings| {
@@ -464,8 +460,9 @@ fn a_view_compared_with_itself_and_its_noise() {
 #[ignore]
 fn cornell_box_cost() {
     use crate::render::{Renderer, Shading};
-    use crate::{pipeline, Overrides, Prepared, SolveRequest, Solver};
-    let scene = crate::scene::cornell_box();
+    use crate::{pipeline, Prepared, SolveRequest, Solver};
+    let file = crate::scene::cornell_box();
+    let scene = file.scene;
     let camera = Camera::for_scene(&scene, 64, 64);
     let mut last = None;
     for samples in [64, 256, 1024] {
@@ -489,7 +486,7 @@ fn cornell_box_cost() {
         }
     }
     let view = last.unwrap();
-    let prepared = Prepared::new(scene, Overrides::default(), &NoProgress).unwrap();
+    let prepared = Prepared::new(scene, file.settings, &NoProgress).unwrap();
     let request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
     let solution = pipeline::solve(
         &prepared,

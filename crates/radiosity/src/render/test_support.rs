@@ -4,14 +4,10 @@ use glam::{dvec3, DVec3};
 use image::RgbImage;
 
 use super::Camera;
-use crate::scene::{MeshSettings, Rgb, Scene, Surface};
+use crate::scene::{Rgb, Scene, Surface};
 
 pub(crate) fn scene(surfaces: Vec<Surface>) -> Scene {
     Scene {
-        settings: MeshSettings {
-            max_patch_area: 1.0,
-            integral_steps: 1,
-        },
         surfaces,
         camera: None,
     }

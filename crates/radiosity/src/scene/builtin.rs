@@ -2,8 +2,8 @@
 
 use glam::dvec3;
 
-use super::{CameraHint, Scene};
-use crate::io::scene_file::parse_scene;
+use super::CameraHint;
+use crate::io::scene_file::{parse_scene, SceneFile};
 
 /// The text of `examples/cornell_box.scene`, compiled in.
 const CORNELL_BOX_SCENE: &str = include_str!("../../../../examples/cornell_box.scene");
@@ -12,23 +12,25 @@ const CORNELL_BOX_SCENE: &str = include_str!("../../../../examples/cornell_box.s
 /// millimetres), with the Cornell camera: eye at (278, 273, -800) looking along +z, a 35 mm
 /// lens on 25 mm film (vertical field of view 2 atan(12.5/35), about 39.31 degrees).
 ///
-/// The scene is `examples/cornell_box.scene`, compiled in; a test checks that it parses.
-pub fn cornell_box() -> Scene {
-    let mut scene = parse_scene(CORNELL_BOX_SCENE, "examples/cornell_box.scene (built in)")
+/// The scene is `examples/cornell_box.scene`, compiled in, with that file's settings
+/// (`MAX_PATCH_AREA` 1000 mm^2, `INTEGRAL_STEPS` 2); a test checks that it parses.
+pub fn cornell_box() -> SceneFile {
+    let mut file = parse_scene(CORNELL_BOX_SCENE, "examples/cornell_box.scene (built in)")
         .unwrap_or_else(|e| panic!("the built-in Cornell box does not parse:\n{e}"));
-    scene.camera = Some(CameraHint {
+    file.scene.camera = Some(CameraHint {
         eye: dvec3(278.0, 273.0, -800.0),
         look_at: dvec3(278.0, 273.0, 0.0),
         up: dvec3(0.0, 1.0, 0.0),
         fov_y_degrees: 2.0 * (12.5f64 / 35.0).atan().to_degrees(),
     });
-    scene
+    file
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::geometry::{self, polygon_centroid, polygon_normal};
+    use crate::scene::Scene;
     use glam::DVec3;
 
     fn surface<'s>(scene: &'s Scene, name: &str) -> &'s super::super::Surface {
@@ -41,18 +43,23 @@ mod tests {
 
     #[test]
     fn embedded_file_parses() {
-        let scene = parse_scene(CORNELL_BOX_SCENE, "cornell_box.scene").unwrap();
+        let SceneFile { settings, scene } =
+            parse_scene(CORNELL_BOX_SCENE, "cornell_box.scene").unwrap();
         // Light, 4 ceiling pieces, floor, back and green walls, the red wall's two
         // triangles, 5 + 5 block faces.
         assert_eq!(scene.surfaces.len(), 20);
-        assert_eq!(scene.settings.max_patch_area, 1000.0);
-        assert_eq!(scene.settings.integral_steps, 2);
+        assert_eq!(settings.max_patch_area, 1000.0);
+        assert_eq!(settings.integral_steps, 2);
         assert_eq!(scene.camera, None);
+        // The built-in box is that file, with the camera added.
+        let built_in = cornell_box();
+        assert_eq!(built_in.settings, settings);
+        assert_eq!(built_in.scene.surfaces, scene.surfaces);
     }
 
     #[test]
     fn camera_is_the_cornell_camera() {
-        let cam = cornell_box().camera.unwrap();
+        let cam = cornell_box().scene.camera.unwrap();
         assert_eq!(cam.eye, dvec3(278.0, 273.0, -800.0));
         assert_eq!(cam.look_at, dvec3(278.0, 273.0, 0.0));
         assert_eq!(cam.up, DVec3::Y);
@@ -65,7 +72,7 @@ mod tests {
 
     #[test]
     fn light_and_colours() {
-        let scene = cornell_box();
+        let scene = cornell_box().scene;
         let light = surface(&scene, "Light");
         let pi = std::f64::consts::PI;
         assert_eq!(light.emission.0, [17.0 * pi, 12.0 * pi, 4.0 * pi]);
@@ -87,7 +94,7 @@ mod tests {
 
     #[test]
     fn ceiling_has_a_hole_the_size_of_the_light() {
-        let scene = cornell_box();
+        let scene = cornell_box().scene;
         let ceiling: f64 = scene
             .surfaces
             .iter()
@@ -103,7 +110,7 @@ mod tests {
     // corners it stays watertight with its neighbours (no corner moves).
     #[test]
     fn red_wall_is_two_triangles_of_its_measured_corners() {
-        let scene = cornell_box();
+        let scene = cornell_box().scene;
         let lower = &surface(&scene, "Left wall (red) lower").vertices;
         let upper = &surface(&scene, "Left wall (red) upper").vertices;
         let measured = [
@@ -127,7 +134,7 @@ mod tests {
 
     #[test]
     fn every_face_looks_into_the_room_or_out_of_its_block() {
-        let scene = cornell_box();
+        let scene = cornell_box().scene;
         let room_centre = dvec3(278.0, 274.4, 279.6);
         let short_centre = dvec3(185.5, 82.5, 169.0);
         let tall_centre = dvec3(368.5, 165.0, 351.25);
@@ -164,8 +171,8 @@ mod tests {
 
     #[test]
     fn element_count() {
-        let scene = cornell_box();
-        let mesh = crate::mesh::mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        let SceneFile { settings, scene } = cornell_box();
+        let mesh = crate::mesh::mesh_scene(&scene, settings.max_patch_area).unwrap();
         println!(
             "Cornell box at MAX_PATCH_AREA 1000: {} elements",
             mesh.len()

@@ -46,8 +46,10 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 use super::shape::{axis_aligned_base, box_faces, Facing};
-use super::{MeshSettings, Rgb, Scene, Surface};
+use super::{Rgb, Scene, Surface};
 use crate::geometry::flatten;
+use crate::io::scene_file::SceneFile;
+use crate::mesh::MeshSettings;
 
 /// Wall thickness (m).
 pub const WALL_THICKNESS: f64 = 0.15;
@@ -449,8 +451,9 @@ fn quarter_size(room_size: f64) -> f64 {
     0.5 * (room_size - AISLE) - WALL_MARGIN
 }
 
-/// Builds the scene. Panics when `params.check()` fails.
-pub fn building(params: &BuildingParams) -> Scene {
+/// Builds the scene, with the settings of `params` beside it. Panics when `params.check()`
+/// fails.
+pub fn building(params: &BuildingParams) -> SceneFile {
     if let Err(e) = params.check() {
         panic!("invalid building parameters: {e}");
     }
@@ -460,13 +463,15 @@ pub fn building(params: &BuildingParams) -> Scene {
         surfaces: Vec::with_capacity(params.polygon_count() as usize),
     };
     b.build();
-    Scene {
+    SceneFile {
         settings: MeshSettings {
             max_patch_area: params.max_patch_area,
             integral_steps: params.integral_steps,
         },
-        surfaces: b.surfaces,
-        camera: None,
+        scene: Scene {
+            surfaces: b.surfaces,
+            camera: None,
+        },
     }
 }
 

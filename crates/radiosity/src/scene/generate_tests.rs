@@ -52,7 +52,7 @@ fn polygon_count_has_a_closed_form() {
             furniture,
             ..BuildingParams::default()
         };
-        let scene = building(&p);
+        let scene = building(&p).scene;
         assert_eq!(scene.surfaces.len(), expected_count(&p), "{p:?}");
         assert_eq!(p.polygon_count() as usize, expected_count(&p));
     }
@@ -64,24 +64,25 @@ fn polygon_count_has_a_closed_form() {
 
 #[test]
 fn round_trips_through_the_writer() {
-    let scene = building(&BuildingParams {
+    let file = building(&BuildingParams {
         floors: 2,
         ..small(true)
     });
     let mut text = Vec::new();
-    write_scene(&scene, &mut text).unwrap();
+    write_scene(&file.scene, file.settings, &mut text).unwrap();
     let back = parse_scene(std::str::from_utf8(&text).unwrap(), "building").unwrap();
-    assert_eq!(back, scene);
+    assert_eq!(back, file);
 }
 
 #[test]
 fn deterministic_for_a_seed() {
-    let a = building(&small(true));
-    assert_eq!(a, building(&small(true)));
+    let a = building(&small(true)).scene;
+    assert_eq!(a, building(&small(true)).scene);
     let other = building(&BuildingParams {
         seed: 2,
         ..small(true)
-    });
+    })
+    .scene;
     assert_ne!(a, other);
     assert_eq!(a.surfaces.len(), other.surfaces.len());
 }
@@ -92,7 +93,8 @@ fn every_surface_is_a_valid_polygon() {
         floors: 2,
         rooms_x: 3,
         ..small(true)
-    });
+    })
+    .scene;
     for s in &scene.surfaces {
         let mut v = s.vertices.clone();
         geometry::validate_polygon(&v).unwrap_or_else(|e| panic!("{}: {e}", s.name));
@@ -129,7 +131,7 @@ fn fronts_face_the_room() {
         rooms_x: 3,
         ..small(true)
     };
-    let scene = building(&p);
+    let scene = building(&p).scene;
     let mut groups: HashMap<&str, (DVec3, usize)> = HashMap::new();
     for s in &scene.surfaces {
         if !s.name.contains(" shell ") {
@@ -247,7 +249,8 @@ fn no_coplanar_surfaces_overlap() {
         floors: 2,
         rooms_x: 3,
         ..small(true)
-    });
+    })
+    .scene;
     let info: Vec<(DVec3, f64, DVec3, DVec3)> = scene
         .surfaces
         .iter()
@@ -307,7 +310,7 @@ fn bad_parameters_are_refused() {
         ..BuildingParams::default()
     };
     bare.check().unwrap();
-    assert_eq!(building(&bare).surfaces.len(), expected_count(&bare));
+    assert_eq!(building(&bare).scene.surfaces.len(), expected_count(&bare));
 }
 
 #[test]
@@ -328,8 +331,8 @@ fn furniture_fits_the_smallest_room() {
 #[test]
 fn element_counts_at_the_default_and_the_million_setting() {
     use crate::mesh::{mesh_scene, MeshError, MAX_ELEMENTS};
-    let scene = building(&BuildingParams::default());
-    let mesh = mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+    let SceneFile { settings, scene } = building(&BuildingParams::default());
+    let mesh = mesh_scene(&scene, settings.max_patch_area).unwrap();
     assert!((30_000..40_000).contains(&mesh.len()), "{}", mesh.len());
     // The million setting meshes (the help of --max-area promises about a million).
     let million = mesh_scene(&scene, 0.0125).unwrap();

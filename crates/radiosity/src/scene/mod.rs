@@ -1,16 +1,19 @@
 //! Scenes: surfaces with emission and reflectance, the model that the rest of the library
 //! works on.
 //!
-//! A [`Scene`] is what a scene file says, after parsing and checking: meshing settings and a
+//! A [`Scene`] is the geometry and materials of a scene file, after parsing and checking: a
 //! list of planar convex [`Surface`]s. Each surface is one-sided: it emits and reflects only
 //! on its front, the side from which its vertices run counter-clockwise (the right-hand-rule
-//! normal points out of the front). Every surface occludes from both sides.
+//! normal points out of the front). Every surface occludes from both sides. The file's
+//! meshing and integration settings (`MAX_PATCH_AREA`, `INTEGRAL_STEPS`: [`MeshSettings`])
+//! are not part of the scene: they come beside it in a [`SceneFile`], and whoever meshes a
+//! scene says with which settings.
 //!
 //! Scene files (the paper's Appendix A format) are read and written by
 //! [`crate::io::scene_file`], which also describes the format and its polygon checks.
 //! [`cornell_box`] is the built-in Cornell box (`examples/cornell_box.scene`, compiled in),
-//! [`building`] generates furnished buildings of any size, and the box primitive's faces are
-//! made here (module `shape`).
+//! [`building`] generates furnished buildings of any size (both come with their settings, as
+//! a [`SceneFile`]), and the box primitive's faces are made here (module `shape`).
 
 use glam::DVec3;
 
@@ -21,23 +24,15 @@ pub(crate) mod shape;
 pub use builtin::cornell_box;
 pub use generate::{building, BuildingParams};
 
-/// The scene file's reader, writer and error, at the paths the command line and the viewer
-/// use; they live in [`crate::io::scene_file`].
-pub use crate::io::scene_file::{read_scene, write_scene_file, SceneError};
+/// The scene file's reader, writer, contents and error, at the paths the command line and
+/// the viewer use; they live in [`crate::io::scene_file`].
+pub use crate::io::scene_file::{read_scene, write_scene_file, SceneError, SceneFile};
+
+/// The settings a scene file gives beside its scene: see [`crate::mesh::MeshSettings`].
+pub use crate::mesh::MeshSettings;
 
 /// Colours of surfaces: see [`crate::light`].
 pub use crate::light::Rgb;
-
-/// The meshing and integration settings at the top of a scene file.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MeshSettings {
-    /// `MAX_PATCH_AREA`: surfaces larger than this (scene units squared) are subdivided into
-    /// elements of at most this area.
-    pub max_patch_area: f64,
-    /// `INTEGRAL_STEPS`: k, the number of sample points along each axis of each element in
-    /// the double area integral (paper 2.8; 1 means one point per element).
-    pub integral_steps: u32,
-}
 
 /// One planar convex polygon of the scene, as written in a `PATCHBEGIN` ... `PATCHEND` block.
 #[derive(Clone, Debug, PartialEq)]
@@ -52,11 +47,10 @@ pub struct Surface {
     pub vertices: Vec<DVec3>,
 }
 
-/// A checked scene: settings and surfaces.
+/// A checked scene: its surfaces (geometry, emission and reflectance), and the camera it
+/// suggests. How finely to mesh it is not the scene's to say: see [`MeshSettings`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
-    /// Meshing and integration settings.
-    pub settings: MeshSettings,
     /// The surfaces, in file order (a box primitive contributes six).
     pub surfaces: Vec<Surface>,
     /// A suggested camera, for scenes that come with one (the built-in Cornell box).

@@ -342,7 +342,7 @@ fn energy_is_conserved() {
 #[test]
 fn scene_convenience_uses_surface_properties() {
     use crate::mesh::mesh_scene;
-    use crate::scene::{MeshSettings, Rgb, Surface};
+    use crate::scene::{Rgb, Surface};
     use glam::dvec3;
     // Two unit squares facing each other one unit apart (one element each).
     let bottom = vec![
@@ -357,10 +357,6 @@ fn scene_convenience_uses_surface_properties() {
         .map(|v| *v + dvec3(0., 0., 1.))
         .collect();
     let scene = Scene {
-        settings: MeshSettings {
-            max_patch_area: 1.0,
-            integral_steps: 1,
-        },
         surfaces: vec![
             Surface {
                 name: "light".into(),
@@ -409,7 +405,7 @@ fn closed_cube_with_computed_form_factors_stays_within_furnace_bounds() {
     };
     use crate::io::form_factor_file::{mesh_fingerprint, read_form_factors, write_form_factors};
     use crate::mesh::mesh_scene;
-    use crate::scene::{MeshSettings, Rgb, Surface};
+    use crate::scene::{Rgb, Surface};
     use glam::{dvec3, DVec3};
     // The unit cube seen from inside: each face's front (u x v) points inwards.
     let face = |a: DVec3, u: DVec3, v: DVec3| vec![a, a + u, a + u + v, a + v];
@@ -424,10 +420,6 @@ fn closed_cube_with_computed_form_factors_stays_within_furnace_bounds() {
     ];
     let (rho, e) = (0.5, 1.0);
     let scene = Scene {
-        settings: MeshSettings {
-            max_patch_area: 0.25,
-            integral_steps: 2,
-        },
         surfaces: faces
             .into_iter()
             .enumerate()

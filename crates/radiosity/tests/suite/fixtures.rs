@@ -9,7 +9,7 @@ use radiosity::form_factor::{
 use radiosity::mesh::{mesh_scene, Mesh};
 use radiosity::pipeline::{self, Overrides, Prepared, Solution, SolveRequest};
 use radiosity::progress::NoProgress;
-use radiosity::scene::{cornell_box, MeshSettings, Rgb, Scene, Surface};
+use radiosity::scene::{cornell_box, Rgb, Scene, Surface};
 use radiosity::solve::{keep_going, Solver};
 use radiosity::visibility::PolygonBvh;
 
@@ -23,12 +23,12 @@ pub fn surface(name: &str, vertices: Vec<DVec3>) -> Surface {
     }
 }
 
-/// The closed unit cube [0, 1]^3, every face looking in, grey and dark (see [`surface`]),
-/// its MAX_PATCH_AREA `max_area` and INTEGRAL_STEPS 2: faces `face0` to `face5` at z = 0,
-/// z = 1, x = 0, x = 1, y = 0 and y = 1. It is the scene of the closed-box and reciprocity
-/// columns of the library's accuracy table (`form_factor::accuracy`), vertex for vertex
-/// (`closed_cube_is_the_accuracy_tables_closed_box` checks it).
-pub fn closed_cube(max_area: f64) -> Scene {
+/// The closed unit cube [0, 1]^3, every face looking in, grey and dark (see [`surface`]):
+/// faces `face0` to `face5` at z = 0, z = 1, x = 0, x = 1, y = 0 and y = 1. It is the scene
+/// of the closed-box and reciprocity columns of the library's accuracy table
+/// (`form_factor::accuracy`), vertex for vertex (`closed_cube_is_the_accuracy_tables_closed_box`
+/// checks it).
+pub fn closed_cube() -> Scene {
     let c = |x: f64, y: f64, z: f64| dvec3(x, y, z);
     // Each face counter-clockwise seen from inside the cube.
     let faces = [
@@ -40,10 +40,6 @@ pub fn closed_cube(max_area: f64) -> Scene {
         [c(1., 1., 0.), c(1., 1., 1.), c(0., 1., 1.), c(0., 1., 0.)],
     ];
     Scene {
-        settings: MeshSettings {
-            max_patch_area: max_area,
-            integral_steps: 2,
-        },
         surfaces: faces
             .into_iter()
             .enumerate()
@@ -55,12 +51,8 @@ pub fn closed_cube(max_area: f64) -> Scene {
 
 /// The [`closed_cube`] with face `i` emitting `emission(i)` and every face reflecting
 /// `reflectance`.
-pub fn lit_closed_cube(
-    max_area: f64,
-    emission: impl Fn(usize) -> [f64; 3],
-    reflectance: [f64; 3],
-) -> Scene {
-    let mut scene = closed_cube(max_area);
+pub fn lit_closed_cube(emission: impl Fn(usize) -> [f64; 3], reflectance: [f64; 3]) -> Scene {
+    let mut scene = closed_cube();
     for (i, s) in scene.surfaces.iter_mut().enumerate() {
         s.emission = Rgb(emission(i));
         s.reflectance = Rgb(reflectance);
@@ -96,9 +88,14 @@ impl Meshed {
     }
 }
 
-/// `scene` meshed at its own MAX_PATCH_AREA, and its form-factor matrix by `method`.
-pub fn matrix_for(scene: &Scene, method: FormFactorMethod) -> (FormFactorMatrix, Mesh) {
-    let meshed = Meshed::new(scene, scene.settings.max_patch_area);
+/// `scene` meshed into elements of at most `max_area`, and its form-factor matrix by
+/// `method`.
+pub fn matrix_for(
+    scene: &Scene,
+    max_area: f64,
+    method: FormFactorMethod,
+) -> (FormFactorMatrix, Mesh) {
+    let meshed = Meshed::new(scene, max_area);
     (meshed.matrix(method), meshed.mesh)
 }
 
@@ -108,17 +105,14 @@ pub fn element_areas(mesh: &Mesh) -> Vec<f64> {
 }
 
 /// The built-in Cornell box prepared at MAX_PATCH_AREA `max_area` (mm^2) and, where given,
-/// INTEGRAL_STEPS `steps` (else the scene's own).
+/// INTEGRAL_STEPS `steps` (else the scene file's own).
 pub fn prepared_cornell(max_area: f64, steps: Option<u32>) -> Prepared {
-    Prepared::new(
-        cornell_box(),
-        Overrides {
-            max_patch_area: Some(max_area),
-            integral_steps: steps,
-        },
-        &NoProgress,
-    )
-    .unwrap()
+    let file = cornell_box();
+    let overrides = Overrides {
+        max_patch_area: Some(max_area),
+        integral_steps: steps,
+    };
+    Prepared::new(file.scene, overrides.apply(file.settings), &NoProgress).unwrap()
 }
 
 /// `prepared` solved by dense Gauss-Seidel at the library's default settings.
@@ -136,7 +130,7 @@ pub fn dense_gauss_seidel(prepared: &Prepared) -> Solution {
 
 #[test]
 fn closed_cube_faces_are_unit_squares_looking_in() {
-    let scene = closed_cube(1.0);
+    let scene = closed_cube();
     assert_eq!(scene.surfaces.len(), 6);
     let centre = dvec3(0.5, 0.5, 0.5);
     for s in &scene.surfaces {
@@ -157,7 +151,6 @@ fn closed_cube_faces_are_unit_squares_looking_in() {
     }
     // Elements per face: 1, 2 x 2, 3 x 3.
     for (max_area, elements) in [(1.0, 6), (0.25, 24), (1.0 / 9.0, 54)] {
-        let scene = closed_cube(max_area);
         assert_eq!(mesh_scene(&scene, max_area).unwrap().len(), elements);
     }
 }
@@ -173,7 +166,7 @@ fn closed_cube_is_the_accuracy_tables_closed_box() {
     };
     let max_area = 1.0 / 9.0;
     let row = radiosity::form_factor::accuracy::measure(method, max_area);
-    let (f, mesh) = matrix_for(&closed_cube(max_area), method);
+    let (f, mesh) = matrix_for(&closed_cube(), max_area, method);
     assert_eq!(mesh.len(), 54);
     let closed_box = (0..f.n())
         .map(|i| (f.row_sum(i) - 1.0).abs())

@@ -6,7 +6,7 @@ use radiosity::form_factor::accuracy::surface_to_surface;
 use radiosity::form_factor::{
     area_integral_pair, compute_rows, reference, FormFactorMatrix, FormFactorMethod, RayCounter,
 };
-use radiosity::scene::{MeshSettings, Scene};
+use radiosity::scene::Scene;
 
 use crate::fixtures::{closed_cube, element_areas, matrix_for, surface, Meshed};
 
@@ -94,9 +94,12 @@ fn perpendicular_unit_squares_converge_as_k() {
     }
 }
 
-/// A closed unit cube, every face facing in, 3 x 3 elements a face.
+/// The element area that cuts each face of [`unit_cube`] into 3 x 3 elements.
+const CUBE_AREA: f64 = 1.0 / 9.0;
+
+/// A closed unit cube, every face facing in (meshed at [`CUBE_AREA`] below).
 fn unit_cube() -> Scene {
-    closed_cube(1.0 / 9.0)
+    closed_cube()
 }
 
 // Closed cube, 3 x 3 elements per face, k = 8. Row sums equal 1 exactly for the true
@@ -108,7 +111,7 @@ fn unit_cube() -> Scene {
 #[test]
 fn closed_cube_rows_sum_to_one_and_reciprocity_holds() {
     let scene = unit_cube();
-    let meshed = Meshed::new(&scene, scene.settings.max_patch_area);
+    let meshed = Meshed::new(&scene, CUBE_AREA);
     let mesh = &meshed.mesh;
     assert_eq!(mesh.len(), 54);
     let method = FormFactorMethod::AreaIntegral { steps: 8 };
@@ -155,10 +158,6 @@ fn occluder_blocks_opposed_squares() {
     };
     for (lo, hi, expect_zero) in [(-1.0, 2.0, true), (0.25, 0.75, false)] {
         let scene = Scene {
-            settings: MeshSettings {
-                max_patch_area: 2.0,
-                integral_steps: 8,
-            },
             surfaces: vec![
                 surface("a", unit_square_z0()),
                 surface("b", opposed_square()),
@@ -191,12 +190,8 @@ fn assert_rows_sum_to_one(f: &FormFactorMatrix, tolerance: f64) {
     }
 }
 
-fn opposed_squares_scene(max_area: f64) -> Scene {
+fn opposed_squares_scene() -> Scene {
     Scene {
-        settings: MeshSettings {
-            max_patch_area: max_area,
-            integral_steps: 2,
-        },
         surfaces: vec![
             surface("a", unit_square_z0()),
             surface("b", opposed_square()),
@@ -213,7 +208,8 @@ fn opposed_squares_scene(max_area: f64) -> Scene {
 fn hemicube_opposed_squares_and_closed_cube() {
     let exact = reference::parallel_rectangles(1.0, 1.0, 1.0);
     let (f, mesh) = matrix_for(
-        &opposed_squares_scene(1.0 / 64.0),
+        &opposed_squares_scene(),
+        1.0 / 64.0,
         FormFactorMethod::Hemicube { resolution: 256 },
     );
     let est = surface_to_surface(&f, &mesh, 0, 1);
@@ -224,7 +220,11 @@ fn hemicube_opposed_squares_and_closed_cube() {
 
     // Closed cube: every cell of every hemicube sees a wall, and the deltas sum to 1, so
     // each row sums to 1 up to f32 rounding of its entries (n x 6e-8).
-    let (f, _) = matrix_for(&unit_cube(), FormFactorMethod::Hemicube { resolution: 64 });
+    let (f, _) = matrix_for(
+        &unit_cube(),
+        CUBE_AREA,
+        FormFactorMethod::Hemicube { resolution: 64 },
+    );
     assert_rows_sum_to_one(&f, 1e-5);
     for i in 0..f.n() {
         assert_eq!(f.get(i, i), 0.0);
@@ -242,17 +242,18 @@ fn montecarlo_is_deterministic_and_converges() {
         samples: 25_600,
         seed: 7,
     };
-    let (f, mesh) = matrix_for(&opposed_squares_scene(1.0 / 16.0), method);
+    let (f, mesh) = matrix_for(&opposed_squares_scene(), 1.0 / 16.0, method);
     let est = surface_to_surface(&f, &mesh, 0, 1);
     assert!(
         (est - exact).abs() < 0.0125,
         "Monte Carlo F = {est}, exact {exact}"
     );
     // Same seed, same numbers; another seed, other numbers.
-    let (again, _) = matrix_for(&opposed_squares_scene(1.0 / 16.0), method);
+    let (again, _) = matrix_for(&opposed_squares_scene(), 1.0 / 16.0, method);
     assert_eq!(f, again);
     let (other, _) = matrix_for(
-        &opposed_squares_scene(1.0 / 16.0),
+        &opposed_squares_scene(),
+        1.0 / 16.0,
         FormFactorMethod::MonteCarlo {
             samples: 25_600,
             seed: 8,
@@ -264,6 +265,7 @@ fn montecarlo_is_deterministic_and_converges() {
     // rounding of its entries).
     let (f, _) = matrix_for(
         &unit_cube(),
+        CUBE_AREA,
         FormFactorMethod::MonteCarlo {
             samples: 400,
             seed: 1,
@@ -292,11 +294,8 @@ fn methods_agree_on_an_occluded_scene() {
             dvec3(0.25, 0.75, 0.5),
         ],
     );
-    let scene_with = |max_area: f64| {
-        let mut scene = opposed_squares_scene(max_area);
-        scene.surfaces.push(blocker.clone());
-        scene
-    };
+    let mut scene = opposed_squares_scene();
+    scene.surfaces.push(blocker);
     let unoccluded = reference::parallel_rectangles(1.0, 1.0, 1.0);
     let estimates: Vec<(FormFactorMethod, f64)> = [
         (1.0 / 64.0, FormFactorMethod::AreaIntegral { steps: 8 }),
@@ -313,7 +312,7 @@ fn methods_agree_on_an_occluded_scene() {
     ]
     .into_iter()
     .map(|(max_area, method)| {
-        let (f, mesh) = matrix_for(&scene_with(max_area), method);
+        let (f, mesh) = matrix_for(&scene, max_area, method);
         (method, surface_to_surface(&f, &mesh, 0, 1))
     })
     .collect();
@@ -331,12 +330,8 @@ fn methods_agree_on_an_occluded_scene() {
     }
 }
 
-fn perpendicular_squares_scene(max_area: f64) -> Scene {
+fn perpendicular_squares_scene() -> Scene {
     Scene {
-        settings: MeshSettings {
-            max_patch_area: max_area,
-            integral_steps: 2,
-        },
         surfaces: vec![
             surface("a", unit_square_z0()),
             surface("b", perpendicular_square()),
@@ -350,21 +345,24 @@ fn perpendicular_squares_scene(max_area: f64) -> Scene {
 // 2e-7; so does any subdivision, summed (f32 rounding of each entry, 64 entries).
 #[test]
 fn contour_reproduces_closed_forms() {
-    for (scene, exact) in [
+    for (scene, max_area, exact) in [
         (
-            opposed_squares_scene(1.0),
+            opposed_squares_scene(),
+            1.0,
             reference::parallel_rectangles(1.0, 1.0, 1.0),
         ),
         (
-            perpendicular_squares_scene(1.0),
+            perpendicular_squares_scene(),
+            1.0,
             reference::perpendicular_rectangles(1.0, 1.0, 1.0),
         ),
         (
-            perpendicular_squares_scene(1.0 / 16.0),
+            perpendicular_squares_scene(),
+            1.0 / 16.0,
             reference::perpendicular_rectangles(1.0, 1.0, 1.0),
         ),
     ] {
-        let (f, mesh) = matrix_for(&scene, FormFactorMethod::Contour { steps: 2 });
+        let (f, mesh) = matrix_for(&scene, max_area, FormFactorMethod::Contour { steps: 2 });
         let est = surface_to_surface(&f, &mesh, 0, 1);
         assert!(
             (est - exact).abs() < 2e-7 * exact,
@@ -374,7 +372,11 @@ fn contour_reproduces_closed_forms() {
     }
     // A closed cube: exact form factors of a closed convex enclosure sum to 1 in every
     // row; f32 storage of 54 entries bounds the error by ~54 x 6e-8.
-    let (f, _) = matrix_for(&unit_cube(), FormFactorMethod::Contour { steps: 2 });
+    let (f, _) = matrix_for(
+        &unit_cube(),
+        CUBE_AREA,
+        FormFactorMethod::Contour { steps: 2 },
+    );
     assert_rows_sum_to_one(&f, 4e-6);
 }
 
@@ -391,7 +393,8 @@ fn analytic_converges_as_k_squared_even_at_shared_edges() {
     let opposed = reference::parallel_rectangles(1.0, 1.0, 1.0);
     for k in [2u32, 4, 8, 16, 32] {
         let (f, mesh) = matrix_for(
-            &perpendicular_squares_scene(1.0),
+            &perpendicular_squares_scene(),
+            1.0,
             FormFactorMethod::Analytic { steps: k },
         );
         let err = (surface_to_surface(&f, &mesh, 0, 1) - perpendicular).abs();
@@ -400,7 +403,8 @@ fn analytic_converges_as_k_squared_even_at_shared_edges() {
             "perpendicular, k = {k}: error {err}"
         );
         let (f, mesh) = matrix_for(
-            &opposed_squares_scene(1.0),
+            &opposed_squares_scene(),
+            1.0,
             FormFactorMethod::Analytic { steps: k },
         );
         let err = (surface_to_surface(&f, &mesh, 0, 1) - opposed).abs();

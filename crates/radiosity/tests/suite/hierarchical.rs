@@ -12,12 +12,24 @@ use radiosity::solve::{
 
 use crate::fixtures::{dense_gauss_seidel, lit_closed_cube, prepared_cornell};
 
-/// A closed unit cube, one element a face, every face facing in, E and rho uniform.
+/// A closed unit cube, every face facing in, E and rho uniform; one element a face at
+/// MAX_PATCH_AREA [`CUBE_AREA`].
 fn unit_cube(e: [f64; 3], rho: [f64; 3]) -> Scene {
-    lit_closed_cube(1.0, |_| e, rho)
+    lit_closed_cube(|_| e, rho)
 }
 
-fn solve(scene: &Scene, epsilon: f64, min_area: f64) -> HierarchicalSolution {
+/// The MAX_PATCH_AREA of [`unit_cube`]: one element a face.
+const CUBE_AREA: f64 = 1.0;
+
+/// The built-in Cornell box and its scene file's MAX_PATCH_AREA (1000 mm^2).
+fn cornell() -> (Scene, f64) {
+    let file = cornell_box();
+    (file.scene, file.settings.max_patch_area)
+}
+
+/// `scene` by hierarchical radiosity, its patches split along the grid of the mesh at
+/// MAX_PATCH_AREA `max_area`.
+fn solve(scene: &Scene, max_area: f64, epsilon: f64, min_area: f64) -> HierarchicalSolution {
     let bvh = occluder_bvh(scene);
     let settings = HierarchicalSettings {
         epsilon,
@@ -25,7 +37,7 @@ fn solve(scene: &Scene, epsilon: f64, min_area: f64) -> HierarchicalSolution {
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: None,
     };
-    solve_hierarchical(scene, &bvh, &settings, &NoProgress).unwrap()
+    solve_hierarchical(scene, max_area, &bvh, &settings, &NoProgress).unwrap()
 }
 
 /// Area-weighted mean B of every input surface, per band.
@@ -107,7 +119,7 @@ fn unrefined_closed_cube_is_exact() {
     // Without refinement every face gathers from the five others at the mean of four exact
     // point-to-polygon values, each summing to exactly 1 over the five faces: B = E / (1 - rho)
     // to the solve tolerance (1e-7 of max E per sweep change, amplified by 1 / (1 - rho)).
-    let s = solve(&unit_cube(CUBE_E, CUBE_RHO), 10.0, 1.0 / 256.0);
+    let s = solve(&unit_cube(CUBE_E, CUBE_RHO), CUBE_AREA, 10.0, 1.0 / 256.0);
     assert_eq!(s.report.leaves, 6);
     assert_eq!(s.report.links, 30);
     let (mean, worst) = cube_errors(&s);
@@ -123,7 +135,7 @@ fn refined_closed_cube_is_close_to_the_closed_form() {
     // relative error 3.3e-2, largest 0.19 (a corner leaf); escaped power -0.8 %, -0.4 % and
     // -1.9 % of emitted (red, green, blue: the error of the form-factor sums, amplified by
     // 1 / (1 - rho)). Tolerances: 5 %, 25 % and 3 %.
-    let s = solve(&unit_cube(CUBE_E, CUBE_RHO), 0.01, 1.0 / 256.0);
+    let s = solve(&unit_cube(CUBE_E, CUBE_RHO), CUBE_AREA, 0.01, 1.0 / 256.0);
     let (mean, worst) = cube_errors(&s);
     let b = s.report.balance;
     let escaped: Vec<f64> = (0..3).map(|k| b.escaped[k] / b.emitted[k]).collect();
@@ -143,10 +155,10 @@ fn refined_closed_cube_is_close_to_the_closed_form() {
 #[test]
 fn cornell_box_agrees_with_the_dense_solve() {
     const EPS: f64 = 0.01;
-    let scene = cornell_box();
+    let (scene, max_area) = cornell();
     let dense = dense_cornell();
     let t = std::time::Instant::now();
-    let s = solve(&scene, EPS, 500.0);
+    let s = solve(&scene, max_area, EPS, 500.0);
     let elapsed = t.elapsed();
     let h = per_surface(&s.mesh, &s.radiosity);
     let rms = relative_rms(&scene, &h, &dense.per_surface);
@@ -191,14 +203,15 @@ fn clustering_makes_linking_about_linear_in_the_surfaces() {
     // surfaces grow 7.8x; measured with clusters, the links grow 10.1x: exponent 1.13.
     // Bound: 1.4, well below quadratic.
     let links = |rooms_x, rooms_z| {
-        let scene = radiosity::scene::building(&radiosity::scene::BuildingParams {
+        let file = radiosity::scene::building(&radiosity::scene::BuildingParams {
             floors: 1,
             rooms_x,
             rooms_z,
             max_patch_area: 4.0,
             ..Default::default()
         });
-        let s = solve(&scene, 0.5, 1.0);
+        let scene = file.scene;
+        let s = solve(&scene, file.settings.max_patch_area, 0.5, 1.0);
         eprintln!(
             "{rooms_x} x {rooms_z} rooms: {} surfaces, {} leaves, {} clusters, {} links",
             scene.surfaces.len(),
@@ -222,9 +235,9 @@ fn clustering_makes_linking_about_linear_in_the_surfaces() {
 
 #[test]
 fn smaller_epsilon_refines_more() {
-    let scene = cornell_box();
-    let coarse = solve(&scene, 0.5, 250.0);
-    let fine = solve(&scene, 0.1, 250.0);
+    let (scene, max_area) = cornell();
+    let coarse = solve(&scene, max_area, 0.5, 250.0);
+    let fine = solve(&scene, max_area, 0.1, 250.0);
     assert!(coarse.report.leaves > scene.surfaces.len());
     assert!(fine.report.leaves > coarse.report.leaves);
     assert!(fine.report.links > coarse.report.links);
@@ -244,9 +257,9 @@ fn smaller_epsilon_refines_more() {
 
 #[test]
 fn deterministic() {
-    let scene = cornell_box();
-    let a = solve(&scene, 0.1, 250.0);
-    let b = solve(&scene, 0.1, 250.0);
+    let (scene, max_area) = cornell();
+    let a = solve(&scene, max_area, 0.1, 250.0);
+    let b = solve(&scene, max_area, 0.1, 250.0);
     assert_eq!(a.radiosity, b.radiosity);
     assert_eq!(a.mesh.vertices, b.mesh.vertices);
     assert_eq!(a.report.links, b.report.links);
@@ -254,7 +267,7 @@ fn deterministic() {
 
 #[test]
 fn refuses_bad_settings() {
-    let scene = cornell_box();
+    let (scene, max_area) = cornell();
     let bvh = occluder_bvh(&scene);
     for (epsilon, min_area, tolerance) in [
         (0.0, 1.0, 1e-6),
@@ -270,7 +283,7 @@ fn refuses_bad_settings() {
             tolerance,
             max_memory_bytes: None,
         };
-        assert!(solve_hierarchical(&scene, &bvh, &settings, &NoProgress).is_err());
+        assert!(solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).is_err());
     }
 }
 
@@ -278,7 +291,7 @@ fn refuses_bad_settings() {
 fn refuses_to_outgrow_its_memory_limit() {
     // The Cornell box at epsilon 0.01 holds about 340,000 links (over 10 MiB); with a 4 MiB
     // limit refinement must stop with the error that says what to change, not allocate on.
-    let scene = cornell_box();
+    let (scene, max_area) = cornell();
     let bvh = occluder_bvh(&scene);
     let settings = HierarchicalSettings {
         epsilon: 0.01,
@@ -286,7 +299,7 @@ fn refuses_to_outgrow_its_memory_limit() {
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: Some(4 << 20),
     };
-    let err = solve_hierarchical(&scene, &bvh, &settings, &NoProgress).unwrap_err();
+    let err = solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).unwrap_err();
     let text = err.to_string();
     assert!(text.contains("larger epsilon or minimum area"), "{text}");
     assert!(
@@ -314,7 +327,12 @@ fn against_exact_dense(
     settings
         .iter()
         .map(|&(epsilon, min_area)| {
-            let s = solve(&prepared.scene, epsilon, min_area);
+            let s = solve(
+                &prepared.scene,
+                prepared.settings.max_patch_area,
+                epsilon,
+                min_area,
+            );
             let c = compare(
                 &prepared.mesh,
                 &dense.radiosity,
@@ -371,13 +389,12 @@ fn inside(poly: &[glam::DVec3], n: glam::DVec3, x: glam::DVec3, tol: f64) -> boo
 #[test]
 fn leaves_nest_with_the_mesh_elements() {
     // Every leaf on a quadrilateral surface lies within one element of the mesh made at the
-    // scene's MAX_PATCH_AREA, or is the union of whole elements: the hierarchy splits along
+    // solve's MAX_PATCH_AREA, or is the union of whole elements: the hierarchy splits along
     // the mesh's grid lines. (The Cornell box at 1000 mm^2: 18 x 18 and 17 x 18 grids and
     // the like, none a power of two, so bisection alone would not nest.)
-    let mut scene = cornell_box();
-    scene.settings.max_patch_area = 1000.0;
+    let scene = cornell_box().scene;
     let mesh = radiosity::mesh::mesh_scene(&scene, 1000.0).unwrap();
-    let s = solve(&scene, 0.03, 250.0);
+    let s = solve(&scene, 1000.0, 0.03, 250.0);
     let corners = |m: &radiosity::mesh::Mesh, e: usize| -> Vec<glam::DVec3> {
         m.corner_positions(e).collect()
     };

@@ -2,7 +2,7 @@
 //! sum to at most 1 plus the method's own error bound; sampled methods are deterministic.
 
 use radiosity::form_factor::FormFactorMethod;
-use radiosity::scene::read_scene;
+use radiosity::scene::{read_scene, SceneFile};
 
 use crate::fixtures::Meshed;
 
@@ -56,9 +56,9 @@ fn every_method_on_every_example_keeps_rows_at_most_one() {
         ),
     ];
     for path in examples() {
-        let scene = read_scene(&path).unwrap();
+        let SceneFile { settings, scene } = read_scene(&path).unwrap();
         // Coarser than the scene asks, to keep the test quick on two cores.
-        let meshed = Meshed::new(&scene, 8.0 * scene.settings.max_patch_area);
+        let meshed = Meshed::new(&scene, 8.0 * settings.max_patch_area);
         for (method, bound) in methods {
             let f = meshed.matrix(method);
             let mut worst: f64 = 0.0;

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::mesh::mesh_scene;
-use crate::scene::{MeshSettings, Rgb, Scene, Surface};
+use crate::scene::{Rgb, Scene, Surface};
 use glam::dvec3;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -27,10 +27,6 @@ fn scene(lift: f64) -> Scene {
         ]
     };
     Scene {
-        settings: MeshSettings {
-            max_patch_area: 0.5,
-            integral_steps: 2,
-        },
         surfaces: [rect(0.0, 1.0), rect(1.0, 2.0), rect(2.0 + lift, 1.0)]
             .into_iter()
             .enumerate()

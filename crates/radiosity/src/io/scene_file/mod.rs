@@ -1,9 +1,10 @@
-//! The scene file: the paper's Appendix A format, read into a
-//! [`Scene`](crate::scene::Scene) and written back.
+//! The scene file: the paper's Appendix A format, read into a [`SceneFile`] (the meshing
+//! settings and the [`Scene`]) and written back.
 //!
 //! [`read_scene`] and [`parse_scene`] read the format, [`write_scene`] and
-//! [`write_scene_file`] write it. The built-in Cornell box ([`crate::scene::cornell_box`])
-//! is `examples/cornell_box.scene`, compiled in and read by [`parse_scene`].
+//! [`write_scene_file`] write a scene with the settings given beside it. The built-in
+//! Cornell box ([`crate::scene::cornell_box`]) is `examples/cornell_box.scene`, compiled in
+//! and read by [`parse_scene`].
 //!
 //! # The scene format
 //!
@@ -76,3 +77,18 @@ mod write;
 
 pub use read::{parse_scene, read_scene, ParseError, SceneError};
 pub use write::{write_scene, write_scene_file};
+
+use crate::mesh::MeshSettings;
+use crate::scene::Scene;
+
+/// What a scene file holds: the settings of its first two lines (`MAX_PATCH_AREA`,
+/// `INTEGRAL_STEPS`) and the scene between `SCENEBEGIN` and `SCENEEND`. The built-in and
+/// generated scenes come the same way ([`crate::scene::cornell_box`],
+/// [`crate::scene::building`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneFile {
+    /// How the file says to mesh and integrate its scene.
+    pub settings: MeshSettings,
+    /// The surfaces (and, for the built-in box, a camera).
+    pub scene: Scene,
+}

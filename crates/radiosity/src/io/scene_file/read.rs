@@ -7,10 +7,12 @@ use thiserror::Error;
 
 use super::lex::{lex, Keyword, Line, Token};
 use super::polygon;
+use super::SceneFile;
 use crate::geometry;
 use crate::light::Rgb;
+use crate::mesh::MeshSettings;
 use crate::scene::shape::{self, Facing};
-use crate::scene::{MeshSettings, Scene, Surface};
+use crate::scene::{Scene, Surface};
 
 /// After this many errors the reader stops looking for more.
 const MAX_ERRORS: usize = 100;
@@ -81,7 +83,7 @@ impl SceneError {
 /// Reads and checks the scene file at `path`.
 ///
 /// A file that cannot be read, or is not UTF-8, gives a [`SceneError`] naming the file.
-pub fn read_scene(path: &Path) -> Result<Scene, SceneError> {
+pub fn read_scene(path: &Path) -> Result<SceneFile, SceneError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path)
         .map_err(|e| SceneError::whole_file(&name, format!("cannot read the scene file: {e}")))?;
@@ -104,8 +106,8 @@ pub fn read_scene(path: &Path) -> Result<Scene, SceneError> {
 ///
 /// `source_name` is the file name used in error messages. Every error in the text is reported,
 /// in order; after an error inside a `PATCHBEGIN` or `BOXBEGIN` block the reader skips to the
-/// end of that block and goes on. The result's `camera` is `None`.
-pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
+/// end of that block and goes on. The scene's `camera` is `None`.
+pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneError> {
     let (lines, eof) = lex(text);
     let mut parser = Parser {
         file: source_name,
@@ -117,10 +119,12 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
     let settings = parser.header();
     let surfaces = parser.body();
     match settings {
-        Some(settings) if parser.errors.is_empty() => Ok(Scene {
+        Some(settings) if parser.errors.is_empty() => Ok(SceneFile {
             settings,
-            surfaces,
-            camera: None,
+            scene: Scene {
+                surfaces,
+                camera: None,
+            },
         }),
         _ => Err(SceneError {
             errors: parser.errors,

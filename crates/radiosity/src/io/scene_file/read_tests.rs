@@ -72,9 +72,9 @@ fn one_error(text: &str, line: usize, column: usize, needle: &str) {
 
 #[test]
 fn valid_scene() {
-    let scene = parse_scene(VALID, "t.scene").unwrap();
-    assert_eq!(scene.settings.max_patch_area, 100.0);
-    assert_eq!(scene.settings.integral_steps, 2);
+    let SceneFile { settings, scene } = parse_scene(VALID, "t.scene").unwrap();
+    assert_eq!(settings.max_patch_area, 100.0);
+    assert_eq!(settings.integral_steps, 2);
     assert_eq!(scene.camera, None);
     assert_eq!(scene.surfaces.len(), 1);
     let s = &scene.surfaces[0];
@@ -117,9 +117,9 @@ sceneend
 // trailing comment
 
 ";
-    let scene = parse_scene(text, "t.scene").unwrap();
-    assert_eq!(scene.settings.max_patch_area, 0.25);
-    assert_eq!(scene.settings.integral_steps, 3);
+    let SceneFile { settings, scene } = parse_scene(text, "t.scene").unwrap();
+    assert_eq!(settings.max_patch_area, 0.25);
+    assert_eq!(settings.integral_steps, 3);
     let s = &scene.surfaces[0];
     assert_eq!(s.name, "My floor");
     assert_eq!(s.emission, Rgb([0.1, 2.0, 3.0]));
@@ -337,7 +337,8 @@ fn polygon_errors_point_at_vertex0() {
         &with_lines(&[(14, "VERTEX1 0 1 0"), (16, "VERTEX3 1 0 0")]),
         "t",
     )
-    .unwrap();
+    .unwrap()
+    .scene;
     let n = geometry::polygon_normal(&flipped.surfaces[0].vertices).unwrap();
     assert_eq!(n, -DVec3::Z);
 }
@@ -353,7 +354,9 @@ fn planarity_message_states_deviation_limit_and_units() {
 #[test]
 fn slightly_non_planar_polygon_is_flattened() {
     // 0.004 / 4 = 0.001 off the plane, under the limit 0.002 * sqrt(2).
-    let scene = parse_scene(&with_line(15, "VERTEX2 1 1 0.004"), "t").unwrap();
+    let scene = parse_scene(&with_line(15, "VERTEX2 1 1 0.004"), "t")
+        .unwrap()
+        .scene;
     let v = &scene.surfaces[0].vertices;
     assert!(geometry::max_plane_deviation(v) < 1e-12);
     assert!((v[2].z - 0.003).abs() < 1e-4, "{:?}", v[2]);
@@ -543,7 +546,9 @@ fn check_facing(faces: &[Surface], out: bool) {
 
 #[test]
 fn axis_aligned_box() {
-    let scene = parse_scene(&box_scene("OUT", "ORIGIN 1 0 2\nSIZE 2 0.8 1"), "t").unwrap();
+    let scene = parse_scene(&box_scene("OUT", "ORIGIN 1 0 2\nSIZE 2 0.8 1"), "t")
+        .unwrap()
+        .scene;
     let faces = &scene.surfaces;
     let names: Vec<&str> = faces.iter().map(|f| f.name.as_str()).collect();
     assert_eq!(
@@ -572,7 +577,9 @@ fn axis_aligned_box() {
         Some(-DVec3::Y)
     );
 
-    let room = parse_scene(&box_scene("in", "ORIGIN 1 0 2\nSIZE 2 0.8 1"), "t").unwrap();
+    let room = parse_scene(&box_scene("in", "ORIGIN 1 0 2\nSIZE 2 0.8 1"), "t")
+        .unwrap()
+        .scene;
     check_facing(&room.surfaces, false);
     assert!((enclosed_volume(&room.surfaces) + 1.6).abs() < 1e-12);
     assert_eq!(
@@ -600,7 +607,7 @@ fn box_from_a_face_and_a_height() {
     let expected = geometry::polygon_area(&base) * 0.75;
     let n = geometry::polygon_normal(&base).unwrap();
     for (facing, out) in [("OUT", true), ("IN", false)] {
-        let scene = parse_scene(&box_scene(facing, &shape), "t").unwrap();
+        let scene = parse_scene(&box_scene(facing, &shape), "t").unwrap().scene;
         let faces = &scene.surfaces;
         assert_eq!(faces.len(), 6);
         check_facing(faces, out);

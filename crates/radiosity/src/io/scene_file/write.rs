@@ -2,19 +2,21 @@
 //!
 //! Numbers are printed with Rust's `{}` formatting of `f64`, the shortest text that reads
 //! back as the same value, so reading a written scene gives back exactly the scene written
-//! (for any scene that [`super::parse_scene`] could have produced). Boxes are written as their
-//! six patches; the camera hint is not part of the format and is not written.
+//! (for any scene that [`super::parse_scene`] could have produced). The settings are written
+//! first, from the [`MeshSettings`] given beside the scene. Boxes are written as their six
+//! patches; the camera hint is not part of the format and is not written.
 
 use std::io::{self, Write};
 use std::path::Path;
 
+use crate::mesh::MeshSettings;
 use crate::scene::{Scene, Surface};
 
-/// Writes `scene` as scene-file text to `out`.
+/// Writes `scene` with `settings` as scene-file text to `out`.
 ///
 /// Fails with [`io::ErrorKind::InvalidInput`] for a surface name that would not read back as
 /// itself (one with a line break, a `//`, or leading or trailing whitespace).
-pub fn write_scene(scene: &Scene, out: &mut impl Write) -> io::Result<()> {
+pub fn write_scene(scene: &Scene, settings: MeshSettings, out: &mut impl Write) -> io::Result<()> {
     for (i, s) in scene.surfaces.iter().enumerate() {
         check_name(i, &s.name)?;
     }
@@ -24,8 +26,8 @@ pub fn write_scene(scene: &Scene, out: &mut impl Write) -> io::Result<()> {
         env!("CARGO_PKG_VERSION")
     )?;
     writeln!(out, "// {} surfaces.", scene.surfaces.len())?;
-    writeln!(out, "MAX_PATCH_AREA {}", scene.settings.max_patch_area)?;
-    writeln!(out, "INTEGRAL_STEPS {}", scene.settings.integral_steps)?;
+    writeln!(out, "MAX_PATCH_AREA {}", settings.max_patch_area)?;
+    writeln!(out, "INTEGRAL_STEPS {}", settings.integral_steps)?;
     writeln!(out, "SCENEBEGIN")?;
     for surface in &scene.surfaces {
         writeln!(out)?;
@@ -35,9 +37,10 @@ pub fn write_scene(scene: &Scene, out: &mut impl Write) -> io::Result<()> {
     writeln!(out, "SCENEEND")
 }
 
-/// Writes `scene` to the file at `path`, replacing it atomically (temporary file and rename).
-pub fn write_scene_file(scene: &Scene, path: &Path) -> io::Result<()> {
-    crate::io::write_atomically(path, |w| write_scene(scene, w))
+/// Writes `scene` with `settings` to the file at `path`, replacing it atomically (temporary
+/// file and rename).
+pub fn write_scene_file(scene: &Scene, settings: MeshSettings, path: &Path) -> io::Result<()> {
+    crate::io::write_atomically(path, |w| write_scene(scene, settings, w))
 }
 
 /// One `PATCHBEGIN` ... `PATCHEND` block.
@@ -74,7 +77,7 @@ fn check_name(index: usize, name: &str) -> io::Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{parse_scene, read_scene};
+    use super::super::{parse_scene, read_scene, SceneFile};
     use super::*;
     use crate::geometry;
     use crate::scene::cornell_box;
@@ -103,28 +106,29 @@ mod tests {
         ),
     ];
 
-    fn written(scene: &Scene) -> String {
+    fn written(file: &SceneFile) -> String {
         let mut out = Vec::new();
-        write_scene(scene, &mut out).unwrap();
+        write_scene(&file.scene, file.settings, &mut out).unwrap();
         String::from_utf8(out).unwrap()
     }
 
-    /// Asserts that reading the written scene gives it back bit for bit.
+    /// Asserts that reading the written scene gives it and its settings back bit for bit.
     #[track_caller]
-    fn round_trips(scene: &Scene) {
-        let text = written(scene);
+    fn round_trips(file: &SceneFile) {
+        let text = written(file);
         let mut back = parse_scene(&text, "written").unwrap_or_else(|e| panic!("{e}\n{text}"));
-        back.camera = scene.camera;
-        assert_eq!(&back, scene);
-        let bits = |s: &Scene| -> Vec<u64> {
-            s.surfaces
+        back.scene.camera = file.scene.camera;
+        assert_eq!(&back, file);
+        let bits = |f: &SceneFile| -> Vec<u64> {
+            f.scene
+                .surfaces
                 .iter()
-                .flat_map(|f| f.vertices.iter().flat_map(|v| v.to_array()))
-                .chain([s.settings.max_patch_area])
+                .flat_map(|s| s.vertices.iter().flat_map(|v| v.to_array()))
+                .chain([f.settings.max_patch_area])
                 .map(f64::to_bits)
                 .collect()
         };
-        assert_eq!(bits(&back), bits(scene));
+        assert_eq!(bits(&back), bits(file));
         // Writing again gives the same text.
         assert_eq!(written(&back), text);
     }
@@ -132,9 +136,9 @@ mod tests {
     #[test]
     fn every_example_parses_and_round_trips() {
         for (name, text) in EXAMPLES {
-            let scene = parse_scene(text, name).unwrap_or_else(|e| panic!("{e}"));
+            let file = parse_scene(text, name).unwrap_or_else(|e| panic!("{e}"));
             assert!(text.starts_with("// "), "{name} needs a header comment");
-            round_trips(&scene);
+            round_trips(&file);
         }
     }
 
@@ -178,7 +182,7 @@ mod tests {
 
     #[test]
     fn room_example_contents() {
-        let scene = parse_scene(EXAMPLES[1].1, "room.scene").unwrap();
+        let SceneFile { settings, scene } = parse_scene(EXAMPLES[1].1, "room.scene").unwrap();
         let (lo, hi) = scene.bounds();
         assert_eq!((lo, hi), (glam::DVec3::ZERO, glam::dvec3(5.0, 2.7, 4.0)));
         let lights = scene
@@ -193,7 +197,7 @@ mod tests {
             .find(|s| s.name == "Ottoman.top")
             .unwrap();
         assert!(top.vertices.iter().all(|v| (v.y - 0.42).abs() < 1e-12));
-        let mesh = crate::mesh::mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        let mesh = crate::mesh::mesh_scene(&scene, settings.max_patch_area).unwrap();
         println!(
             "room.scene: {} surfaces, {} elements",
             scene.surfaces.len(),
@@ -203,15 +207,15 @@ mod tests {
 
     #[test]
     fn paper196_example_meshes_to_196_elements() {
-        let scene = parse_scene(EXAMPLES[4].1, "paper196.scene").unwrap();
-        assert_eq!(scene.settings.integral_steps, 2);
-        let mesh = crate::mesh::mesh_scene(&scene, scene.settings.max_patch_area).unwrap();
+        let SceneFile { settings, scene } = parse_scene(EXAMPLES[4].1, "paper196.scene").unwrap();
+        assert_eq!(settings.integral_steps, 2);
+        let mesh = crate::mesh::mesh_scene(&scene, settings.max_patch_area).unwrap();
         assert_eq!(mesh.len(), 196);
     }
 
     #[test]
     fn occluder_example_contents() {
-        let scene = parse_scene(EXAMPLES[2].1, "occluder.scene").unwrap();
+        let scene = parse_scene(EXAMPLES[2].1, "occluder.scene").unwrap().scene;
         let occluder = scene
             .surfaces
             .iter()
@@ -238,11 +242,14 @@ mod tests {
 
     #[test]
     fn unwritable_names_are_refused() {
-        let mut scene = cornell_box();
+        let SceneFile {
+            settings,
+            mut scene,
+        } = cornell_box();
         for bad in ["a\nb", "a // b", " padded", "x\r"] {
             scene.surfaces[0].name = bad.to_string();
             let mut out = Vec::new();
-            let err = write_scene(&scene, &mut out).unwrap_err();
+            let err = write_scene(&scene, settings, &mut out).unwrap_err();
             assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
         }
     }
@@ -252,11 +259,11 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("radiosity-write-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("box.scene");
-        let scene = cornell_box();
-        write_scene_file(&scene, &path).unwrap();
+        let file = cornell_box();
+        write_scene_file(&file.scene, file.settings, &path).unwrap();
         let mut back = read_scene(&path).unwrap();
-        back.camera = scene.camera;
-        assert_eq!(back, scene);
+        back.scene.camera = file.scene.camera;
+        assert_eq!(back, file);
         assert_eq!(
             std::fs::read_dir(&dir).unwrap().count(),
             1,

@@ -7,7 +7,7 @@
 //! four at its bilinear midpoints, a triangle into four at its edge midpoints; a polygon of
 //! five or more corners is first cut into the fan of triangles from its centroid (as
 //! [`crate::mesh`] does), each fan triangle a root of its own. Where a patch spans several
-//! elements of the mesh [`crate::mesh`] would make at the scene's `MAX_PATCH_AREA`, it
+//! elements of the mesh [`crate::mesh`] would make at the given `MAX_PATCH_AREA`, it
 //! splits along the grid lines nearest its middle instead (four children, or two across a
 //! patch twice as long as wide), so that the leaves nest with the mesh's elements: a leaf
 //! is a piece of one element or a union of whole ones, and a solution can be compared with
@@ -188,10 +188,12 @@ pub struct HierarchicalSolution {
 }
 
 /// Solves `scene` by hierarchical radiosity with clustering and BF refinement (see the
-/// module documentation): `occluders` is the scene's occluder BVH
-/// ([`crate::form_factor::occluder_bvh`]).
+/// module documentation): patches split along the lines that [`crate::mesh::mesh_scene`]
+/// cuts at `max_patch_area`, so that the leaves nest with that mesh's elements;
+/// `occluders` is the scene's occluder BVH ([`crate::form_factor::occluder_bvh`]).
 pub fn solve_hierarchical(
     scene: &Scene,
+    max_patch_area: f64,
     occluders: &PolygonBvh,
     settings: &HierarchicalSettings,
     progress: &dyn Progress,
@@ -274,7 +276,7 @@ pub fn solve_hierarchical(
                 .collect()
         };
         // The mesh's grid of each root (fan triangles share the polygon's m).
-        let grid = crate::mesh::grid_of(v, scene.settings.max_patch_area).unwrap_or([0, 0]);
+        let grid = crate::mesh::grid_of(v, max_patch_area).unwrap_or([0, 0]);
         let roots = polys
             .iter()
             .map(|p| solver.new_patch(s as u32, p, grid, surface.emission.0))
