@@ -132,6 +132,13 @@ pub fn dense_gauss_seidel(prepared: &Prepared) -> Solution {
     .unwrap()
 }
 
+/// The scene of `contact.scene`: a floor with a rug lying in its plane, a block standing on
+/// the floor against the back wall, a stool standing on the rug and a light panel above
+/// (surfaces that lie on or touch others, their faces coplanar), MAX_PATCH_AREA 0.1 m^2.
+pub fn contact_scene() -> Scene {
+    radiosity::io::scene_file::parse_scene(include_str!("contact.scene"), "contact.scene").unwrap()
+}
+
 // ----- the fixtures' own checks -----
 
 #[test]
