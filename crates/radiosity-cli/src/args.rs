@@ -178,18 +178,9 @@ pub enum ShadingArg {
     Wireframe,
 }
 
+/// Exposure and gamma: the flags `render` and `pathtrace` share.
 #[derive(Args)]
-pub struct RenderArgs {
-    #[command(flatten)]
-    pub scene: SceneArgs,
-    #[command(flatten)]
-    pub solve: SolveOptions,
-    /// Output PNG (default: cornell.png for the built-in box, else the scene's name).
-    #[arg(short, long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
-    /// Shading.
-    #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
-    pub shading: ShadingArg,
+pub struct ToneArgs {
     /// Gamma: displayed = value^(1/gamma) (paper 2.7).
     #[arg(long, default_value_t = 2.2)]
     pub gamma: f64,
@@ -197,6 +188,12 @@ pub struct RenderArgs {
     /// normalisation), a number multiplies radiosities by it.
     #[arg(long, default_value = "auto", value_parser = parse_exposure)]
     pub exposure: Exposure,
+}
+
+/// Where the camera is and the size of its image: the flags `render` and `pathtrace`
+/// share, so that a render and a path trace of one scene line up pixel for pixel.
+#[derive(Args)]
+pub struct CameraArgs {
     /// Eye position "x,y,z" (default: the scene's camera, or one that frames the scene).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
     pub eye: Option<DVec3>,
@@ -210,11 +207,29 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
     pub fov: Option<f64>,
     /// Image width in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub width: u32,
     /// Image height in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub height: u32,
+}
+
+#[derive(Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveOptions,
+    /// Output PNG (default: cornell.png for the built-in box, else the scene's name).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Shading.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
+    pub shading: ShadingArg,
+    #[command(flatten)]
+    pub tone: ToneArgs,
+    #[command(flatten)]
+    pub camera: CameraArgs,
     /// Rays per pixel along each axis: 2 or more antialiases edges (N^2 times the rays).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub supersample: u32,
@@ -225,6 +240,70 @@ pub struct RenderArgs {
     /// Progressive: shots between snapshots.
     #[arg(long, default_value_t = 10, value_name = "N")]
     pub snapshot_every: usize,
+}
+
+#[derive(Args)]
+pub struct PathTraceArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveOptions,
+    #[command(flatten)]
+    pub tone: ToneArgs,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Output PNG of the path-traced view (default: <scene>-pathtrace.png). With --compare
+    /// the radiosity render and the error map go beside it, as <output>-radiosity.png and
+    /// <output>-error.png.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Paths per pixel (at least 2, for a standard error): the noise falls as 1/sqrt(N).
+    #[arg(long, default_value_t = 256, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
+    pub paths: u32,
+    /// Seed of the paths: the same seed gives the same image, bit for bit, on any number of
+    /// threads. (--seed is the Monte Carlo form factors' seed.)
+    #[arg(long, default_value_t = 1, value_name = "S")]
+    pub path_seed: u64,
+    /// The most diffuse reflections a path may make (Russian roulette ends almost all paths
+    /// long before).
+    #[arg(long, default_value_t = 256, value_name = "N")]
+    pub max_bounces: u32,
+    /// Russian roulette starts after this many reflections (unbiased for any value).
+    #[arg(long, default_value_t = 3, value_name = "N")]
+    pub roulette_after: u32,
+    /// No light sampling (next-event estimation): the plain path tracer, which finds a light
+    /// only by bouncing into it; far noisier under small lights.
+    #[arg(long)]
+    pub no_light_sampling: bool,
+    /// Also solve the scene by radiosity (with the solve flags, as `render`), render it with
+    /// the same camera, and print the pixel RMS, bias and largest difference of its
+    /// luminance from the path-traced view's (pixels that show an emitter left out) beside
+    /// the path tracer's own noise. Both images are written with one exposure (auto: the
+    /// radiosity solution's). The meshing, form-factor and solver flags (--max-area,
+    /// --steps, --method, --solver, ...) act on this solve only; the path tracer traces the
+    /// scene's polygons.
+    #[arg(long)]
+    pub compare: bool,
+    /// --compare: the radiosity render's shading.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
+    pub shading: ShadingArg,
+    /// --compare: rays per pixel along each axis of the radiosity render (the path tracer
+    /// averages over the whole pixel, so one ray through the centre would count edge
+    /// aliasing as error).
+    #[arg(long, default_value_t = 4, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub supersample: u32,
+    /// --compare: the relative error that saturates the error map's colours (blue: the
+    /// radiosity render is darker, red: brighter).
+    #[arg(long, default_value_t = 0.2, value_name = "FRACTION", value_parser = parse_positive)]
+    pub error_scale: f64,
+    /// Write the path-traced view (linear radiosity, standard errors, the emitter mask, the
+    /// camera and settings) to this OpenEXR file, to be read back with --reference.
+    #[arg(long, value_name = "FILE.exr", conflicts_with = "reference")]
+    pub save_reference: Option<PathBuf>,
+    /// Read the path-traced view from this file (written by --save-reference) instead of
+    /// tracing it; refused if it was traced from another scene, camera or image size.
+    #[arg(long, value_name = "FILE.exr")]
+    pub reference: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -409,6 +488,14 @@ pub fn parse_exposure(text: &str) -> Result<Exposure, String> {
     match text.parse::<f64>() {
         Ok(s) if s > 0.0 && s.is_finite() => Ok(Exposure::Fixed(s)),
         _ => Err("expected \"auto\" or a positive number".into()),
+    }
+}
+
+/// A positive finite number.
+pub fn parse_positive(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
+        _ => Err("expected a positive number".into()),
     }
 }
 

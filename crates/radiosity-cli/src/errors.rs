@@ -2,7 +2,9 @@
 //! hint in this program's own commands and flags that the library cannot give.
 
 use radiosity::form_factor::{FormFactorFileError, FormFactorMethod, OutOfMemory};
+use radiosity::io::path_traced_file::PathTracedFileError;
 use radiosity::pipeline::PipelineError;
+use radiosity::render::Camera;
 use radiosity::scene;
 use radiosity::solve::SolveError;
 
@@ -80,7 +82,37 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
             _ => None,
         };
     }
+    if let Some(e) = err.downcast_ref::<PathTracedFileError>() {
+        const RETRACE: &str = "; trace a new reference with --save-reference";
+        return match e {
+            PathTracedFileError::Size { found, .. } => Some(format!(
+                "{RETRACE}, or use the size it was traced at (--width {} --height {})",
+                found.0, found.1
+            )),
+            PathTracedFileError::Camera { found, .. } => Some(format!(
+                "{RETRACE}, or use the camera it was traced with ({})",
+                camera_flags(found)
+            )),
+            PathTracedFileError::Scene { .. } => Some(format!("{RETRACE} for this scene")),
+            PathTracedFileError::NotPathTraced { .. } | PathTracedFileError::NotExr { .. } => {
+                Some("; write one with `radiosity pathtrace --save-reference FILE.exr`".into())
+            }
+            _ => None,
+        };
+    }
     err.downcast_ref::<OutOfMemory>().map(|_| MEMORY.into())
+}
+
+/// The flags that give `camera`: `--eye x,y,z --look-at x,y,z --up x,y,z --fov F`.
+fn camera_flags(camera: &Camera) -> String {
+    let v = |v: glam::DVec3| format!("{},{},{}", v.x, v.y, v.z);
+    format!(
+        "--eye {} --look-at {} --up {} --fov {}",
+        v(camera.eye),
+        v(camera.look_at),
+        v(camera.up),
+        camera.fov_y_degrees
+    )
 }
 
 /// The flags that select `method`: `--method contour --steps 4`.

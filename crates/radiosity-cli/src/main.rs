@@ -21,8 +21,8 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 use args::{
-    BenchArgs, CheckArgs, CompareArgs, FormFactorArgs, GenerateCommand, RenderArgs, SolveArgs,
-    ViewArgs,
+    BenchArgs, CheckArgs, CompareArgs, FormFactorArgs, GenerateCommand, PathTraceArgs, RenderArgs,
+    SolveArgs, ViewArgs,
 };
 use errors::describe;
 
@@ -56,6 +56,10 @@ enum Command {
     /// area k = 2, use --method contour --steps 4) on the same mesh; print time, peak memory
     /// and the difference of element radiosity as a Markdown table row.
     Compare(CompareArgs),
+    /// Path trace a scene (an unbiased Monte Carlo render of the same polygons and camera,
+    /// no form factors) to a PNG image and print its noise; with --compare, also render the
+    /// radiosity solution and print its pixel difference from the path-traced view.
+    Pathtrace(PathTraceArgs),
     /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
     View(ViewArgs),
     /// Generate a scene file procedurally.
@@ -84,6 +88,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Check(args) => commands::check::run(args),
         Command::Bench(args) => commands::bench::run(args),
         Command::Compare(args) => commands::compare::run(args),
+        Command::Pathtrace(args) => commands::pathtrace::run(args),
         Command::View(args) => commands::view::run(args),
         Command::Generate {
             what: GenerateCommand::Building(args),

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use radiosity::pathtrace::{FilmComparison, PathTraceSettings, PathTraced};
 use radiosity::pipeline::{FormFactorStats, Prepared, Solution, SolutionReport};
 use radiosity::scene::{BuildingParams, Scene};
 use radiosity::solve::{Solver, SolverKind};
@@ -303,4 +304,53 @@ pub fn building(output: &Path, params: &BuildingParams, built: &Scene, elements:
         params.max_patch_area,
         elements
     );
+}
+
+/// Prints how a path-traced view was made and its noise: the RMS over the pixels that show
+/// no emitter of the standard error of luminance, relative to their mean luminance.
+pub fn path_traced(view: &PathTraced, settings: &PathTraceSettings) {
+    let noise = view.noise();
+    let pixels = view.width() * view.height();
+    outln!(
+        "paths             {} a pixel, seed {}, at most {} bounces, roulette after {}, light sampling {}",
+        view.samples_per_pixel(),
+        settings.seed,
+        settings.max_bounces,
+        settings.roulette_after_bounces,
+        if settings.next_event_estimation { "on" } else { "off" }
+    );
+    outln!(
+        "noise             {:.2} % (RMS standard error of luminance over the mean luminance \
+         {:.4e}; mean standard error {:.4e}; {} pixels, {} showing an emitter left out)",
+        100.0 * noise.relative(),
+        noise.mean_luminance,
+        noise.mean_standard_error,
+        noise.pixels,
+        pixels - noise.pixels
+    );
+}
+
+/// Prints a radiosity render's difference from the path-traced view: RMS, mean and largest
+/// difference of pixel luminance, and the path tracer's own noise on the same scale, all
+/// relative to the path-traced view's RMS luminance.
+pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
+    outln!(
+        "compared          the radiosity render ({elements} elements) with the path-traced \
+         view on luminance: {} pixels ({} showing an emitter left out), relative to the \
+         path tracer's RMS luminance {:.4e}",
+        c.pixels,
+        c.excluded,
+        c.reference_rms_luminance
+    );
+    outln!("rms               {:.2} %", 100.0 * c.rms);
+    outln!("bias              {:+.2} %", 100.0 * c.bias);
+    outln!("max               {:.2} %", 100.0 * c.max);
+    if let Some(noise) = c.reference_noise {
+        outln!(
+            "reference noise   {:.2} % (the path tracer's RMS standard error: the rms a render \
+             equal to the true image would show)",
+            100.0 * noise
+        );
+        outln!("rms less noise    {:.2} %", 100.0 * c.rms_less_noise());
+    }
 }

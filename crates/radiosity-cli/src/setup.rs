@@ -12,7 +12,9 @@ use radiosity::render::{Camera, RenderSettings, Shading};
 use radiosity::scene::{self, Scene, SceneFile};
 use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
 
-use crate::args::{MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions};
+use crate::args::{
+    CameraArgs, MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions, ToneArgs,
+};
 use crate::progress_bar::Reporter;
 
 /// The scene (from its file or built in), meshed for the form-factor method of `args`,
@@ -100,7 +102,9 @@ fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
     ));
 }
 
-fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(SceneFile, String)> {
+/// The scene file at `path`, or the built-in Cornell box, with a short name for default
+/// outputs ("cornell", or the file's stem).
+pub fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(SceneFile, String)> {
     match path {
         None => Ok((
             run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
@@ -193,7 +197,32 @@ fn solver(
 }
 
 pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
-    if let Some(out) = &args.output {
+    check_png(args.output.as_deref())?;
+    image_size(&args.camera)?;
+    let gamma = gamma(&args.tone)?;
+    if args.supersample == 0 || args.supersample > 16 {
+        bail!("--supersample must be between 1 and 16");
+    }
+    Ok(RenderSettings {
+        shading: shading(args.shading),
+        gamma,
+        supersample: args.supersample,
+        ..RenderSettings::default()
+    })
+}
+
+/// The library's shading for `--shading`.
+pub fn shading(arg: ShadingArg) -> Shading {
+    match arg {
+        ShadingArg::Smooth => Shading::Smooth,
+        ShadingArg::Flat => Shading::Flat,
+        ShadingArg::Wireframe => Shading::Wireframe,
+    }
+}
+
+/// Refuses an output image that is not named *.png.
+pub fn check_png(output: Option<&Path>) -> Result<()> {
+    if let Some(out) = output {
         let png = out
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("png"));
@@ -204,6 +233,19 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
             );
         }
     }
+    Ok(())
+}
+
+/// `--gamma`, checked.
+pub fn gamma(args: &ToneArgs) -> Result<f64> {
+    if !(args.gamma > 0.0 && args.gamma.is_finite()) {
+        bail!("--gamma must be a positive number, got {}", args.gamma);
+    }
+    Ok(args.gamma)
+}
+
+/// Refuses an image with no pixels or more than 100 megapixels.
+fn image_size(args: &CameraArgs) -> Result<()> {
     if args.width == 0 || args.height == 0 {
         bail!("--width and --height must be at least 1");
     }
@@ -214,26 +256,13 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
             args.height
         );
     }
-    if !(args.gamma > 0.0 && args.gamma.is_finite()) {
-        bail!("--gamma must be a positive number, got {}", args.gamma);
-    }
-    if args.supersample == 0 || args.supersample > 16 {
-        bail!("--supersample must be between 1 and 16");
-    }
-    let shading = match args.shading {
-        ShadingArg::Smooth => Shading::Smooth,
-        ShadingArg::Flat => Shading::Flat,
-        ShadingArg::Wireframe => Shading::Wireframe,
-    };
-    Ok(RenderSettings {
-        shading,
-        gamma: args.gamma,
-        supersample: args.supersample,
-        ..RenderSettings::default()
-    })
+    Ok(())
 }
 
-pub fn camera(args: &RenderArgs, scene: &Scene) -> Result<Camera> {
+/// The camera the flags ask for: the scene's (or one that frames it) at `--width` x
+/// `--height`, with `--eye`, `--look-at`, `--up` and `--fov` put in.
+pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
+    image_size(args)?;
     let mut camera = Camera::for_scene(scene, args.width, args.height);
     if let Some(eye) = args.eye {
         camera.eye = eye;

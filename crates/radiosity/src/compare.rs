@@ -4,14 +4,15 @@
 //! solution cannot be compared with a dense solve index by index. [`compare`] projects the
 //! other solution onto each reference element: the area-weighted mean of the other
 //! solution at the element's 4 x 4 integration points (at each, the element of the other
-//! mesh that contains it, found by a ray along the surface normal through a BVH of the
-//! other mesh). Both sides are then area averages over the same element, so an element that
+//! mesh that contains it, found in a BVH of the other mesh's elements of the same input
+//! surface, so that a coplanar surface lying on it cannot hide it). Both sides are then area averages over the same element, so an element that
 //! straddles a shadow edge is compared with the same straddling average, not with whichever
 //! side its centroid falls on. Differences are reported relative to the reference's
 //! *reflected* radiosity B - E: the part a solver computes (the emitters' E would otherwise
 //! dominate the norms and hide the error).
 #![allow(clippy::needless_range_loop)] // bands read best as indices
 
+use glam::DVec3;
 use thiserror::Error;
 
 use crate::light::Rgb;
@@ -86,42 +87,105 @@ pub fn compare(
 
 /// `other` (on `other_mesh`) averaged over each element of `reference_mesh`: the
 /// area-weighted mean at the element's 4 x 4 integration points of the other mesh's
-/// element under each point (found by a ray along the surface normal through a BVH of the
-/// other mesh).
+/// element under each point. Each point is looked up among the other mesh's elements of
+/// its own input surface only (a BVH per surface, [`PolygonBvh::polygon_at`]), so a
+/// surface that lies on it or touches it (a rug on a floor, the bottom of a box standing
+/// on it, coplanar with it) cannot hide the element it lies on. A reference element whose
+/// 16 points all lie on one element of the other mesh takes that element's value exactly,
+/// so a solution compared with itself differs by exactly zero.
 pub fn project(
     reference_mesh: &Mesh,
     other_mesh: &Mesh,
     other: &Radiosity,
 ) -> Result<Radiosity, CompareError> {
-    let bvh = PolygonBvh::over_elements(other_mesh);
-    let delta = 1e-6 * bvh.scale();
+    let surfaces = SurfaceIndex::new(other_mesh);
+    // A point is on an element when within this distance of its plane: far above
+    // rounding, far below any element's size.
+    let delta = 1e-6 * surfaces.scale;
     let mut out = Vec::with_capacity(reference_mesh.len());
     let mut points = Vec::new();
     for (i, el) in reference_mesh.elements.iter().enumerate() {
+        let not_covered = CompareError::NotCovered {
+            element: i,
+            surface: el.surface,
+        };
+        let Some(bvh) = surfaces.of(el.surface) else {
+            return Err(not_covered);
+        };
         points.clear();
         reference_mesh.integration_points(i, 4, &mut points);
         let mut projected = [0.0; 3];
+        let mut single = Some(None);
         for &(x, w) in &points {
-            // The other mesh's element under x (a ray down the normal, from just in front);
-            // a point on an edge of the other mesh is nudged towards the centroid.
-            let found = [0.0, 1e-6, 1e-4].iter().find_map(|&nudge| {
-                let c = x + nudge * (el.centroid - x);
-                bvh.closest_hit(c + delta * el.normal, -el.normal, 0.0, 2.0 * delta)
-                    .filter(|h| other_mesh.elements[h.id as usize].surface == el.surface)
-            });
+            // The other mesh's element of this surface at x; a point on an outer edge of the
+            // surface, which rounding can put just outside it, is nudged towards the
+            // element's centroid.
+            let found = [0.0, 1e-6, 1e-4]
+                .iter()
+                .find_map(|&nudge| bvh.polygon_at(x + nudge * (el.centroid - x), delta));
             let Some(hit) = found else {
-                return Err(CompareError::NotCovered {
-                    element: i,
-                    surface: el.surface,
-                });
+                return Err(not_covered);
+            };
+            single = match single {
+                Some(None) => Some(Some(hit)),
+                Some(Some(id)) if id == hit => single,
+                _ => None,
             };
             for k in 0..3 {
-                projected[k] += w * other.0[hit.id as usize][k];
+                projected[k] += w * other.0[hit as usize][k];
             }
         }
-        out.push(Rgb(projected.map(|p| p / el.area)));
+        out.push(match single {
+            Some(Some(id)) => other.0[id as usize],
+            _ => Rgb(projected.map(|p| p / el.area)),
+        });
     }
     Ok(Radiosity(out))
+}
+
+/// A mesh's elements in one BVH per input surface, each element tagged with its index in
+/// the mesh.
+struct SurfaceIndex {
+    /// Per surface, its elements' BVH (`None` for a surface without elements).
+    bvhs: Vec<Option<PolygonBvh>>,
+    /// The length of the bounding-box diagonal of the whole mesh.
+    scale: f64,
+}
+
+impl SurfaceIndex {
+    fn new(mesh: &Mesh) -> SurfaceIndex {
+        let bvhs = mesh
+            .surface_elements
+            .iter()
+            .map(|range| {
+                if range.is_empty() {
+                    return None;
+                }
+                let polygons: Vec<Vec<DVec3>> = range
+                    .clone()
+                    .map(|e| mesh.corner_positions(e as usize).collect())
+                    .collect();
+                let ids: Vec<u32> = range.clone().collect();
+                Some(PolygonBvh::new(&polygons, &ids))
+            })
+            .collect();
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for v in &mesh.vertices {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        let scale = if mesh.vertices.is_empty() {
+            1.0
+        } else {
+            (hi - lo).length().max(f64::MIN_POSITIVE)
+        };
+        SurfaceIndex { bvhs, scale }
+    }
+
+    /// The BVH of surface `surface`'s elements, if it has any.
+    fn of(&self, surface: u32) -> Option<&PolygonBvh> {
+        self.bvhs.get(surface as usize).and_then(Option::as_ref)
+    }
 }
 
 #[cfg(test)]

@@ -24,6 +24,8 @@ pub enum Stage {
     Shade,
     /// Rendering the image (work unit: one image row).
     Render,
+    /// Path tracing a view (work unit: one image row), see [`crate::pathtrace`].
+    PathTrace,
     /// Writing output files.
     Write,
 }
@@ -39,6 +41,7 @@ impl Stage {
             Stage::Solve => "solve",
             Stage::Shade => "shade",
             Stage::Render => "render",
+            Stage::PathTrace => "path trace",
             Stage::Write => "write",
         }
     }

@@ -6,6 +6,7 @@ pub mod check;
 pub mod compare;
 pub mod formfactors;
 pub mod generate;
+pub mod pathtrace;
 pub mod render;
 pub mod solve;
 pub mod view;

@@ -23,8 +23,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if args.snapshots.is_some() && solver.needs_matrix() {
         bail!("--snapshots needs --solver progressive");
     }
-    let camera = camera(&args, &prepared.scene)?;
-    let exposure = args.exposure;
+    let camera = camera(&args.camera, &prepared.scene)?;
+    let exposure = args.tone.exposure;
     if let Some(dir) = &args.snapshots {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }

@@ -4,4 +4,5 @@
 mod fixtures;
 
 mod commands;
+mod pathtrace;
 mod view;

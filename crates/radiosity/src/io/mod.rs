@@ -5,6 +5,8 @@
 //! * [`scene_file`]: the paper's Appendix A scene format, reader and writer.
 //! * [`form_factor_file`]: the form-factor matrix, written once and read back (paper 2.8).
 //! * [`solution`]: the per-element solution as CSV or JSON, for scripts.
+//! * [`path_traced_file`]: a path-traced view (means, standard errors, emitter mask, the
+//!   camera and settings) as OpenEXR, so that a reference is traced once.
 //! * [`png`]: rendered images as PNG files.
 //! * [`write_atomically`]: how every writer here replaces a file, so that a reader sees the
 //!   old file or the whole new one, never half of one.
@@ -14,6 +16,7 @@
 
 mod atomic_write;
 pub mod form_factor_file;
+pub mod path_traced_file;
 pub mod png;
 pub mod scene_file;
 pub mod solution;

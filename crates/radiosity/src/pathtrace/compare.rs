@@ -12,7 +12,9 @@ use thiserror::Error;
 
 use super::estimate::PathTraced;
 use crate::light::Rgb;
-use crate::render::{Film, FilmContent};
+use crate::progress::NoProgress;
+use crate::render::{Camera, Film, FilmContent, Renderer, Shading};
+use crate::scene::Scene;
 
 /// The false-colour scale [`ErrorMap::to_image`] falls back to: 20 % of the reference's
 /// RMS luminance saturates.
@@ -249,17 +251,70 @@ impl PathTraced {
     /// ([`PathTraced::emitter_mask`]), and reports this view's own noise
     /// ([`FilmComparison::reference_noise`]).
     pub fn compare(&self, other: &Film) -> Result<FilmComparison, FilmCompareError> {
-        let mut c = compare_films(self.film(), other, self.emitter_mask())?;
+        self.compare_excluding(other, &vec![false; self.emitter_mask().len()])
+    }
+
+    /// [`PathTraced::compare`], leaving out also the pixels where `exclude` (one entry per
+    /// pixel, row by row) is true: for example those where the other view shows an emitter
+    /// ([`emitter_pixels`]), which few paths a pixel can miss on a pixel the light's edge
+    /// crosses, and whose emission would then count as the other view's error.
+    pub fn compare_excluding(
+        &self,
+        other: &Film,
+        exclude: &[bool],
+    ) -> Result<FilmComparison, FilmCompareError> {
+        let pixels = self.emitter_mask().len();
+        if exclude.len() != pixels {
+            return Err(FilmCompareError::Mask {
+                mask: exclude.len(),
+                pixels,
+            });
+        }
+        let mask: Vec<bool> = self
+            .emitter_mask()
+            .iter()
+            .zip(exclude)
+            .map(|(&a, &b)| a || b)
+            .collect();
+        let mut c = compare_films(self.film(), other, &mask)?;
         let squares: f64 = self
             .luminance_standard_errors()
             .iter()
-            .zip(self.emitter_mask())
+            .zip(&mask)
             .filter(|(_, &e)| !e)
             .map(|(s, _)| s * s)
             .sum();
         c.reference_noise = Some((squares / c.pixels as f64).sqrt() / c.reference_rms_luminance);
         Ok(c)
     }
+}
+
+/// The pixels of `camera`'s view in which any of the `supersample` x `supersample` rays of
+/// the radiosity renderer (over `renderer`'s mesh, cut from `scene`) first hits an element
+/// of an emitting surface: the renderer's own emitter mask, one entry per pixel, row by row.
+pub fn emitter_pixels(
+    renderer: &Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    supersample: u32,
+) -> Vec<bool> {
+    let mesh = renderer.mesh();
+    let emits: Vec<[f64; 3]> = mesh
+        .elements
+        .iter()
+        .map(|e| {
+            let lit = scene
+                .surfaces
+                .get(e.surface as usize)
+                .is_some_and(|s| s.emission.max_band() > 0.0);
+            [if lit { 1.0 } else { 0.0 }; 3]
+        })
+        .collect();
+    let film = renderer.film(camera, &emits, &[], Shading::Flat, supersample, &NoProgress);
+    film.samples()
+        .chunks_exact(film.samples_per_pixel().max(1))
+        .map(|s| s.iter().any(|v| v[0] > 0.0))
+        .collect()
 }
 
 #[cfg(test)]

@@ -129,6 +129,37 @@ impl PathTraced {
         }
     }
 
+    /// A view from its parts, as a file reader finds them ([`crate::io::path_traced_file`]):
+    /// a film of one sample a pixel, and per pixel (row by row) the standard error per band
+    /// and on luminance and whether it shows an emitter.
+    ///
+    /// # Panics
+    /// If the film has more than one sample a pixel or is not radiosity, or a list does not
+    /// have one entry per pixel.
+    pub(crate) fn from_parts(
+        film: Film,
+        standard_error: Vec<Rgb>,
+        luminance_standard_error: Vec<f64>,
+        shows_emitter: Vec<bool>,
+        samples_per_pixel: u32,
+    ) -> PathTraced {
+        let pixels = film.width() * film.height();
+        assert!(film.samples_per_pixel() == 1 && film.content() == FilmContent::Radiosity);
+        assert!(
+            standard_error.len() == pixels
+                && luminance_standard_error.len() == pixels
+                && shows_emitter.len() == pixels,
+            "one entry per pixel"
+        );
+        PathTraced {
+            film,
+            standard_error,
+            luminance_standard_error,
+            shows_emitter,
+            samples_per_pixel,
+        }
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> usize {
         self.film.width()

@@ -31,7 +31,9 @@
 //! * `estimate`: the result, [`PathTraced`]: the film of pixel means, each mean's standard
 //!   error (per band and on luminance), and the mask of pixels that show an emitter.
 //! * `compare`: two films compared on luminance ([`compare_films`],
-//!   [`PathTraced::compare`]) and the per-pixel error in false colour ([`ErrorMap`]).
+//!   [`PathTraced::compare`], [`PathTraced::compare_excluding`] with the radiosity
+//!   renderer's own [`emitter_pixels`]) and the per-pixel error in false colour
+//!   ([`ErrorMap`]).
 //!
 //! ```
 //! use radiosity::pathtrace::{self, PathTraceSettings};
@@ -59,7 +61,7 @@ mod tests;
 mod view;
 
 pub use compare::{
-    compare_films, false_colour, ErrorMap, FilmCompareError, FilmComparison,
+    compare_films, emitter_pixels, false_colour, ErrorMap, FilmCompareError, FilmComparison,
     DEFAULT_ERROR_FULL_SCALE,
 };
 pub use estimate::{NoiseSummary, PathTraced};

@@ -346,7 +346,7 @@ fn progress_is_one_unit_a_row() {
     struct Count(AtomicU64, AtomicU64);
     impl Progress for Count {
         fn start(&self, stage: Stage, total: u64) {
-            assert_eq!(stage, Stage::Render);
+            assert_eq!(stage, Stage::PathTrace);
             self.0.store(total, Ordering::SeqCst);
         }
         fn advance(&self, done: u64) {
@@ -451,6 +451,44 @@ fn a_view_compared_with_itself_and_its_noise() {
     assert_eq!(noise.pixels, c.pixels);
     let expected = noise.rms_standard_error / c.reference_rms_luminance;
     assert!((c.reference_noise.unwrap() - expected).abs() < 1e-12);
+}
+
+#[test]
+fn the_renderers_emitter_pixels_are_left_out_too() {
+    // From halfway between the squares, a 60 degree view straight up sees only the light
+    // (its corner rays reach z = 1 at 0.41 from the axis, inside the half-width 0.5), and
+    // straight down only the receiver: the renderer's mask is every pixel, then none.
+    let s = receiver_under_light();
+    let mesh = crate::mesh::mesh_scene(&s, 0.25).unwrap();
+    let renderer = crate::render::Renderer::new(&mesh);
+    let eye = dvec3(0.0, 0.0, 0.5);
+    let up = camera(eye, dvec3(0.0, 0.0, 1.0), 60.0, 8);
+    let down = camera(eye, dvec3(0.0, 0.0, 0.0), 60.0, 8);
+    assert_eq!(emitter_pixels(&renderer, &s, &up, 2), vec![true; 64]);
+    assert_eq!(emitter_pixels(&renderer, &s, &down, 3), vec![false; 64]);
+    // compare_excluding leaves out the union of its mask and the path tracer's own.
+    let view = path_trace(
+        &s,
+        &camera(eye, dvec3(1.0, 0.0, 0.5), 120.0, 8),
+        &PathTraceSettings::DEFAULT.with_samples(4),
+        &NoProgress,
+    )
+    .unwrap();
+    let own = view.emitter_mask().iter().filter(|&&e| e).count();
+    assert!(own > 0 && own < 63, "{own}");
+    let mut mask = vec![false; 64];
+    let extra = view.emitter_mask().iter().position(|&e| !e).unwrap();
+    mask[extra] = true;
+    let c = view.compare_excluding(view.film(), &mask).unwrap();
+    assert_eq!((c.excluded, c.pixels), (own + 1, 63 - own));
+    assert_eq!(view.compare(view.film()).unwrap().excluded, own);
+    assert!(matches!(
+        view.compare_excluding(view.film(), &mask[..10]),
+        Err(FilmCompareError::Mask {
+            mask: 10,
+            pixels: 64
+        })
+    ));
 }
 
 /// What a path-traced Cornell box costs, and how far the radiosity renderer's view of it

@@ -15,7 +15,7 @@ impl PathTracer {
     /// The view of `camera`: `settings.samples_per_pixel` paths a pixel, pixel p (row by row
     /// from the top-left corner) drawing from a generator seeded from (`settings.seed`, p)
     /// alone, so the result is the same bit for bit on any number of threads. Rows are
-    /// traced in parallel and reported as [`Stage::Render`], one `advance(1)` a row.
+    /// traced in parallel and reported as [`Stage::PathTrace`], one `advance(1)` a row.
     ///
     /// Refuses settings with fewer than two samples a pixel, and a camera whose eye, target
     /// or up is not finite or whose field of view is not in (0, 180) degrees. An image with
@@ -33,7 +33,7 @@ impl PathTracer {
         if w == 0 || h == 0 {
             return Ok(PathTraced::from_pixels(w, h, n, &[]));
         }
-        let rows: Vec<Vec<PixelEstimate>> = run_stage(progress, Stage::Render, h as u64, || {
+        let rows: Vec<Vec<PixelEstimate>> = run_stage(progress, Stage::PathTrace, h as u64, || {
             (0..h)
                 .into_par_iter()
                 .map(|y| {

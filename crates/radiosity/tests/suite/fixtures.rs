@@ -9,7 +9,7 @@ use radiosity::form_factor::{
 use radiosity::mesh::{mesh_scene, Mesh};
 use radiosity::pipeline::{self, Overrides, Prepared, Solution, SolveRequest};
 use radiosity::progress::NoProgress;
-use radiosity::scene::{cornell_box, Rgb, Scene, Surface};
+use radiosity::scene::{cornell_box, Rgb, Scene, SceneFile, Surface};
 use radiosity::solve::{keep_going, Solver};
 use radiosity::visibility::PolygonBvh;
 
@@ -124,6 +124,13 @@ pub fn dense_gauss_seidel(prepared: &Prepared) -> Solution {
         &NoProgress,
     )
     .unwrap()
+}
+
+/// The scene of `contact.scene`: a floor with a rug lying in its plane, a block standing on
+/// the floor against the back wall, a stool standing on the rug and a light panel above
+/// (surfaces that lie on or touch others, their faces coplanar), MAX_PATCH_AREA 0.1 m^2.
+pub fn contact_scene() -> SceneFile {
+    radiosity::io::scene_file::parse_scene(include_str!("contact.scene"), "contact.scene").unwrap()
 }
 
 // ----- the fixtures' own checks -----

@@ -3,6 +3,7 @@
 
 mod fixtures;
 
+mod compare;
 mod form_factors;
 mod hierarchical;
 mod methods_on_examples;

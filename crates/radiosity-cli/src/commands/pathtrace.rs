@@ -1,0 +1,198 @@
+//! `radiosity pathtrace`: the path-traced view of a scene, the yardstick of the radiosity
+//! chain; with `--compare`, the radiosity render of the same camera beside it, their pixel
+//! difference and an error map; `--save-reference` / `--reference` keep an expensive view
+//! in an OpenEXR file.
+
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use radiosity::io::path_traced_file::{read_path_traced, write_path_traced};
+use radiosity::pathtrace::{emitter_pixels, path_trace, PathTraceSettings};
+use radiosity::progress::{run_stage, Stage};
+use radiosity::render::{self, tonemap, Renderer, Shading};
+use radiosity::scene::Scene;
+use radiosity::shade::{self, Exposure};
+
+use super::solve_scene;
+use crate::args::PathTraceArgs;
+use crate::progress_bar::Reporter;
+use crate::report;
+use crate::setup::{self, camera, check_png, gamma, load_scene, prepare_solve};
+
+pub fn run(args: PathTraceArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    check_png(args.output.as_deref())?;
+    let gamma = gamma(&args.tone)?;
+    let settings = PathTraceSettings {
+        samples_per_pixel: args.paths,
+        max_bounces: args.max_bounces,
+        roulette_after_bounces: args.roulette_after,
+        next_event_estimation: !args.no_light_sampling,
+        seed: args.path_seed,
+    };
+    settings.check()?;
+    let shading = setup::shading(args.shading);
+    if args.compare && shading == Shading::Wireframe {
+        bail!("--compare needs --shading smooth or flat: a wireframe has no radiosity to compare");
+    }
+    if let Some(path) = &args.save_reference {
+        check_exr(path)?;
+    }
+
+    // The scene: meshed and with its solver for --compare, as it is for the path tracer.
+    let prepared = if args.compare {
+        Some(prepare_solve(&args.scene, &args.solve, &reporter)?)
+    } else {
+        None
+    };
+    let loaded;
+    let (scene, stem): (&Scene, &str) = match &prepared {
+        Some((p, stem, _)) => (&p.scene, stem),
+        None => {
+            loaded = load_scene(args.scene.scene.as_deref(), &reporter)?;
+            (&loaded.0.scene, &loaded.1)
+        }
+    };
+    let camera = camera(&args.camera, scene)?;
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}-pathtrace.png")));
+
+    // The path-traced view: traced, or read back.
+    let (view, settings) = match &args.reference {
+        Some(path) => {
+            let saved = run_stage(&reporter, Stage::Parse, 0, || {
+                read_path_traced(path, &camera, scene)
+            })?;
+            reporter.note(&format!(
+                "reference read from {} ({} paths a pixel, seed {})",
+                path.display(),
+                saved.settings.samples_per_pixel,
+                saved.settings.seed
+            ));
+            (saved.view, saved.settings)
+        }
+        None => {
+            let start = std::time::Instant::now();
+            let view = path_trace(scene, &camera, &settings, &reporter)?;
+            let seconds = start.elapsed().as_secs_f64();
+            reporter.note(&format!(
+                "path traced {} x {} at {} paths a pixel in {:.2} s ({:.2} M paths/s)",
+                camera.width,
+                camera.height,
+                settings.samples_per_pixel,
+                seconds,
+                (camera.width as f64 * camera.height as f64 * settings.samples_per_pixel as f64)
+                    / seconds.max(1e-9)
+                    / 1e6
+            ));
+            (view, settings)
+        }
+    };
+    if let Some(path) = &args.save_reference {
+        run_stage(&reporter, Stage::Write, 0, || {
+            write_path_traced(path, &view, &camera, &settings, scene)
+        })?;
+        reporter.note(&format!("wrote the reference to {}", path.display()));
+    }
+    report::path_traced(&view, &settings);
+
+    let Some((prepared, _, solver)) = &prepared else {
+        // Alone: the view's own exposure unless one is given.
+        let scale = match args.tone.exposure {
+            Exposure::Fixed(s) => s,
+            Exposure::Brightest => view.brightest_scale(),
+        };
+        reporter.note(&format!(
+            "exposure scale {scale} (`render --exposure {scale}` shows a render with it)"
+        ));
+        write_image(
+            &tonemap::to_image(view.film(), scale, gamma),
+            &output,
+            &reporter,
+        )?;
+        reporter.print_timings();
+        return Ok(());
+    };
+
+    // --compare: the radiosity render of the same camera, with the same exposure.
+    let (solution, _) = solve_scene(
+        prepared,
+        *solver,
+        args.solve.form_factors.as_deref(),
+        &mut |_| ControlFlow::Continue(()),
+        &reporter,
+    )?;
+    let b = solution.element_rgb();
+    let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
+        shade::vertex_radiosity(&solution.mesh, b)
+    });
+    let renderer = Renderer::new(&solution.mesh);
+    let film = renderer.film(&camera, b, &vertex_b, shading, args.supersample, &reporter);
+    // Pixels that show an emitter in either view are left out: few paths can miss a
+    // light's edge that the renderer's grid of rays meets.
+    let emitters = emitter_pixels(&renderer, scene, &camera, args.supersample);
+    let comparison = view.compare_excluding(&film, &emitters)?;
+    let scale = args.tone.exposure.scale(scene, &solution.mesh, b);
+    report::path_trace_comparison(&comparison, solution.mesh.len());
+    let radiosity_png = sibling(&output, "radiosity");
+    let error_png = sibling(&output, "error");
+    write_image(
+        &tonemap::to_image(view.film(), scale, gamma),
+        &output,
+        &reporter,
+    )?;
+    write_image(
+        &tonemap::to_image(&film, scale, gamma),
+        &radiosity_png,
+        &reporter,
+    )?;
+    write_image(
+        &comparison.error_map.to_image(args.error_scale),
+        &error_png,
+        &reporter,
+    )?;
+    reporter.note(&format!(
+        "exposure scale {scale} for both; error map: white 0, blue darker and red brighter \
+         than the path tracer, full colour at {} % of its RMS luminance, black left out",
+        100.0 * args.error_scale
+    ));
+    reporter.print_timings();
+    Ok(())
+}
+
+/// `out.png` -> `out-<suffix>.png`, beside it.
+fn sibling(output: &Path, suffix: &str) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map_or("pathtrace".into(), |s| s.to_string_lossy().into_owned());
+    output.with_file_name(format!("{stem}-{suffix}.png"))
+}
+
+/// Refuses a reference file not named *.exr.
+fn check_exr(path: &Path) -> Result<()> {
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        bail!(
+            "{}: references are OpenEXR files; give it an .exr name",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+fn write_image(image: &image::RgbImage, path: &Path, reporter: &Reporter) -> Result<()> {
+    run_stage(reporter, Stage::Write, 0, || render::write_png(image, path))
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    reporter.note(&format!(
+        "wrote {} ({} x {})",
+        path.display(),
+        image.width(),
+        image.height()
+    ));
+    Ok(())
+}

@@ -1,0 +1,226 @@
+//! `radiosity pathtrace`: the path-traced view, its comparison with the radiosity render,
+//! and the saved reference, on the built-in Cornell box at a few pixels and paths.
+
+use std::path::Path;
+use std::process::Output;
+
+use crate::fixtures::{radiosity, scratch_dir, stderr, stdout};
+
+/// The value of the stdout line that starts with `name` (its first word after it, a
+/// percentage's number).
+fn value(out: &Output, name: &str) -> f64 {
+    let text = stdout(out);
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(name))
+        .unwrap_or_else(|| panic!("no `{name}` line in:\n{text}"));
+    line[name.len()..]
+        .split_whitespace()
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number in `{line}`"))
+}
+
+fn rgb(dir: &Path, name: &str) -> image::RgbImage {
+    image::open(dir.join(name)).unwrap().to_rgb8()
+}
+
+#[test]
+fn path_trace_writes_the_view_and_its_noise_and_repeats_itself_for_a_seed() {
+    let dir = scratch_dir("pathtrace");
+    let run = |seed: &str, out: &str| {
+        let o = radiosity(
+            &[
+                "pathtrace",
+                "--width",
+                "12",
+                "--height",
+                "10",
+                "--paths",
+                "4",
+                "--path-seed",
+                seed,
+                "-o",
+                out,
+            ],
+            &dir,
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        o
+    };
+    let out = run("1", "a.png");
+    let img = rgb(&dir, "a.png");
+    assert_eq!(img.dimensions(), (12, 10));
+    // The red wall on the left, the green on the right (the Cornell camera; the outer
+    // columns look past the box).
+    let (left, right) = (img.get_pixel(2, 5), img.get_pixel(9, 5));
+    assert!(
+        left[0] > left[1] && right[1] > right[0],
+        "{left:?} {right:?}"
+    );
+    let noise = value(&out, "noise");
+    assert!(noise > 0.0 && noise < 100.0, "{}", stdout(&out));
+    assert!(
+        stdout(&out).contains("4 a pixel, seed 1"),
+        "{}",
+        stdout(&out)
+    );
+    assert!(stderr(&out).contains("path trace"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("timings:"), "{}", stderr(&out));
+    // The same seed, the same bytes; another seed, another image.
+    run("1", "b.png");
+    run("2", "c.png");
+    let read = |n: &str| std::fs::read(dir.join(n)).unwrap();
+    assert_eq!(read("a.png"), read("b.png"));
+    assert_ne!(rgb(&dir, "a.png"), rgb(&dir, "c.png"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_prints_the_rms_and_lines_up_with_render() {
+    let dir = scratch_dir("pathtrace-compare");
+    let size = ["--width", "16", "--height", "16", "--max-area", "20000"];
+    let pt = |extra: &[&str]| {
+        let mut args = vec!["pathtrace", "--compare", "--paths", "16", "-o", "pt.png"];
+        args.extend_from_slice(&size);
+        args.extend_from_slice(extra);
+        let out = radiosity(&args, &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        out
+    };
+    let out = pt(&["--save-reference", "ref.exr"]);
+    let rms = value(&out, "rms ");
+    let noise = value(&out, "reference noise");
+    // A coarse mesh (about 130 elements) against 16 paths a pixel: tens of per cent at
+    // most, and never zero (the two renderers share no code but the camera).
+    assert!(rms > 0.0 && rms < 50.0, "{}", stdout(&out));
+    assert!(noise > 0.0 && noise < rms * 2.0, "{}", stdout(&out));
+    assert!(stdout(&out).contains("showing an emitter left out"));
+    for name in ["pt.png", "pt-radiosity.png", "pt-error.png"] {
+        assert_eq!(rgb(&dir, name).dimensions(), (16, 16), "{name}");
+    }
+    // The radiosity image is what `render` makes of the same camera, 4 x 4 rays a pixel,
+    // auto exposure: pixel for pixel.
+    let mut args = vec!["render", "--supersample", "4", "-o", "render.png", "-q"];
+    args.extend_from_slice(&size);
+    let r = radiosity(&args, &dir);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert_eq!(rgb(&dir, "render.png"), rgb(&dir, "pt-radiosity.png"));
+
+    // The reference read back gives the same comparison, to the digits printed.
+    let again = pt(&["--reference", "ref.exr"]);
+    for line in ["rms ", "bias", "max", "reference noise"] {
+        assert_eq!(value(&again, line), value(&out, line), "{line}");
+    }
+    assert!(stderr(&again).contains("reference read from ref.exr (16 paths a pixel, seed 1)"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_saved_reference_round_trips_and_refuses_another_view() {
+    let dir = scratch_dir("pathtrace-reference");
+    let run_at = |width: &str, extra: &[&str]| {
+        let mut args = vec![
+            "pathtrace",
+            "--paths",
+            "8",
+            "--exposure",
+            "0.02",
+            "--height",
+            "8",
+        ];
+        args.extend_from_slice(&["--width", width]);
+        args.extend_from_slice(extra);
+        radiosity(&args, &dir)
+    };
+    let run = |extra: &[&str]| run_at("10", extra);
+    let traced = run(&["--save-reference", "ref.exr", "-o", "a.png"]);
+    assert!(traced.status.success(), "{}", stderr(&traced));
+    let read = run(&["--reference", "ref.exr", "-o", "b.png"]);
+    assert!(read.status.success(), "{}", stderr(&read));
+    assert_eq!(value(&read, "noise"), value(&traced, "noise"));
+    // The stored view is rounded to 32-bit floats: at most one 8-bit level apart.
+    let (a, b) = (rgb(&dir, "a.png"), rgb(&dir, "b.png"));
+    let worst = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| x.abs_diff(*y))
+        .max();
+    assert!(worst <= Some(1), "{worst:?}");
+
+    // Another size or camera is refused, naming the file and both views.
+    let wider = run_at("11", &["--reference", "ref.exr"]);
+    assert_eq!(wider.status.code(), Some(1));
+    let text = stderr(&wider);
+    assert!(
+        text.contains("ref.exr holds a 10 x 8 view, not the 11 x 8 asked for")
+            && text.contains("--width 10 --height 8"),
+        "{text}"
+    );
+    let moved = run(&["--reference", "ref.exr", "--eye", "278,273,-700"]);
+    let text = stderr(&moved);
+    assert!(!moved.status.success());
+    assert!(
+        text.contains("ref.exr was traced from another camera")
+            && text.contains("eye [278, 273, -700]")
+            && text.contains("--eye 278,273,-800"),
+        "{text}"
+    );
+    // Not a reference at all.
+    std::fs::write(dir.join("junk.exr"), b"junk").unwrap();
+    let junk = run(&["--reference", "junk.exr"]);
+    assert!(
+        stderr(&junk).contains("junk.exr is not a readable OpenEXR file"),
+        "{}",
+        stderr(&junk)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_flags_exit_2_with_what_was_expected() {
+    let dir = scratch_dir("pathtrace-args");
+    for (args, needle) in [
+        (vec!["pathtrace", "--paths", "0"], "--paths"),
+        (vec!["pathtrace", "--paths", "1"], "2.."),
+        (vec!["pathtrace", "--width", "0"], "--width"),
+        (vec!["pathtrace", "--supersample", "0"], "--supersample"),
+        (vec!["pathtrace", "--error-scale", "0"], "positive number"),
+        (vec!["pathtrace", "--eye", "1,2"], "three numbers"),
+        (
+            vec![
+                "pathtrace",
+                "--reference",
+                "a.exr",
+                "--save-reference",
+                "b.exr",
+            ],
+            "cannot be used with",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    // Checked after parsing: exit 1, and the message says what to give.
+    for (args, needle) in [
+        (
+            vec!["pathtrace", "--compare", "--shading", "wireframe"],
+            "--shading smooth or flat",
+        ),
+        (
+            vec!["pathtrace", "-o", "view.jpg"],
+            "give the output a .png name",
+        ),
+        (
+            vec!["pathtrace", "--save-reference", "ref.png"],
+            "give it an .exr name",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
