@@ -12,7 +12,7 @@ use radiosity::render::{Camera, RenderSettings, Shading};
 use radiosity::scene::{self, Scene};
 use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
 
-use crate::args::{MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions};
+use crate::args::{DirectLightArg, MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions};
 use crate::progress_bar::Reporter;
 
 /// The scene (from its file or built in), meshed for the form-factor method of `args`,
@@ -223,10 +223,18 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
         ShadingArg::Flat => Shading::Flat,
         ShadingArg::Wireframe => Shading::Wireframe,
     };
+    if !(args.adaptive_contrast >= 0.0 && args.adaptive_contrast.is_finite()) {
+        bail!(
+            "--adaptive-contrast must be a fraction of at least 0, got {}",
+            args.adaptive_contrast
+        );
+    }
     Ok(RenderSettings {
         shading,
         gamma: args.gamma,
         supersample: args.supersample,
+        adaptive_contrast: (args.adaptive_contrast > 0.0).then_some(args.adaptive_contrast),
+        direct_light: args.direct_light == DirectLightArg::Gather,
         ..RenderSettings::default()
     })
 }
