@@ -178,6 +178,16 @@ pub enum ShadingArg {
     Wireframe,
 }
 
+/// Where smooth shading takes the direct light from.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DirectLightArg {
+    /// Gathered at every ray's hit point from the emitters (Lambert's exact form factor and
+    /// shadow rays); the mesh gives only the indirect light: sharp shadows and contact lines.
+    Gather,
+    /// Interpolated from the mesh with the rest of the light (the paper's smooth shading).
+    Mesh,
+}
+
 /// Exposure and gamma: the flags `render` and `pathtrace` share.
 #[derive(Args)]
 pub struct ToneArgs {
@@ -230,9 +240,18 @@ pub struct RenderArgs {
     pub tone: ToneArgs,
     #[command(flatten)]
     pub camera: CameraArgs,
-    /// Rays per pixel along each axis: 2 or more antialiases edges (N^2 times the rays).
-    #[arg(long, default_value_t = 1, value_name = "N")]
+    /// Rays per pixel along each axis, at most: 2 or more antialiases edges. An even N above
+    /// 2 is adaptive (see --adaptive-contrast); 1 casts one ray through each pixel centre.
+    #[arg(long, default_value_t = 8, value_name = "N")]
     pub supersample: u32,
+    /// Adaptive antialiasing: a pixel gets all N x N rays only where its first four see
+    /// different surfaces or luminances apart by more than this fraction of the brightest;
+    /// elsewhere four rays. 0 casts all N x N everywhere.
+    #[arg(long, default_value_t = 0.02, value_name = "FRACTION")]
+    pub adaptive_contrast: f64,
+    /// Smooth shading's direct light: gathered per ray, or from the mesh.
+    #[arg(long, value_enum, default_value_t = DirectLightArg::Gather)]
+    pub direct_light: DirectLightArg,
     /// Progressive: write the picture as it converges to DIR/shot-00010.png and so on, every
     /// --snapshot-every shots (with the ambient term added for display).
     #[arg(long, value_name = "DIR")]
@@ -287,11 +306,17 @@ pub struct PathTraceArgs {
     /// --compare: the radiosity render's shading.
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
-    /// --compare: rays per pixel along each axis of the radiosity render (the path tracer
-    /// averages over the whole pixel, so one ray through the centre would count edge
-    /// aliasing as error).
-    #[arg(long, default_value_t = 4, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
+    /// --compare: rays per pixel along each axis of the radiosity render, at most, as for
+    /// `render` (the path tracer averages over the whole pixel, so one ray through the
+    /// centre would count edge aliasing as error).
+    #[arg(long, default_value_t = 8, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
     pub supersample: u32,
+    /// --compare: adaptive antialiasing of the radiosity render, as for `render`.
+    #[arg(long, default_value_t = 0.02, value_name = "FRACTION")]
+    pub adaptive_contrast: f64,
+    /// --compare: the radiosity render's direct light, as for `render`.
+    #[arg(long, value_enum, default_value_t = DirectLightArg::Gather)]
+    pub direct_light: DirectLightArg,
     /// --compare: the relative error that saturates the error map's colours (blue: the
     /// radiosity render is darker, red: brighter).
     #[arg(long, default_value_t = 0.2, value_name = "FRACTION", value_parser = parse_positive)]

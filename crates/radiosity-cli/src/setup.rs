@@ -13,7 +13,8 @@ use radiosity::scene::{self, Scene, SceneFile};
 use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
 
 use crate::args::{
-    CameraArgs, MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions, ToneArgs,
+    CameraArgs, DirectLightArg, MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions,
+    ToneArgs,
 };
 use crate::progress_bar::Reporter;
 
@@ -203,10 +204,18 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     if args.supersample == 0 || args.supersample > 16 {
         bail!("--supersample must be between 1 and 16");
     }
+    if !(args.adaptive_contrast >= 0.0 && args.adaptive_contrast.is_finite()) {
+        bail!(
+            "--adaptive-contrast must be a fraction of at least 0, got {}",
+            args.adaptive_contrast
+        );
+    }
     Ok(RenderSettings {
         shading: shading(args.shading),
         gamma,
         supersample: args.supersample,
+        adaptive_contrast: (args.adaptive_contrast > 0.0).then_some(args.adaptive_contrast),
+        direct_light: args.direct_light == DirectLightArg::Gather,
         ..RenderSettings::default()
     })
 }

@@ -83,6 +83,6 @@ pub fn shade_and_render(
         exposure_scale: scale,
         ..settings
     };
-    let renderer = Renderer::new(mesh);
+    let renderer = Renderer::for_settings(mesh, &prepared.scene, &settings);
     radiosity::render::render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
 }

@@ -80,6 +80,7 @@ fn offscreen_cornell_box_matches_the_cpu_render() {
                 exposure_scale: scale,
                 gamma: 2.2,
                 supersample: 1,
+                ..RenderSettings::default()
             },
             &NoProgress,
         );

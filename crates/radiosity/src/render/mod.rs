@@ -25,6 +25,7 @@ use crate::progress::{run_stage, Progress, Stage};
 use tonemap::ToneMap;
 
 mod camera;
+mod direct;
 mod film;
 mod renderer;
 #[cfg(test)]
@@ -32,6 +33,7 @@ mod test_support;
 pub mod tonemap;
 
 pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
+pub use direct::{DirectCorrection, DirectLight, COARSE_RAYS};
 pub use film::{sample_offset, Film, FilmContent};
 pub use renderer::{barycentric, inverse_bilinear, Renderer, Shading};
 
@@ -52,16 +54,23 @@ pub struct RenderSettings {
     /// (averaged before gamma). 1 (the default) casts one ray through the pixel centre;
     /// 0 is treated as 1.
     pub supersample: u32,
+    /// Adaptive antialiasing's contrast threshold (see [`Renderer::with_adaptive_sampling`]);
+    /// `None` casts every pixel's full grid.
+    pub adaptive_contrast: Option<f64>,
+    /// Smooth shading gathers the direct light per ray (see [`Renderer::with_direct_light`]).
+    pub direct_light: bool,
 }
 
 impl Default for RenderSettings {
-    /// Smooth shading, exposure 1, gamma 2.2, no supersampling.
+    /// Smooth shading from the mesh alone, exposure 1, gamma 2.2, no supersampling.
     fn default() -> Self {
         RenderSettings {
             shading: Shading::Smooth,
             exposure_scale: 1.0,
             gamma: 2.2,
             supersample: 1,
+            adaptive_contrast: None,
+            direct_light: false,
         }
     }
 }
@@ -209,6 +218,7 @@ mod tests {
                 exposure_scale: 0.7,
                 gamma: 1.8,
                 supersample: 8,
+                ..RenderSettings::default()
             };
             let img = render(&r, &cam, &eb, &vb, &settings, &NoProgress);
             let film = r.film(&cam, &eb, &vb, shading, 8, &NoProgress);

@@ -24,10 +24,12 @@ use std::ops::Range;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::direct::DirectCorrection;
 use super::film::{sample_offset, Film, FilmContent};
 use super::Camera;
 use crate::mesh::Mesh;
 use crate::progress::{run_stage, Progress, Stage};
+use crate::scene::Scene;
 use crate::visibility::PolygonBvh;
 
 /// How the hit element is coloured.
@@ -52,6 +54,11 @@ pub struct Renderer<'m> {
     /// Per element, bit i set when edge i (corner i to corner i + 1) is on the boundary of
     /// its surface (no other element shares it).
     boundary_edges: Vec<u8>,
+    /// Smooth shading's direct light gathered per ray, when asked for
+    /// ([`Renderer::with_direct_light`]).
+    direct: Option<DirectCorrection<'m>>,
+    /// Adaptive antialiasing's contrast threshold, when on ([`Renderer::with_adaptive_sampling`]).
+    adaptive: Option<f64>,
 }
 
 impl<'m> Renderer<'m> {
@@ -88,12 +95,57 @@ impl<'m> Renderer<'m> {
             bvh: PolygonBvh::over_elements(mesh),
             bounds: (lo, hi),
             boundary_edges,
+            direct: None,
+            adaptive: None,
         }
+    }
+
+    /// The renderer of `mesh` (cut from `scene`) that `settings` ask for: with the direct
+    /// light gathered and adaptive antialiasing when they say so.
+    pub fn for_settings(
+        mesh: &'m Mesh,
+        scene: &Scene,
+        settings: &super::RenderSettings,
+    ) -> Renderer<'m> {
+        let mut renderer = Renderer::new(mesh);
+        if settings.direct_light {
+            renderer = renderer.with_direct_light(scene);
+        }
+        if let Some(contrast) = settings.adaptive_contrast {
+            renderer = renderer.with_adaptive_sampling(contrast);
+        }
+        renderer
     }
 
     /// The mesh being rendered.
     pub fn mesh(&self) -> &'m Mesh {
         self.mesh
+    }
+
+    /// Smooth shading from now on gathers the direct light of `scene` (from which the mesh
+    /// was cut) at every ray's hit point, with Lambert's formula and shadow rays, and takes
+    /// only the indirect light's variation from the mesh (see [`DirectCorrection`]).
+    pub fn with_direct_light(mut self, scene: &Scene) -> Renderer<'m> {
+        self.direct = Some(DirectCorrection::new(scene, self.mesh));
+        self
+    }
+
+    /// From now on an even supersampling n > 2 is adaptive: each pixel first casts four
+    /// rays, at the centres of its quadrants, and casts the full n x n grid only when they
+    /// see different surfaces (a silhouette, a miss) or luminances that spread by more than
+    /// `contrast` times the largest of them (a shadow edge); otherwise each of the four
+    /// stands for its quadrant, and the pixel is what plain 2 x 2 supersampling gives
+    /// (Whitted 1980, "An improved illumination model for shaded display", CACM 23, section
+    /// 4's adaptive subdivision of pixels). Wireframe is never adaptive (its lines are
+    /// thinner than a quadrant).
+    pub fn with_adaptive_sampling(mut self, contrast: f64) -> Renderer<'m> {
+        self.adaptive = Some(contrast);
+        self
+    }
+
+    /// True when smooth shading gathers the direct light per ray.
+    pub fn gathers_direct_light(&self) -> bool {
+        self.direct.is_some()
     }
 
     /// The linear film of `camera`'s view, `supersample` x `supersample` rays a pixel (0 is
@@ -165,16 +217,65 @@ impl<'m> Renderer<'m> {
         let mut film = Film::new(camera.width as usize, rows.len(), n, film_content(shading));
         let screen = camera.screen();
         let footprint = camera.pixel_angle();
+        let adaptive = self
+            .adaptive
+            .filter(|_| n > 2 && n % 2 == 0 && shading != Shading::Wireframe);
         film.par_rows_mut().for_each(|(r, row)| {
             let y = rows.start + r;
+            let mut rays_scratch: Vec<[f64; 3]> = Vec::new();
             for (x, pixel) in row.chunks_exact_mut(n * n).enumerate() {
+                let salt = (y * camera.width as usize + x) as u64;
+                let seen = |sx: f64, sy: f64| {
+                    let dir = camera.direction_in(screen, sx, sy);
+                    self.trace(
+                        camera.eye, dir, footprint, element_b, vertex_b, shading, salt,
+                    )
+                };
+                // The grid this pixel gets: n x n, or under adaptive sampling four rays at
+                // the quadrants' centres first and then 2 x 2 (those four), n/2 x n/2 or
+                // n x n as they ask (see `refinement`). A coarser grid's g x g rays each
+                // stand for (n/g)^2 slots, so the pixel's mean is that of the g x g grid.
+                let mut grid = n;
+                let mut coarse = None;
+                if let Some(contrast) = adaptive {
+                    let first: [Seen; 4] = std::array::from_fn(|q| {
+                        let (i, j) = ((q % 2) as f64, (q / 2) as f64);
+                        seen(x as f64 + 0.25 + 0.5 * i, y as f64 + 0.25 + 0.5 * j)
+                    });
+                    grid = match refinement(&first, contrast) {
+                        Refine::No => 2,
+                        Refine::Contrast => (n / 2).max(2),
+                        Refine::Silhouette => n,
+                    };
+                    coarse = Some(first);
+                }
+                let mut rays = [[0.0; 3]; 4];
+                let values: &[[f64; 3]] = match coarse {
+                    Some(first) if grid == 2 => {
+                        for (r, f) in rays.iter_mut().zip(&first) {
+                            *r = f.value;
+                        }
+                        &rays
+                    }
+                    _ => {
+                        for j in 0..grid {
+                            for i in 0..grid {
+                                let sx = x as f64 + sample_offset(i, grid);
+                                let sy = y as f64 + sample_offset(j, grid);
+                                pixel[j * grid + i] = seen(sx, sy).value;
+                            }
+                        }
+                        if grid == n {
+                            continue;
+                        }
+                        rays_scratch.clear();
+                        rays_scratch.extend_from_slice(&pixel[..grid * grid]);
+                        &rays_scratch
+                    }
+                };
                 for j in 0..n {
                     for i in 0..n {
-                        let sx = x as f64 + sample_offset(i, n);
-                        let sy = y as f64 + sample_offset(j, n);
-                        let dir = camera.direction_in(screen, sx, sy);
-                        pixel[j * n + i] =
-                            self.trace(camera.eye, dir, footprint, element_b, vertex_b, shading);
+                        pixel[j * n + i] = values[(j * grid / n) * grid + i * grid / n];
                     }
                 }
             }
@@ -186,7 +287,9 @@ impl<'m> Renderer<'m> {
     /// What the unit ray `eye + t dir` sees: the radiosity of the element it hits first
     /// (flat), the vertex radiosities interpolated there (smooth), or 1 on an element edge
     /// and 0 elsewhere (wireframe); 0 for a miss or the back of an element. `footprint` is
-    /// the angle one pixel subtends (for wireframe lines).
+    /// the angle one pixel subtends (for wireframe lines); `salt` shifts the direct light's
+    /// shadow rays.
+    #[allow(clippy::too_many_arguments)]
     fn trace(
         &self,
         eye: DVec3,
@@ -195,22 +298,23 @@ impl<'m> Renderer<'m> {
         element_b: &[[f64; 3]],
         vertex_b: &[[f64; 3]],
         shading: Shading,
-    ) -> [f64; 3] {
+        salt: u64,
+    ) -> Seen {
         if self.mesh.is_empty() {
-            return [0.0; 3];
+            return Seen::NOTHING;
         }
         let (lo, hi) = self.bounds;
         let t_max = (eye - 0.5 * (lo + hi)).length() + (hi - lo).length() + 1.0;
         let Some(hit) = self.bvh.closest_hit(eye, dir, 0.0, t_max) else {
-            return [0.0; 3];
+            return Seen::NOTHING;
         };
         let e = hit.id as usize;
         let el = &self.mesh.elements[e];
         if el.normal.dot(dir) >= 0.0 {
-            return [0.0; 3]; // the back of a one-sided surface
+            return Seen::NOTHING; // the back of a one-sided surface
         }
         let x = eye + hit.t * dir;
-        match shading {
+        let value = match shading {
             Shading::Flat => element_b[e],
             Shading::Smooth => {
                 // Interpolation weights of the element's corners at x (no allocation: this
@@ -232,6 +336,12 @@ impl<'m> Renderer<'m> {
                     let b = vertex_b[c[i] as usize];
                     for k in 0..3 {
                         sum[k] += w * b[k];
+                    }
+                }
+                if let Some(direct) = &self.direct {
+                    let d = direct.at(e, x, &weights[..c.len()], salt);
+                    for k in 0..3 {
+                        sum[k] = (sum[k] + d[k]).max(0.0);
                     }
                 }
                 sum
@@ -257,7 +367,57 @@ impl<'m> Renderer<'m> {
                     [0.0; 3]
                 }
             }
+        };
+        Seen {
+            value,
+            surface: Some(el.surface),
         }
+    }
+}
+
+/// What one ray saw: its value and the surface it hit (none for a miss or a back face).
+#[derive(Clone, Copy, Debug)]
+struct Seen {
+    value: [f64; 3],
+    surface: Option<u32>,
+}
+
+impl Seen {
+    const NOTHING: Seen = Seen {
+        value: [0.0; 3],
+        surface: None,
+    };
+}
+
+/// What a pixel's four first rays ask for under adaptive sampling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Refine {
+    /// One surface, nearly one value: the four rays are the pixel.
+    No,
+    /// One surface whose light changes within the pixel (a shadow edge): n/2 x n/2 rays.
+    Contrast,
+    /// Different surfaces, or a miss (an edge of an object): the full n x n.
+    Silhouette,
+}
+
+/// Silhouette when the four rays do not all see one surface; contrast when their
+/// luminances spread by more than `contrast` times their largest.
+fn refinement(coarse: &[Seen; 4], contrast: f64) -> Refine {
+    let surface = coarse[0].surface;
+    if coarse.iter().any(|s| s.surface != surface) {
+        return Refine::Silhouette;
+    }
+    let lum = |s: &Seen| crate::light::Rgb(s.value).luminance();
+    let (lo, hi) = coarse
+        .iter()
+        .map(lum)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), l| {
+            (a.min(l), b.max(l))
+        });
+    if hi - lo > contrast * hi.abs() {
+        Refine::Contrast
+    } else {
+        Refine::No
     }
 }
 
@@ -448,6 +608,7 @@ mod tests {
             exposure_scale: 1.0,
             gamma,
             supersample: 1,
+            ..RenderSettings::default()
         };
         let mut cam = Camera {
             eye: dvec3(0., 0., -4.),
@@ -480,6 +641,60 @@ mod tests {
             assert_eq!(flat, smooth);
             assert_eq!(px(&flat, 20, 15), tone_map(b, 1.0, 2.2));
         }
+    }
+
+    #[test]
+    fn adaptive_sampling_refines_edges_only() {
+        // Two flat-shaded quads, red and green, side by side with a gap at x in (256, 300)
+        // that shows nothing: within a quad every pixel is its colour, at their edges the
+        // pixels mix. Adaptive 8 x 8 sampling must give, pixel for pixel, the plain 2 x 2
+        // film inside the quads (where the first four rays agree) and the full 8 x 8 film at
+        // the edges where they see different surfaces or nothing.
+        let s = scene(vec![
+            surface("red", 0.0, facing_minus_z(300., 500., 100., 450., 0.)),
+            surface("green", 0.0, facing_minus_z(56., 256., 100., 450., 0.)),
+        ]);
+        let mesh = mesh_scene(&s, 1e9).unwrap();
+        let eb = vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let cam = cornell_camera(32, 24);
+        let plain = Renderer::new(&mesh);
+        let adaptive = Renderer::new(&mesh).with_adaptive_sampling(0.02);
+        let film = adaptive.film(&cam, &eb, &[], Shading::Flat, 8, &NoProgress);
+        let full = plain.film(&cam, &eb, &[], Shading::Flat, 8, &NoProgress);
+        let quarter = plain.film(&cam, &eb, &[], Shading::Flat, 2, &NoProgress);
+        let mean = |p: &[[f64; 3]]| {
+            let mut m = [0.0; 3];
+            for s in p {
+                for k in 0..3 {
+                    m[k] += s[k] / p.len() as f64;
+                }
+            }
+            m
+        };
+        let (mut edges, mut inside) = (0, 0);
+        for y in 0..24 {
+            for x in 0..32 {
+                let f = full.pixel(x, y);
+                let uniform = f.iter().all(|v| v == &f[0]);
+                let got = mean(film.pixel(x, y));
+                if uniform {
+                    inside += 1;
+                    assert_eq!(got, mean(quarter.pixel(x, y)), "pixel ({x}, {y})");
+                } else {
+                    // An edge: the full grid where the four first rays see it, else (an
+                    // edge that only grazes the pixel) the 2 x 2 one.
+                    let q = mean(quarter.pixel(x, y));
+                    assert!(got == mean(f) || got == q, "edge pixel ({x}, {y})");
+                    if got == mean(f) && got != q {
+                        edges += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            edges > 20 && inside > 300,
+            "{edges} edge and {inside} inside pixels"
+        );
     }
 
     #[test]

@@ -1,0 +1,491 @@
+//! Direct light gathered where the eye looks: the irradiance a point receives straight from
+//! the emitters, computed at the point itself with Lambert's exact point-to-polygon form
+//! factor and shadow rays, instead of read off the mesh.
+//!
+//! A radiosity solution is piecewise constant on its elements, and smooth shading
+//! interpolates it linearly; where the light changes faster than an element (shadow edges,
+//! the lines where a box stands on a floor, the corners where walls meet a lit ceiling) the
+//! interpolation smears it. Most of that fast change is the *direct* part of the light, the
+//! irradiance `D(x) = sum_j E_j F(x -> j) V(x, j)` from the emitters j (exitance E_j, exact
+//! unoccluded form factor F, visible fraction V). So the renderer replaces the mesh's linear
+//! approximation of the direct part by the point's own value, and keeps the mesh for the
+//! rest (the indirect light, which varies slowly):
+//!
+//! ```text
+//! B(x) = B_smooth(x) + rho(x) (D(x) - D_smooth(x))
+//! ```
+//!
+//! where `B_smooth` is the smooth-shaded radiosity and `D_smooth` is the element averages of
+//! D interpolated exactly as B is (the same vertex averaging and the same weights). Where D
+//! is linear across the elements the correction vanishes; an element's average of the
+//! corrected B stays the solver's B_i (up to the interpolation), so the solution's energy
+//! is not changed, only where within the element the light falls. This is the "ray-traced
+//! direct illumination" pass of lighting-design tools (Lightscape; Shirley 1990, "A ray
+//! tracing method for illumination calculation in diffuse-specular scenes", Graphics
+//! Interface 90, which gathers the direct light per pixel and takes the indirect part from
+//! a radiosity pass), and the direct-light half of a final gather (Lischinski, Tampieri and
+//! Greenberg 1993, "Combining hierarchical radiosity and discontinuity meshing", SIGGRAPH 93).
+//!
+//! The visible fraction is estimated with shadow rays to stratified points of the emitter
+//! (each point weighted by its area and the point-to-point kernel cos cos / r^2, so that a
+//! fully visible emitter gives Lambert's exact value and a fully hidden one exactly 0): a
+//! first pass of about [`COARSE_RAYS`] rays, and where they disagree (a penumbra) a finer
+//! pass of four times as many. Each stratum's point is jittered by a hash of a caller's
+//! salt and the stratum (stratified sampling: the strata's errors are independent and
+//! mostly cancel, where one shift for all of them would add up). The renderer salts by
+//! pixel, so that penumbrae show fine noise from pixel to pixel rather than bands, while
+//! the rays within one pixel share their strata (their differences are then the light's,
+//! which adaptive antialiasing looks for, not noise). The result depends on the point and
+//! the salt only, not on threads or order.
+
+use std::sync::OnceLock;
+
+use glam::DVec3;
+
+use crate::form_factor::exact::point_to_polygon;
+use crate::geometry;
+use crate::light::Rgb;
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+use crate::visibility::PolygonBvh;
+
+/// Shadow rays per emitter in the first pass at a point (about: the strata are whole
+/// grids on each of the emitter's triangles).
+pub const COARSE_RAYS: usize = 16;
+
+/// Each element's average direct irradiance is taken over this many x this many points
+/// (see [`Mesh::integration_points`]).
+const ELEMENT_POINTS: u32 = 3;
+
+/// One emitting surface: its polygon, exitance, and how its points are sampled.
+#[derive(Clone, Debug)]
+struct Emitter {
+    polygon: Vec<DVec3>,
+    normal: DVec3,
+    exitance: Rgb,
+    /// Where the strata lie: the quadrilateral's bilinear map, or a fan of triangles.
+    strata: Strata,
+    /// Strata per axis in the coarse pass (the fine pass has twice as many).
+    coarse: usize,
+}
+
+/// The parameter domains that a grid of strata covers.
+#[derive(Clone, Debug)]
+enum Strata {
+    /// A quadrilateral: one grid over its bilinear parameters, weighted by the Jacobian
+    /// (most emitters are rectangles, and one grid across the whole light resolves a shadow
+    /// edge far better than grids on the two halves of a diagonal).
+    Quad([DVec3; 4]),
+    /// A triangle or a polygon of five or more corners: a fan of triangles from corner 0
+    /// with their areas, a grid on each through the area-preserving square-to-triangle map.
+    Fan(Vec<([DVec3; 3], f64)>),
+}
+
+impl Emitter {
+    fn new(surface: &crate::scene::Surface) -> Option<Emitter> {
+        let normal = geometry::polygon_normal(&surface.vertices)?;
+        let v = &surface.vertices;
+        let (strata, domains) = if v.len() == 4 {
+            (Strata::Quad([v[0], v[1], v[2], v[3]]), 1)
+        } else {
+            let triangles: Vec<([DVec3; 3], f64)> = (1..v.len() - 1)
+                .map(|i| {
+                    let t = [v[0], v[i], v[i + 1]];
+                    (t, 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
+                })
+                .filter(|(_, a)| *a > 0.0)
+                .collect();
+            if triangles.is_empty() {
+                return None;
+            }
+            let n = triangles.len();
+            (Strata::Fan(triangles), n)
+        };
+        let per_domain = COARSE_RAYS as f64 / domains as f64;
+        Some(Emitter {
+            polygon: v.clone(),
+            normal,
+            exitance: surface.emission,
+            coarse: per_domain.sqrt().round().max(1.0) as usize,
+            strata,
+        })
+    }
+
+    /// Calls `f(point, area weight)` for the `m` x `m` strata of each domain, each point
+    /// jittered within its stratum by a hash of `salt` and the stratum.
+    fn for_each_point(&self, m: usize, salt: u64, mut f: impl FnMut(DVec3, f64)) {
+        let cell = 1.0 / m as f64;
+        let at = |domain: usize, i: usize, j: usize| {
+            let (a, b) = jitter(salt, (domain * m + j) * m + i);
+            ((i as f64 + a) * cell, (j as f64 + b) * cell)
+        };
+        match &self.strata {
+            Strata::Quad(q) => {
+                for j in 0..m {
+                    for i in 0..m {
+                        let (u, v) = at(0, i, j);
+                        let du = (1.0 - v) * (q[1] - q[0]) + v * (q[2] - q[3]);
+                        let dv = (1.0 - u) * (q[3] - q[0]) + u * (q[2] - q[1]);
+                        f(
+                            crate::mesh::bilinear(q, u, v),
+                            du.cross(dv).length() * cell * cell,
+                        );
+                    }
+                }
+            }
+            Strata::Fan(triangles) => {
+                for (k, (t, area)) in triangles.iter().enumerate() {
+                    for j in 0..m {
+                        for i in 0..m {
+                            let (u1, u2) = at(k, i, j);
+                            // Square to triangle, area-preserving (Shirley 1992, "Nonuniform
+                            // random point sets via warping", Graphics Gems III).
+                            let s = u1.sqrt();
+                            let y = t[0] * (1.0 - s) + t[1] * (s * (1.0 - u2)) + t[2] * (s * u2);
+                            f(y, area * cell * cell);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The kernel-weighted visible fraction of the emitter seen from `x` (normal `n`), with
+    /// `m` x `m` jittered strata per domain (see `for_each_point`): (sum of weight x visibility, sum of
+    /// weights, rays all agreed).
+    fn visible(
+        &self,
+        occluders: &PolygonBvh,
+        x: DVec3,
+        n: DVec3,
+        m: usize,
+        salt: u64,
+    ) -> (f64, f64, bool) {
+        let (mut seen, mut total) = (0.0, 0.0);
+        let (mut any_seen, mut any_hidden) = (false, false);
+        self.for_each_point(m, salt, |y, area| {
+            let d = y - x;
+            let r2 = d.length_squared();
+            let (cx, cy) = (n.dot(d), -self.normal.dot(d));
+            if cx <= 0.0 || cy <= 0.0 || r2 <= 0.0 {
+                return;
+            }
+            let w = area * cx * cy / (r2 * r2);
+            total += w;
+            if occluders.segment_blocked(x, y) {
+                any_hidden = true;
+            } else {
+                any_seen = true;
+                seen += w;
+            }
+        });
+        (seen, total, !(any_seen && any_hidden))
+    }
+}
+
+/// The emitters of a scene and its surfaces as occluders: the direct irradiance at any
+/// point ([`DirectLight::irradiance`]).
+pub struct DirectLight {
+    emitters: Vec<Emitter>,
+    occluders: PolygonBvh,
+}
+
+impl DirectLight {
+    /// The emitters (surfaces with some positive exitance) of `scene`, with its surfaces
+    /// as occluders.
+    pub fn new(scene: &Scene) -> DirectLight {
+        DirectLight {
+            emitters: scene
+                .surfaces
+                .iter()
+                .filter(|s| s.emission.max_band() > 0.0)
+                .filter_map(Emitter::new)
+                .collect(),
+            occluders: PolygonBvh::over_surfaces(scene),
+        }
+    }
+
+    /// True when the scene has no emitter (every irradiance is then 0).
+    pub fn is_empty(&self) -> bool {
+        self.emitters.is_empty()
+    }
+
+    /// The direct irradiance at `x` on a surface with unit front normal `n`:
+    /// `sum_j E_j F(x -> j) V_j`, per band (the quantity that, times rho, is the direct part
+    /// of the reflected radiosity). `salt` jitters the shadow rays' strata.
+    pub fn irradiance(&self, x: DVec3, n: DVec3, salt: u64) -> Rgb {
+        let mut sum = Rgb::default();
+        for e in &self.emitters {
+            let f = point_to_polygon(x, n, &e.polygon);
+            if f <= 0.0 {
+                continue;
+            }
+            let (mut seen, mut total, agreed) = e.visible(&self.occluders, x, n, e.coarse, salt);
+            if !agreed {
+                (seen, total, _) = e.visible(&self.occluders, x, n, 2 * e.coarse, salt ^ FINE_SALT);
+            }
+            // All strata behind the point's plane while Lambert sees a sliver: count it seen.
+            let fraction = if total > 0.0 { seen / total } else { 1.0 };
+            sum += e.exitance * (f * fraction);
+        }
+        sum
+    }
+}
+
+/// Salts the fine pass apart from the coarse one.
+const FINE_SALT: u64 = 0x6a09_e667_f3bc_c909;
+
+/// A point in [0, 1)^2 that depends on `salt` and `stratum` only: the jitter of one stratum.
+fn jitter(salt: u64, stratum: usize) -> (f64, f64) {
+    let a = splitmix(salt ^ splitmix(stratum as u64));
+    let b = splitmix(a);
+    let unit = |h: u64| (h >> 11) as f64 / (1u64 << 53) as f64;
+    (unit(a), unit(b))
+}
+
+/// SplitMix64's output function (Steele, Lea and Flood 2014): a hash, not a generator here.
+fn splitmix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The correction of smooth shading by the direct light at each point (see the module
+/// documentation): `rho(x) (D(x) - D_smooth(x))`, for one mesh of one scene, whatever the
+/// solution. Element averages of D are computed the first time a view needs them, so a
+/// view of a corner of a large mesh costs only the elements it shows.
+pub struct DirectCorrection<'m> {
+    light: DirectLight,
+    mesh: &'m Mesh,
+    /// Reflectance per surface.
+    reflectance: Vec<Rgb>,
+    /// Per vertex, the elements that have it as a corner (CSR offsets and list).
+    vertex_offsets: Vec<u32>,
+    vertex_elements: Vec<u32>,
+    /// Per element, its average direct irradiance, once computed.
+    element_direct: Vec<OnceLock<Rgb>>,
+    /// Per vertex, the area-weighted mean of its elements' averages, once computed.
+    vertex_direct: Vec<OnceLock<Rgb>>,
+}
+
+impl<'m> DirectCorrection<'m> {
+    /// The correction for `mesh`, which was cut from `scene`.
+    pub fn new(scene: &Scene, mesh: &'m Mesh) -> DirectCorrection<'m> {
+        let mut counts = vec![0u32; mesh.vertices.len() + 1];
+        for el in &mesh.elements {
+            for &c in el.corners() {
+                counts[c as usize + 1] += 1;
+            }
+        }
+        for i in 1..counts.len() {
+            counts[i] += counts[i - 1];
+        }
+        let mut fill = counts.clone();
+        let mut list = vec![0u32; counts[mesh.vertices.len()] as usize];
+        for (e, el) in mesh.elements.iter().enumerate() {
+            for &c in el.corners() {
+                list[fill[c as usize] as usize] = e as u32;
+                fill[c as usize] += 1;
+            }
+        }
+        DirectCorrection {
+            light: DirectLight::new(scene),
+            mesh,
+            reflectance: scene.surfaces.iter().map(|s| s.reflectance).collect(),
+            vertex_offsets: counts,
+            vertex_elements: list,
+            element_direct: (0..mesh.len()).map(|_| OnceLock::new()).collect(),
+            vertex_direct: (0..mesh.vertices.len()).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// The average direct irradiance over element `e`.
+    fn element(&self, e: usize) -> Rgb {
+        *self.element_direct[e].get_or_init(|| {
+            let el = &self.mesh.elements[e];
+            let mut points = Vec::with_capacity((ELEMENT_POINTS * ELEMENT_POINTS) as usize);
+            self.mesh.integration_points(e, ELEMENT_POINTS, &mut points);
+            let mut sum = Rgb::default();
+            let mut area = 0.0;
+            for (k, &(x, w)) in points.iter().enumerate() {
+                // Salts of their own, apart from the renderer's pixel salts.
+                let salt = (1 << 63) | (e as u64 * 64 + k as u64);
+                sum += self.light.irradiance(x, el.normal, salt) * w;
+                area += w;
+            }
+            if area > 0.0 {
+                sum * (1.0 / area)
+            } else {
+                Rgb::default()
+            }
+        })
+    }
+
+    /// The area-weighted mean of the element averages around vertex `v` (the rule of
+    /// [`crate::shade::vertex_radiosity`]).
+    fn vertex(&self, v: usize) -> Rgb {
+        *self.vertex_direct[v].get_or_init(|| {
+            let range = self.vertex_offsets[v] as usize..self.vertex_offsets[v + 1] as usize;
+            let mut sum = Rgb::default();
+            let mut weight = 0.0;
+            for &e in &self.vertex_elements[range] {
+                let a = self.mesh.elements[e as usize].area;
+                sum += self.element(e as usize) * a;
+                weight += a;
+            }
+            if weight > 0.0 {
+                sum * (1.0 / weight)
+            } else {
+                Rgb::default()
+            }
+        })
+    }
+
+    /// The correction at `x` on element `e`, whose corners have the interpolation weights
+    /// `weights` (as smooth shading uses them); `salt` jitters the shadow rays' strata (the
+    /// renderer passes the pixel's index).
+    pub fn at(&self, e: usize, x: DVec3, weights: &[f64], salt: u64) -> Rgb {
+        let el = &self.mesh.elements[e];
+        let rho = self.reflectance[el.surface as usize];
+        if rho.max_band() <= 0.0 || self.light.is_empty() {
+            return Rgb::default();
+        }
+        let mut smooth = Rgb::default();
+        for (&c, &w) in el.corners().iter().zip(weights) {
+            smooth += self.vertex(c as usize) * w;
+        }
+        let here = self.light.irradiance(x, el.normal, salt);
+        rho * (here - smooth)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::test_support::{scene, surface};
+    use glam::dvec3;
+    use std::f64::consts::PI;
+
+    /// The square [-1, 1]^2 at height 1 facing down (-z), emitting `e`.
+    fn ceiling_light(e: f64) -> crate::scene::Surface {
+        surface(
+            "light",
+            e,
+            vec![
+                dvec3(-1.0, -1.0, 1.0),
+                dvec3(-1.0, 1.0, 1.0),
+                dvec3(1.0, 1.0, 1.0),
+                dvec3(1.0, -1.0, 1.0),
+            ],
+        )
+    }
+
+    /// Form factor from a point on the axis of a parallel 2 x 2 square at distance 1: four
+    /// corner rectangles X = Y = 1 of the closed form (Howell, catalogue B-3),
+    /// F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))].
+    fn on_axis_form_factor() -> f64 {
+        let s = 2f64.sqrt();
+        4.0 / (2.0 * PI) * 2.0 * (1.0 / s) * (1.0 / s).atan()
+    }
+
+    #[test]
+    fn unoccluded_irradiance_is_lamberts_closed_form() {
+        let light = DirectLight::new(&scene(vec![ceiling_light(3.0)]));
+        let d = light.irradiance(DVec3::ZERO, DVec3::Z, 0);
+        // Every shadow ray is clear, so the result is E F with F from Lambert's formula:
+        // only rounding separates it from the closed form.
+        for k in 0..3 {
+            assert!((d[k] - 3.0 * on_axis_form_factor()).abs() < 1e-12, "{d:?}");
+        }
+        // Facing away, or behind the light: nothing.
+        assert_eq!(light.irradiance(DVec3::ZERO, -DVec3::Z, 0), Rgb::default());
+        assert_eq!(
+            light.irradiance(dvec3(0.0, 0.0, 2.0), DVec3::Z, 0),
+            Rgb::default()
+        );
+    }
+
+    #[test]
+    fn a_blocker_hides_all_or_half_of_the_light() {
+        // A large square at height 0.5 (facing down) hides the whole light: exactly 0.
+        let big = surface(
+            "blocker",
+            0.0,
+            vec![
+                dvec3(-5.0, -5.0, 0.5),
+                dvec3(-5.0, 5.0, 0.5),
+                dvec3(5.0, 5.0, 0.5),
+                dvec3(5.0, -5.0, 0.5),
+            ],
+        );
+        let light = DirectLight::new(&scene(vec![ceiling_light(1.0), big]));
+        assert_eq!(light.irradiance(DVec3::ZERO, DVec3::Z, 7), Rgb::default());
+        // A half-plane x < 0 at height 0.5 hides the half of the light with x < 0, which by
+        // symmetry is half of E F. In a penumbra the light is sampled on an 8 x 8 grid of
+        // its parameters, four columns of strata on each side of the edge; the jitter
+        // within each of the 64 strata moves its kernel weight by up to about 30 % (the
+        // kernel 1 / (1 + r^2)^2 across a stratum a quarter wide), independently, so one
+        // estimate is within about 30 % / sqrt(64) = 4 % of the split (8 %: two standard
+        // errors), and over salts the strata are unbiased in numerator and denominator, so
+        // the mean of 64 salts is within 1 %.
+        let half = surface(
+            "half",
+            0.0,
+            vec![
+                dvec3(-5.0, -5.0, 0.5),
+                dvec3(-5.0, 5.0, 0.5),
+                dvec3(0.0, 5.0, 0.5),
+                dvec3(0.0, -5.0, 0.5),
+            ],
+        );
+        let light = DirectLight::new(&scene(vec![ceiling_light(1.0), half]));
+        let exact = 0.5 * on_axis_form_factor();
+        let mut mean = 0.0;
+        for salt in 0..64 {
+            let d = light.irradiance(DVec3::ZERO, DVec3::Z, salt)[0];
+            assert!(
+                (d / exact - 1.0).abs() < 0.08,
+                "salt {salt}: {d} against {exact}"
+            );
+            mean += d / 64.0;
+        }
+        assert!(
+            (mean / exact - 1.0).abs() < 0.01,
+            "mean {mean} against {exact}"
+        );
+    }
+
+    #[test]
+    fn the_correction_vanishes_where_the_direct_light_is_uniform() {
+        // A floor under a light far larger than it: D is nearly uniform over the floor, so
+        // D(x) and its interpolated element averages agree and the correction is tiny
+        // against D itself.
+        let floor = surface(
+            "floor",
+            0.0,
+            vec![
+                dvec3(-0.1, -0.1, 0.0),
+                dvec3(0.1, -0.1, 0.0),
+                dvec3(0.1, 0.1, 0.0),
+                dvec3(-0.1, 0.1, 0.0),
+            ],
+        );
+        let light = surface(
+            "light",
+            1.0,
+            vec![
+                dvec3(-50.0, -50.0, 1.0),
+                dvec3(-50.0, 50.0, 1.0),
+                dvec3(50.0, 50.0, 1.0),
+                dvec3(50.0, -50.0, 1.0),
+            ],
+        );
+        let s = scene(vec![floor, light]);
+        let mesh = crate::mesh::mesh_scene(&s, 0.01).unwrap();
+        let c = DirectCorrection::new(&s, &mesh);
+        let d = c.at(0, mesh.elements[0].centroid, &[0.25; 4], 0);
+        // D is about 1 (the light nearly fills the hemisphere); rho = 0.5.
+        assert!(d[0].abs() < 1e-3, "{d:?}");
+    }
+}
