@@ -363,22 +363,13 @@ impl<'m> DirectCorrection<'m> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::test_support::{scene, surface};
+    use crate::render::test_support::{facing_minus_z, scene, surface};
     use glam::dvec3;
     use std::f64::consts::PI;
 
     /// The square [-1, 1]^2 at height 1 facing down (-z), emitting `e`.
     fn ceiling_light(e: f64) -> crate::scene::Surface {
-        surface(
-            "light",
-            e,
-            vec![
-                dvec3(-1.0, -1.0, 1.0),
-                dvec3(-1.0, 1.0, 1.0),
-                dvec3(1.0, 1.0, 1.0),
-                dvec3(1.0, -1.0, 1.0),
-            ],
-        )
+        surface("light", e, facing_minus_z(-1.0, 1.0, -1.0, 1.0, 1.0))
     }
 
     /// Form factor from a point on the axis of a parallel 2 x 2 square at distance 1: four
@@ -409,16 +400,7 @@ mod tests {
     #[test]
     fn a_blocker_hides_all_or_half_of_the_light() {
         // A large square at height 0.5 (facing down) hides the whole light: exactly 0.
-        let big = surface(
-            "blocker",
-            0.0,
-            vec![
-                dvec3(-5.0, -5.0, 0.5),
-                dvec3(-5.0, 5.0, 0.5),
-                dvec3(5.0, 5.0, 0.5),
-                dvec3(5.0, -5.0, 0.5),
-            ],
-        );
+        let big = surface("blocker", 0.0, facing_minus_z(-5.0, 5.0, -5.0, 5.0, 0.5));
         let light = DirectLight::new(&scene(vec![ceiling_light(1.0), big]));
         assert_eq!(light.irradiance(DVec3::ZERO, DVec3::Z, 7), Rgb::default());
         // A half-plane x < 0 at height 0.5 hides the half of the light with x < 0, which by
@@ -429,16 +411,7 @@ mod tests {
         // estimate is within about 30 % / sqrt(64) = 4 % of the split (8 %: two standard
         // errors), and over salts the strata are unbiased in numerator and denominator, so
         // the mean of 64 salts is within 1 %.
-        let half = surface(
-            "half",
-            0.0,
-            vec![
-                dvec3(-5.0, -5.0, 0.5),
-                dvec3(-5.0, 5.0, 0.5),
-                dvec3(0.0, 5.0, 0.5),
-                dvec3(0.0, -5.0, 0.5),
-            ],
-        );
+        let half = surface("half", 0.0, facing_minus_z(-5.0, 0.0, -5.0, 5.0, 0.5));
         let light = DirectLight::new(&scene(vec![ceiling_light(1.0), half]));
         let exact = 0.5 * on_axis_form_factor();
         let mut mean = 0.0;
@@ -471,16 +444,7 @@ mod tests {
                 dvec3(-0.1, 0.1, 0.0),
             ],
         );
-        let light = surface(
-            "light",
-            1.0,
-            vec![
-                dvec3(-50.0, -50.0, 1.0),
-                dvec3(-50.0, 50.0, 1.0),
-                dvec3(50.0, 50.0, 1.0),
-                dvec3(50.0, -50.0, 1.0),
-            ],
-        );
+        let light = surface("light", 1.0, facing_minus_z(-50.0, 50.0, -50.0, 50.0, 1.0));
         let s = scene(vec![floor, light]);
         let mesh = crate::mesh::mesh_scene(&s, 0.01).unwrap();
         let c = DirectCorrection::new(&s, &mesh);
