@@ -24,6 +24,7 @@ use image::RgbImage;
 use crate::progress::{run_stage, Progress, Stage};
 use tonemap::ToneMap;
 
+mod adaptive;
 mod camera;
 mod direct;
 mod film;

@@ -24,6 +24,7 @@ use std::ops::Range;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::adaptive::{refinement, Refine, Seen};
 use super::direct::DirectCorrection;
 use super::film::{sample_offset, Film, FilmContent};
 use super::Camera;
@@ -372,52 +373,6 @@ impl<'m> Renderer<'m> {
             value,
             surface: Some(el.surface),
         }
-    }
-}
-
-/// What one ray saw: its value and the surface it hit (none for a miss or a back face).
-#[derive(Clone, Copy, Debug)]
-struct Seen {
-    value: [f64; 3],
-    surface: Option<u32>,
-}
-
-impl Seen {
-    const NOTHING: Seen = Seen {
-        value: [0.0; 3],
-        surface: None,
-    };
-}
-
-/// What a pixel's four first rays ask for under adaptive sampling.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Refine {
-    /// One surface, nearly one value: the four rays are the pixel.
-    No,
-    /// One surface whose light changes within the pixel (a shadow edge): n/2 x n/2 rays.
-    Contrast,
-    /// Different surfaces, or a miss (an edge of an object): the full n x n.
-    Silhouette,
-}
-
-/// Silhouette when the four rays do not all see one surface; contrast when their
-/// luminances spread by more than `contrast` times their largest.
-fn refinement(coarse: &[Seen; 4], contrast: f64) -> Refine {
-    let surface = coarse[0].surface;
-    if coarse.iter().any(|s| s.surface != surface) {
-        return Refine::Silhouette;
-    }
-    let lum = |s: &Seen| crate::light::Rgb(s.value).luminance();
-    let (lo, hi) = coarse
-        .iter()
-        .map(lum)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), l| {
-            (a.min(l), b.max(l))
-        });
-    if hi - lo > contrast * hi.abs() {
-        Refine::Contrast
-    } else {
-        Refine::No
     }
 }
 
