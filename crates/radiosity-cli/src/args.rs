@@ -224,6 +224,26 @@ pub struct CameraArgs {
     pub height: u32,
 }
 
+/// How many rays a pixel gets and where smooth shading's direct light comes from: the flags
+/// `render` and `pathtrace --compare` share, so that the comparison judges what `render`
+/// draws. (The path tracer averages over the whole pixel, so one ray through the centre
+/// would count edge aliasing as error.)
+#[derive(Args)]
+pub struct RayArgs {
+    /// Rays per pixel along each axis, at most: 2 or more antialiases edges. An even N above
+    /// 2 is adaptive (see --adaptive-contrast); 1 casts one ray through each pixel centre.
+    #[arg(long, default_value_t = 8, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub supersample: u32,
+    /// Adaptive antialiasing: a pixel gets all N x N rays only where its first four see
+    /// different surfaces or luminances apart by more than this fraction of the brightest;
+    /// elsewhere four rays. 0 casts all N x N everywhere.
+    #[arg(long, default_value_t = 0.02, value_name = "FRACTION", value_parser = parse_fraction)]
+    pub adaptive_contrast: f64,
+    /// Smooth shading's direct light: gathered per ray, or from the mesh.
+    #[arg(long, value_enum, default_value_t = DirectLightArg::Gather)]
+    pub direct_light: DirectLightArg,
+}
+
 #[derive(Args)]
 pub struct RenderArgs {
     #[command(flatten)]
@@ -240,18 +260,8 @@ pub struct RenderArgs {
     pub tone: ToneArgs,
     #[command(flatten)]
     pub camera: CameraArgs,
-    /// Rays per pixel along each axis, at most: 2 or more antialiases edges. An even N above
-    /// 2 is adaptive (see --adaptive-contrast); 1 casts one ray through each pixel centre.
-    #[arg(long, default_value_t = 8, value_name = "N")]
-    pub supersample: u32,
-    /// Adaptive antialiasing: a pixel gets all N x N rays only where its first four see
-    /// different surfaces or luminances apart by more than this fraction of the brightest;
-    /// elsewhere four rays. 0 casts all N x N everywhere.
-    #[arg(long, default_value_t = 0.02, value_name = "FRACTION")]
-    pub adaptive_contrast: f64,
-    /// Smooth shading's direct light: gathered per ray, or from the mesh.
-    #[arg(long, value_enum, default_value_t = DirectLightArg::Gather)]
-    pub direct_light: DirectLightArg,
+    #[command(flatten)]
+    pub rays: RayArgs,
     /// Progressive: write the picture as it converges to DIR/shot-00010.png and so on, every
     /// --snapshot-every shots (with the ambient term added for display).
     #[arg(long, value_name = "DIR")]
@@ -306,17 +316,9 @@ pub struct PathTraceArgs {
     /// --compare: the radiosity render's shading.
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
-    /// --compare: rays per pixel along each axis of the radiosity render, at most, as for
-    /// `render` (the path tracer averages over the whole pixel, so one ray through the
-    /// centre would count edge aliasing as error).
-    #[arg(long, default_value_t = 8, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
-    pub supersample: u32,
-    /// --compare: adaptive antialiasing of the radiosity render, as for `render`.
-    #[arg(long, default_value_t = 0.02, value_name = "FRACTION")]
-    pub adaptive_contrast: f64,
-    /// --compare: the radiosity render's direct light, as for `render`.
-    #[arg(long, value_enum, default_value_t = DirectLightArg::Gather)]
-    pub direct_light: DirectLightArg,
+    /// --compare: the radiosity render's rays, as for `render`.
+    #[command(flatten)]
+    pub rays: RayArgs,
     /// --compare: the relative error that saturates the error map's colours (blue: the
     /// radiosity render is darker, red: brighter).
     #[arg(long, default_value_t = 0.2, value_name = "FRACTION", value_parser = parse_positive)]
@@ -521,6 +523,14 @@ pub fn parse_positive(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
         _ => Err("expected a positive number".into()),
+    }
+}
+
+/// A number of at least 0 (`--adaptive-contrast`).
+pub fn parse_fraction(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x >= 0.0 && x.is_finite() => Ok(x),
+        _ => Err("expected a number of at least 0".into()),
     }
 }
 

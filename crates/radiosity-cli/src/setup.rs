@@ -13,8 +13,8 @@ use radiosity::scene::{self, Scene, SceneFile};
 use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
 
 use crate::args::{
-    CameraArgs, DirectLightArg, MethodArg, RenderArgs, SceneArgs, ShadingArg, SolveOptions,
-    ToneArgs,
+    CameraArgs, DirectLightArg, MethodArg, RayArgs, RenderArgs, SceneArgs, ShadingArg,
+    SolveOptions, ToneArgs,
 };
 use crate::progress_bar::Reporter;
 
@@ -201,23 +201,22 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     check_png(args.output.as_deref())?;
     image_size(&args.camera)?;
     let gamma = gamma(&args.tone)?;
-    if args.supersample == 0 || args.supersample > 16 {
-        bail!("--supersample must be between 1 and 16");
-    }
-    if !(args.adaptive_contrast >= 0.0 && args.adaptive_contrast.is_finite()) {
-        bail!(
-            "--adaptive-contrast must be a fraction of at least 0, got {}",
-            args.adaptive_contrast
-        );
-    }
     Ok(RenderSettings {
-        shading: shading(args.shading),
         gamma,
-        supersample: args.supersample,
-        adaptive_contrast: (args.adaptive_contrast > 0.0).then_some(args.adaptive_contrast),
-        direct_light: args.direct_light == DirectLightArg::Gather,
-        ..RenderSettings::default()
+        ..ray_settings(&args.rays, args.shading)
     })
+}
+
+/// The render settings `--supersample`, `--adaptive-contrast`, `--direct-light` and
+/// `--shading` ask for (exposure and gamma at their defaults).
+pub fn ray_settings(rays: &RayArgs, shading_arg: ShadingArg) -> RenderSettings {
+    RenderSettings {
+        shading: shading(shading_arg),
+        supersample: rays.supersample,
+        adaptive_contrast: (rays.adaptive_contrast > 0.0).then_some(rays.adaptive_contrast),
+        direct_light: rays.direct_light == DirectLightArg::Gather,
+        ..RenderSettings::default()
+    }
 }
 
 /// The library's shading for `--shading`.

@@ -10,12 +10,12 @@ use anyhow::{bail, Context, Result};
 use radiosity::io::path_traced_file::{read_path_traced, write_path_traced};
 use radiosity::pathtrace::{emitter_pixels, path_trace, PathTraceSettings};
 use radiosity::progress::{run_stage, Stage};
-use radiosity::render::{self, tonemap, RenderSettings, Renderer, Shading};
+use radiosity::render::{self, tonemap, Renderer, Shading};
 use radiosity::scene::Scene;
 use radiosity::shade::{self, Exposure};
 
 use super::solve_scene;
-use crate::args::{DirectLightArg, PathTraceArgs};
+use crate::args::PathTraceArgs;
 use crate::progress_bar::Reporter;
 use crate::report;
 use crate::setup::{self, camera, check_png, gamma, load_scene, prepare_solve};
@@ -129,24 +129,19 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
         shade::vertex_radiosity(&solution.mesh, b)
     });
-    if !(args.adaptive_contrast >= 0.0 && args.adaptive_contrast.is_finite()) {
-        bail!(
-            "--adaptive-contrast must be a fraction of at least 0, got {}",
-            args.adaptive_contrast
-        );
-    }
-    let render_settings = RenderSettings {
-        shading,
-        supersample: args.supersample,
-        adaptive_contrast: (args.adaptive_contrast > 0.0).then_some(args.adaptive_contrast),
-        direct_light: args.direct_light == DirectLightArg::Gather,
-        ..RenderSettings::default()
-    };
+    let render_settings = setup::ray_settings(&args.rays, args.shading);
     let renderer = Renderer::for_settings(&solution.mesh, scene, &render_settings);
-    let film = renderer.film(&camera, b, &vertex_b, shading, args.supersample, &reporter);
+    let film = renderer.film(
+        &camera,
+        b,
+        &vertex_b,
+        shading,
+        args.rays.supersample,
+        &reporter,
+    );
     // Pixels that show an emitter in either view are left out: few paths can miss a
     // light's edge that the renderer's grid of rays meets.
-    let emitters = emitter_pixels(&renderer, scene, &camera, args.supersample);
+    let emitters = emitter_pixels(&renderer, scene, &camera, args.rays.supersample);
     let comparison = view.compare_excluding(&film, &emitters)?;
     let scale = args.tone.exposure.scale(scene, &solution.mesh, b);
     report::path_trace_comparison(&comparison, solution.mesh.len());
