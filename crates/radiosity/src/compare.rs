@@ -37,9 +37,10 @@ pub struct Comparison {
 }
 
 /// Why two solutions could not be compared.
-#[derive(Debug, Error, PartialEq)]
+#[derive(Clone, Debug, Error, PartialEq)]
 pub enum CompareError {
-    /// A reference element's centroid lies on no element of the other mesh.
+    /// More of the reference than [`MAX_UNCOVERED`] lies on no element of the other mesh;
+    /// this is the first such element.
     #[error("reference element {element} (surface {surface}) lies on no element of the other mesh: the meshes are not of one scene")]
     NotCovered {
         /// The reference element.
@@ -61,17 +62,23 @@ pub fn compare(
     other_mesh: &Mesh,
     other: &Radiosity,
 ) -> Result<Comparison, CompareError> {
-    let projected = project(reference_mesh, other_mesh, other)?;
+    let Projection {
+        radiosity: projected,
+        covered,
+    } = project(reference_mesh, other_mesh, other)?;
     let (mut num, mut den, mut sum, mut area, mut max) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
-    for (i, el) in reference_mesh.elements.iter().enumerate() {
+    for (i, &a) in covered.iter().enumerate() {
+        if a <= 0.0 {
+            continue;
+        }
         for k in 0..3 {
             let (r, o) = (reference.0[i][k], projected.0[i][k]);
-            num += el.area * (o - r).powi(2);
-            den += el.area * (r - emission[i][k]).powi(2);
-            sum += el.area * (o - r);
+            num += a * (o - r).powi(2);
+            den += a * (r - emission[i][k]).powi(2);
+            sum += a * (o - r);
             max = max.max((o - r).abs());
         }
-        area += el.area;
+        area += a;
     }
     if den <= 0.0 {
         return Err(CompareError::Dark);
@@ -85,6 +92,24 @@ pub fn compare(
     })
 }
 
+/// Another solution averaged over a reference mesh's elements.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Projection {
+    /// Per reference element, the other solution's mean over the part of it that the other
+    /// mesh covers (0 where it covers none of it).
+    pub radiosity: Radiosity,
+    /// Per reference element, the area of it that the other mesh covers (scene units
+    /// squared): all of it, except where contact refinement
+    /// ([`crate::mesh::refine_contacts`]) dropped buried pieces from one mesh that the
+    /// other, refined differently, kept.
+    pub covered: Vec<f64>,
+}
+
+/// The share of a reference's area that may lie on no element of the other mesh before
+/// [`project`] refuses the pair as meshes of different scenes: meshes of one scene differ
+/// only in the buried pieces along contacts, a few per cent of the area.
+const MAX_UNCOVERED: f64 = 0.25;
+
 /// `other` (on `other_mesh`) averaged over each element of `reference_mesh`: the
 /// area-weighted mean at the element's 4 x 4 integration points of the other mesh's
 /// element under each point. Each point is looked up among the other mesh's elements of
@@ -92,17 +117,22 @@ pub fn compare(
 /// surface that lies on it or touches it (a rug on a floor, the bottom of a box standing
 /// on it, coplanar with it) cannot hide the element it lies on. A reference element whose
 /// 16 points all lie on one element of the other mesh takes that element's value exactly,
-/// so a solution compared with itself differs by exactly zero.
+/// so a solution compared with itself differs by exactly zero. Points on no element of the
+/// other mesh (pieces it dropped as buried) are left out of the mean; more than
+/// [`MAX_UNCOVERED`] of the reference's area so left out is refused.
 pub fn project(
     reference_mesh: &Mesh,
     other_mesh: &Mesh,
     other: &Radiosity,
-) -> Result<Radiosity, CompareError> {
+) -> Result<Projection, CompareError> {
     let surfaces = SurfaceIndex::new(other_mesh);
     // A point is on an element when within this distance of its plane: far above
     // rounding, far below any element's size.
     let delta = 1e-6 * surfaces.scale;
     let mut out = Vec::with_capacity(reference_mesh.len());
+    let mut covered = Vec::with_capacity(reference_mesh.len());
+    let mut first_uncovered = None;
+    let mut uncovered_area = 0.0;
     let mut points = Vec::new();
     for (i, el) in reference_mesh.elements.iter().enumerate() {
         let not_covered = CompareError::NotCovered {
@@ -115,6 +145,7 @@ pub fn project(
         points.clear();
         reference_mesh.integration_points(i, 4, &mut points);
         let mut projected = [0.0; 3];
+        let mut weight = 0.0;
         let mut single = Some(None);
         for &(x, w) in &points {
             // The other mesh's element of this surface at x; a point on an outer edge of the
@@ -124,8 +155,12 @@ pub fn project(
                 .iter()
                 .find_map(|&nudge| bvh.polygon_at(x + nudge * (el.centroid - x), delta));
             let Some(hit) = found else {
-                return Err(not_covered);
+                first_uncovered.get_or_insert(not_covered.clone());
+                uncovered_area += w;
+                single = None;
+                continue;
             };
+            weight += w;
             single = match single {
                 Some(None) => Some(Some(hit)),
                 Some(Some(id)) if id == hit => single,
@@ -137,10 +172,18 @@ pub fn project(
         }
         out.push(match single {
             Some(Some(id)) => other.0[id as usize],
-            _ => Rgb(projected.map(|p| p / el.area)),
+            _ if weight > 0.0 => Rgb(projected.map(|p| p / weight)),
+            _ => Rgb::BLACK,
         });
+        covered.push(if single.is_some() { el.area } else { weight });
     }
-    Ok(Radiosity(out))
+    match first_uncovered {
+        Some(e) if uncovered_area > MAX_UNCOVERED * reference_mesh.total_area() => Err(e),
+        _ => Ok(Projection {
+            radiosity: Radiosity(out),
+            covered,
+        }),
+    }
 }
 
 /// A mesh's elements in one BVH per input surface, each element tagged with its index in

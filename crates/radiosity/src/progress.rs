@@ -16,6 +16,8 @@ pub enum Stage {
     Mesh,
     /// Building the ray-query acceleration structure.
     Bvh,
+    /// Splitting the elements that straddle contacts ([`crate::mesh::refine_contacts`]).
+    Contacts,
     /// Computing form factors (work unit: one element pair of the upper triangle).
     FormFactors,
     /// Solving the radiosity system (work unit: one band or one iteration).
@@ -37,6 +39,7 @@ impl Stage {
             Stage::Parse => "parse",
             Stage::Mesh => "mesh",
             Stage::Bvh => "bvh",
+            Stage::Contacts => "contacts",
             Stage::FormFactors => "form factors",
             Stage::Solve => "solve",
             Stage::Shade => "shade",

@@ -85,6 +85,10 @@ fn a_field_of_surface_values_is_the_same_on_any_mesh() {
     let c = compare(&coarse, &field(&coarse), &e, &fine, &field(&fine)).unwrap();
     assert!(c.rms < 1e-12 && c.max < 1e-12, "{c:?}");
     let (coarse_mm, fine_mm) = (in_millimetres(0.1).mesh, in_millimetres(0.1 / 3.0).mesh);
+    // Contact refinement may split a piece at a footprint's edge in one unit and not in the
+    // other (a probe point that lies on the edge is judged by rounding): the meshes need
+    // not have equal counts.
+    let e = vec![Rgb::BLACK; coarse_mm.len()];
     let c = compare(
         &coarse_mm,
         &field(&coarse_mm),

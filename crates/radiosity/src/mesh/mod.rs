@@ -14,6 +14,10 @@
 //! area integral over the elements. They travel beside the [`Scene`], not in it: the scene
 //! is geometry and materials only.
 
+mod contact;
+
+pub use contact::{refine_contacts, ContactReport, CONTACT_DEPTH, PROBE_DIRECTIONS, PROBE_SLACK};
+
 use std::collections::HashMap;
 use std::ops::Range;
 
