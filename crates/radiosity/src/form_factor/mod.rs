@@ -299,7 +299,7 @@ impl<'a> Engine<'a> {
             FormFactorMethod::AreaIntegral { steps } => Engine::Pairs(area::AreaIntegrator::new(
                 ctx,
                 steps,
-                area::PairKernel::Area,
+                area::PairKernel::AreaExactNear,
             )),
             FormFactorMethod::Contour { steps } => Engine::Pairs(area::AreaIntegrator::new(
                 ctx,

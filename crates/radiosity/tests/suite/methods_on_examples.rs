@@ -27,9 +27,10 @@ fn examples() -> Vec<std::path::PathBuf> {
 }
 
 // Bounds on the row sums, from each method's error:
-// - area: first order at shared edges, 0.05/k per perpendicular neighbour (two at a
-//   corner: 0.05 at k = 2), plus the near-contact error of furniture against walls;
-//   measured at most 1.022 in these scenes: bound 1.05.
+// - area: beyond half an element the k x k rule (its error falls as the square of the
+//   distance there); nearer, the exact contour value scaled by a visible fraction from
+//   4 x 4 points a side, which overshoots as contour's does at k = 4 (next item: 1.045
+//   here). Measured at most 1.051 (the room at this coarse mesh): bound 1.06.
 // - contour and analytic: exact geometry, but where an occluder may intervene the exact
 //   value is scaled by a visible fraction estimated from k^2 x k^2 point pairs, and the
 //   unoccluded exact values of a row can sum to well over 1 (they count surfaces hidden
@@ -43,7 +44,7 @@ fn examples() -> Vec<std::path::PathBuf> {
 #[test]
 fn every_method_on_every_example_keeps_rows_at_most_one() {
     let methods = [
-        (FormFactorMethod::AreaIntegral { steps: 2 }, 1.05),
+        (FormFactorMethod::AreaIntegral { steps: 2 }, 1.06),
         (FormFactorMethod::Contour { steps: 4 }, 1.05),
         (FormFactorMethod::Analytic { steps: 4 }, 1.05),
         (FormFactorMethod::Hemicube { resolution: 32 }, 1.0 + 1e-5),
