@@ -44,12 +44,19 @@ pub fn check(
     outln!("elements          {}", solution.mesh.len());
     outln!("total area        {:.6}", solution.mesh.total_area());
     let contacts = &prepared.contacts;
-    outln!(
-        "contacts          {} elements split, {} dropped, {:.6} buried area left out (of the grid's elements)",
-        contacts.split,
-        contacts.dropped,
-        contacts.buried_area
-    );
+    if contacts.skipped {
+        outln!(
+            "contacts          not refined: more than {} elements",
+            radiosity::mesh::CONTACT_MAX_ELEMENTS
+        );
+    } else {
+        outln!(
+            "contacts          {} elements split, {} dropped, {:.6} buried area left out (of the grid's elements)",
+            contacts.split,
+            contacts.dropped,
+            contacts.buried_area
+        );
+    }
     outln!("MAX_PATCH_AREA    {}", prepared.settings.max_patch_area);
     outln!("INTEGRAL_STEPS    {}", prepared.settings.integral_steps);
     outln!("method            {}", prepared.method());

@@ -36,6 +36,12 @@ use crate::visibility::PolygonBvh;
 /// straddling pieces 1/8 of the element across (1/64 of its area).
 pub const CONTACT_DEPTH: u32 = 3;
 
+/// Meshes of more elements than this are left as they are: at that size `--solver auto`
+/// takes hierarchical radiosity, which makes its own leaves and does not use them, and the
+/// probe of a million-element building took minutes on two shared cores. (Progressive
+/// refinement forced onto such a mesh goes without contact refinement; `check` says so.)
+pub const CONTACT_MAX_ELEMENTS: usize = 100_000;
+
 /// Rays probed from a point to decide whether it is buried: along the normal and six
 /// directions at 60 degrees from it, 60 degrees apart around it.
 pub const PROBE_DIRECTIONS: usize = 7;
@@ -60,6 +66,8 @@ pub struct ContactReport {
     pub buried_area: f64,
     /// Elements in the refined mesh.
     pub elements: usize,
+    /// True when the mesh was too large to refine ([`CONTACT_MAX_ELEMENTS`]).
+    pub skipped: bool,
 }
 
 /// How much of a piece of surface is buried.
@@ -79,6 +87,14 @@ pub fn refine_contacts(
     scene: &Scene,
     occluders: &PolygonBvh,
 ) -> (Mesh, ContactReport) {
+    if mesh.len() > CONTACT_MAX_ELEMENTS {
+        let report = ContactReport {
+            elements: mesh.len(),
+            skipped: true,
+            ..ContactReport::default()
+        };
+        return (mesh.clone(), report);
+    }
     let probe = Probe::new(scene, occluders);
     // Per element: None where it stays as it is, else the pieces it becomes.
     let refined: Vec<Option<Vec<Vec<DVec3>>>> = (0..mesh.len())
@@ -231,49 +247,59 @@ impl<'a> Probe<'a> {
         let origin = p + self.lift * n;
         let (t1, t2) = n.any_orthonormal_pair();
         let (sin, cos) = (60f64.to_radians().sin(), 60f64.to_radians().cos());
-        let backs = (0..PROBE_DIRECTIONS).filter(|&i| {
+        // Stop at the first ray past the slack that does not hit a back face: most points
+        // are open, and they cost PROBE_SLACK + 1 rays.
+        let mut misses = 0;
+        (0..PROBE_DIRECTIONS).all(|i| {
             let dir = if i == 0 {
                 n
             } else {
                 let phi = (i - 1) as f64 * std::f64::consts::TAU / (PROBE_DIRECTIONS - 1) as f64;
                 (cos * n + sin * (phi.cos() * t1 + phi.sin() * t2)).normalize()
             };
-            match self.occluders.closest_hit(origin, dir, 0.0, f64::INFINITY) {
+            let back = match self.occluders.closest_hit(origin, dir, 0.0, f64::INFINITY) {
                 Some(hit) => self.normals[hit.id as usize].dot(dir) > 0.0,
                 None => false,
+            };
+            if !back {
+                misses += 1;
             }
-        });
-        backs.count() >= PROBE_DIRECTIONS - PROBE_SLACK
+            misses <= PROBE_SLACK
+        })
     }
 
     /// How much of the piece `corners` (3 or 4 corners) is buried, judged at
     /// its 4 x 4 sample points.
     fn cover(&self, corners: &[DVec3], normal: DVec3) -> Cover {
-        let mut buried = 0;
-        let mut total = 0;
-        let mut count = |p: DVec3| {
-            total += 1;
-            if self.buried(p, normal) {
-                buried += 1;
-            }
-        };
         let k = PROBE_GRID;
+        let mut points = Vec::with_capacity((k * k) as usize);
         if corners.len() == 4 {
             for j in 0..k {
                 for i in 0..k {
                     let (u, v) = ((i as f64 + 0.5) / k as f64, (j as f64 + 0.5) / k as f64);
-                    count(bilinear(corners, u, v));
+                    points.push(bilinear(corners, u, v));
                 }
             }
         } else {
             for_each_subtriangle([corners[0], corners[1], corners[2]], k, |t| {
-                count((t[0] + t[1] + t[2]) / 3.0)
+                points.push((t[0] + t[1] + t[2]) / 3.0)
             });
         }
-        match buried {
-            0 => Cover::Open,
-            b if b == total => Cover::Buried,
-            _ => Cover::Partly,
+        let (mut buried, mut open) = (false, false);
+        for p in points {
+            if self.buried(p, normal) {
+                buried = true;
+            } else {
+                open = true;
+            }
+            if buried && open {
+                return Cover::Partly;
+            }
+        }
+        if buried {
+            Cover::Buried
+        } else {
+            Cover::Open
         }
     }
 

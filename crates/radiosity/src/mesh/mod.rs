@@ -16,7 +16,10 @@
 
 mod contact;
 
-pub use contact::{refine_contacts, ContactReport, CONTACT_DEPTH, PROBE_DIRECTIONS, PROBE_SLACK};
+pub use contact::{
+    refine_contacts, ContactReport, CONTACT_DEPTH, CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS,
+    PROBE_SLACK,
+};
 
 use std::collections::HashMap;
 use std::ops::Range;
