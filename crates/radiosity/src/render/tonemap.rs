@@ -122,7 +122,7 @@ pub fn top_mean(pairs: impl IntoIterator<Item = (f64, f64)>, fraction: f64) -> O
     let largest = pairs.first()?.0;
     let total: f64 = pairs.iter().map(|p| p.1).sum();
     let want = fraction.min(1.0) * total;
-    if !(want > 0.0) {
+    if want <= 0.0 || want.is_nan() {
         return Some(largest);
     }
     // Take the brightest pairs until `want` weight is taken, the last in part.
