@@ -231,11 +231,8 @@ impl ViewerApp {
                 } => {
                     if (edit == 0 && !self.solved) || self.auto_scale.is_none() {
                         if let Some(mesh) = &self.mesh {
-                            self.auto_scale = Some(Exposure::Brightest.scale(
-                                &self.modeller.scene,
-                                mesh,
-                                &element_b,
-                            ));
+                            self.auto_scale =
+                                Some(Exposure::Auto.scale(&self.modeller.scene, mesh, &element_b));
                         }
                     }
                     self.element_b = element_b;
@@ -409,11 +406,8 @@ impl ViewerApp {
         ui.horizontal(|ui| {
             if ui.button("auto exposure").clicked() {
                 if let Some(mesh) = &self.mesh {
-                    self.auto_scale = Some(Exposure::Brightest.scale(
-                        &self.modeller.scene,
-                        mesh,
-                        &self.element_b,
-                    ));
+                    self.auto_scale =
+                        Some(Exposure::Auto.scale(&self.modeller.scene, mesh, &self.element_b));
                     self.exposure_stops = 0.0;
                 }
             }

@@ -95,7 +95,7 @@ pub fn solved_cornell(max_area: f64) -> Result<Solved, String> {
     )
     .map_err(|e| e.to_string())?;
     let b = solution.element_rgb().to_vec();
-    let scale = Exposure::Brightest.scale(&prepared.scene, &prepared.mesh, &b);
+    let scale = Exposure::Auto.scale(&prepared.scene, &prepared.mesh, &b);
     Ok((prepared.scene, (*prepared.mesh).clone(), b, scale))
 }
 
@@ -195,7 +195,7 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
     let b = pipeline::solve(&prepared, &request(None), &mut keep_going, &NoProgress)
         .map_err(|e| e.to_string())?
         .radiosity;
-    let scale = Exposure::Brightest.scale(&prepared.scene, mesh, b.as_arrays());
+    let scale = Exposure::Auto.scale(&prepared.scene, mesh, b.as_arrays());
     let camera = Camera::for_scene(&prepared.scene, 1280, 800);
     let mut renderer = MeshRenderer::new(&gpu.device);
     renderer.set_mesh(&gpu.device, mesh);

@@ -77,7 +77,7 @@ fn rendering(c: &mut Criterion) {
     let element_b = solution.element_rgb();
     let vertex_b = shade::vertex_radiosity(&p.mesh, element_b);
     let settings = RenderSettings {
-        exposure_scale: Exposure::Brightest.scale(&p.scene, &p.mesh, element_b),
+        exposure_scale: Exposure::Auto.scale(&p.scene, &p.mesh, element_b),
         ..RenderSettings::default()
     };
     let camera = Camera::for_scene(&p.scene, 256, 256);

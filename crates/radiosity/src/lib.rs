@@ -51,7 +51,7 @@
 //! let b = solution.element_rgb();
 //! let vertex_b = shade::vertex_radiosity(&solution.mesh, b);
 //! let settings = RenderSettings {
-//!     exposure_scale: Exposure::Brightest.scale(&prepared.scene, &solution.mesh, b),
+//!     exposure_scale: Exposure::Auto.scale(&prepared.scene, &solution.mesh, b),
 //!     ..RenderSettings::default()
 //! };
 //! let camera = Camera::for_scene(&prepared.scene, 64, 64);

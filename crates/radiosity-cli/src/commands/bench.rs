@@ -129,13 +129,14 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         (None, _) => 0,
     };
     let camera = Camera::for_scene(&prepared.scene, args.size, args.size);
+    let scale = Exposure::Auto.scale(&prepared.scene, &solution.mesh, solution.element_rgb());
     let image = shade_and_render(
         &prepared,
         &solution.mesh,
         solution.element_rgb(),
         &camera,
         settings,
-        Exposure::Brightest,
+        scale,
         &reporter,
     );
     let total = start.elapsed().as_secs_f64();

@@ -20,6 +20,7 @@ use radiosity::pipeline::{
     self as pipeline, FormFactorStats, FormFactors, Prepared, Solution, SolveRequest,
 };
 use radiosity::progress::{run_stage, Stage};
+use radiosity::render::tonemap::{lit_radiosity_top_mean, AUTO_EXPOSURE_TOP_AREA};
 use radiosity::render::{Camera, RenderSettings, Renderer};
 use radiosity::shade::{self, Exposure};
 use radiosity::solve::{Observer, Solver};
@@ -65,24 +66,48 @@ pub fn solve_scene(
     Ok((solution, stats))
 }
 
-/// Vertex radiosities (the shade stage), exposure, then the image (the render stage).
+/// Vertex radiosities (the shade stage), then the image with radiosities multiplied by
+/// `exposure_scale` (the render stage).
 pub fn shade_and_render(
     prepared: &Prepared,
     mesh: &Mesh,
     element_b: &[[f64; 3]],
     camera: &Camera,
     settings: RenderSettings,
-    exposure: Exposure,
+    exposure_scale: f64,
     reporter: &Reporter,
 ) -> RgbImage {
     let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
         shade::vertex_radiosity(mesh, element_b)
     });
-    let scale = exposure.scale(&prepared.scene, mesh, element_b);
     let settings = RenderSettings {
-        exposure_scale: scale,
+        exposure_scale,
         ..settings
     };
     let renderer = Renderer::for_settings(mesh, &prepared.scene, &settings);
     radiosity::render::render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
+}
+
+/// What `render` says about the exposure `scale` it used: for `auto`, the radiosity it
+/// made white and how bright the brightest non-emitting element is against it.
+pub fn exposure_note(
+    prepared: &Prepared,
+    mesh: &Mesh,
+    element_b: &[[f64; 3]],
+    exposure: Exposure,
+    scale: f64,
+) -> String {
+    if let Exposure::Fixed(_) = exposure {
+        return format!("exposure scale {scale}");
+    }
+    let brightest = lit_radiosity_top_mean(&prepared.scene, mesh, element_b, 0.0).unwrap_or(0.0);
+    format!(
+        "exposure scale {scale} (auto: {:.4}, the mean radiosity of the brightest {} % of \
+         the non-emitting area, is white; the brightest non-emitting element is {:.4}, \
+         {:.2} x white)",
+        1.0 / scale,
+        100.0 * AUTO_EXPOSURE_TOP_AREA,
+        brightest,
+        brightest * scale,
+    )
 }

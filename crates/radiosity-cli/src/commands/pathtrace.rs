@@ -103,7 +103,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         // Alone: the view's own exposure unless one is given.
         let scale = match args.tone.exposure {
             Exposure::Fixed(s) => s,
-            Exposure::Brightest => view.brightest_scale(),
+            Exposure::Auto => view.auto_exposure_scale(),
         };
         reporter.note(&format!(
             "exposure scale {scale} (`render --exposure {scale}` shows a render with it)"
@@ -162,6 +162,13 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         &error_png,
         &reporter,
     )?;
+    if args.tone.exposure == Exposure::Auto {
+        reporter.note(&format!(
+            "exposure scale {scale} (auto, the radiosity solution's); the path-traced view's \
+             own auto exposure would be {}",
+            view.auto_exposure_scale()
+        ));
+    }
     reporter.note(&format!(
         "exposure scale {scale} for both; error map: white 0, blue darker and red brighter \
          than the path tracer, full colour at {} % of its RMS luminance, black left out",

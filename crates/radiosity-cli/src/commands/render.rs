@@ -8,7 +8,7 @@ use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self};
 use radiosity::solve::Step;
 
-use super::{shade_and_render, solve_scene};
+use super::{exposure_note, shade_and_render, solve_scene};
 use crate::args::RenderArgs;
 use crate::progress_bar::Reporter;
 use crate::setup::{camera, prepare_solve, render_settings};
@@ -41,13 +41,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         let quiet = Reporter::new(true);
         let display = state.display_radiosity();
+        let display = radiosity::light::Rgb::as_arrays(&display);
+        let scale = exposure.scale(&prepared.scene, &prepared.mesh, display);
         let image = shade_and_render(
             &prepared,
             &prepared.mesh,
-            radiosity::light::Rgb::as_arrays(&display),
+            display,
             &camera,
             settings,
-            exposure,
+            scale,
             &quiet,
         );
         let path = dir.join(format!("shot-{:05}.png", state.shot));
@@ -76,13 +78,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(dir) = &args.snapshots {
         reporter.note(&format!("wrote {written} snapshots to {}", dir.display()));
     }
+    let scale = exposure.scale(&prepared.scene, &solution.mesh, solution.element_rgb());
     let image = shade_and_render(
         &prepared,
         &solution.mesh,
         solution.element_rgb(),
         &camera,
         settings,
-        exposure,
+        scale,
         &reporter,
     );
     let output = args
@@ -92,6 +95,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
         render::write_png(&image, &output)
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&exposure_note(
+        &prepared,
+        &solution.mesh,
+        solution.element_rgb(),
+        exposure,
+        scale,
+    ));
     reporter.note(&format!(
         "wrote {} ({} x {})",
         output.display(),

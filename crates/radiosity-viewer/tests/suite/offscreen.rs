@@ -66,7 +66,7 @@ fn offscreen_cornell_box_matches_the_cpu_render() {
     let mesh = &prepared.mesh;
     let b = solution.element_rgb().to_vec();
     let vb = shade::vertex_radiosity(mesh, &b);
-    let scale = Exposure::Brightest.scale(&prepared.scene, mesh, &b);
+    let scale = Exposure::Auto.scale(&prepared.scene, mesh, &b);
     let camera = Camera::for_scene(&prepared.scene, 256, 256);
     let renderer = Renderer::new(mesh);
     for (shading, bound) in [(Shading::Smooth, SMOOTH_BOUND), (Shading::Flat, FLAT_BOUND)] {

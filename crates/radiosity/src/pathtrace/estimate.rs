@@ -3,6 +3,7 @@
 //! ([`PathTraced`]); and the running mean and variance that make them (`Accumulator`).
 
 use crate::light::Rgb;
+use crate::render::tonemap::{scale_for, top_mean, AUTO_EXPOSURE_TOP_AREA};
 use crate::render::{Film, FilmContent};
 
 /// The running mean and sum of squared deviations of a pixel's samples, per band and on
@@ -266,25 +267,23 @@ impl PathTraced {
         }
     }
 
-    /// An exposure for a view without a radiosity solution: 1 / the largest band of any
-    /// pixel that shows no emitter (as [`crate::render::tonemap::Exposure::Brightest`]
-    /// leaves out emitting surfaces), or 1 when that is zero. The largest of noisy means
-    /// is biased high, so a view tone-mapped this way is a little dark; when a radiosity
-    /// solution of the scene is at hand, its exposure is the one to share.
-    pub fn brightest_scale(&self) -> f64 {
-        let brightest = self
+    /// An exposure for a view without a radiosity solution, by the statistic of
+    /// [`crate::render::tonemap::Exposure::Auto`] over the film: the pixels that show no
+    /// emitter, each of weight one (their share of the view, where the radiosity exposure
+    /// weighs the scene's area), and of the quantile
+    /// [`crate::render::tonemap::AUTO_EXPOSURE_QUANTILE`] of their largest band, 1 over it
+    /// (1 when it is zero or there is no such pixel). A quantile of noisy means is far less
+    /// biased than their largest, which the noise pushes up. When a radiosity solution of
+    /// the scene is at hand, its exposure is the one to share.
+    pub fn auto_exposure_scale(&self) -> f64 {
+        let lit = self
             .film
             .samples()
             .iter()
             .zip(&self.shows_emitter)
             .filter(|(_, &emitter)| !emitter)
-            .map(|(s, _)| Rgb(*s).max_band())
-            .fold(0.0, f64::max);
-        if brightest > 0.0 && brightest.is_finite() {
-            1.0 / brightest
-        } else {
-            1.0
-        }
+            .map(|(s, _)| (Rgb(*s).max_band(), 1.0));
+        scale_for(top_mean(lit, AUTO_EXPOSURE_TOP_AREA))
     }
 }
 

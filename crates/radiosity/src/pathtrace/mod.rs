@@ -44,7 +44,7 @@
 //! let camera = Camera::for_scene(&scene, 8, 8);
 //! let settings = PathTraceSettings::DEFAULT.with_samples(4);
 //! let view = pathtrace::path_trace(&scene, &camera, &settings, &NoProgress)?;
-//! let image = tonemap::to_image(view.film(), view.brightest_scale(), 2.2);
+//! let image = tonemap::to_image(view.film(), view.auto_exposure_scale(), 2.2);
 //! assert_eq!(image.dimensions(), (8, 8));
 //! assert!(view.noise().mean_standard_error > 0.0);
 //! # Ok::<(), radiosity::pathtrace::PathTraceError>(())

@@ -557,11 +557,8 @@ fn cornell_box_cost() {
             let map = c.error_map.to_image(DEFAULT_ERROR_FULL_SCALE);
             map.save(dir.join(format!("pathtrace-error-{shading:?}.png")))
                 .unwrap();
-            let scale = crate::render::tonemap::Exposure::Brightest.scale(
-                &prepared.scene,
-                &solution.mesh,
-                b,
-            );
+            let scale =
+                crate::render::tonemap::Exposure::Auto.scale(&prepared.scene, &solution.mesh, b);
             let tone = |f: &crate::render::Film| crate::render::tonemap::to_image(f, scale, 2.2);
             tone(view.film()).save(dir.join("pathtrace.png")).unwrap();
             tone(&film)

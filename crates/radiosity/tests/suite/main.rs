@@ -4,6 +4,7 @@
 mod fixtures;
 
 mod compare;
+mod exposure;
 mod form_factors;
 mod hierarchical;
 mod methods_on_examples;

@@ -310,7 +310,7 @@ mod tests {
         let eb = made_up_b(&s, &mesh);
         let vb = vertex_radiosity(&mesh, &eb);
         let r = Renderer::new(&mesh);
-        let scale = crate::render::tonemap::Exposure::Brightest.scale(&s, &mesh, &eb);
+        let scale = crate::render::tonemap::Exposure::Auto.scale(&s, &mesh, &eb);
         let settings = RenderSettings {
             exposure_scale: scale,
             ..RenderSettings::default()
@@ -351,8 +351,7 @@ mod tests {
             let vb = vertex_radiosity(&mesh, &eb);
             let settings = RenderSettings {
                 supersample: 2,
-                exposure_scale: crate::render::tonemap::Exposure::Brightest
-                    .scale(&open, &mesh, &eb),
+                exposure_scale: crate::render::tonemap::Exposure::Auto.scale(&open, &mesh, &eb),
                 ..settings
             };
             let cam = cornell_camera(320, 320);
