@@ -267,14 +267,15 @@ impl PathTraced {
         }
     }
 
-    /// An exposure for a view without a radiosity solution, by the statistic of
-    /// [`crate::render::tonemap::Exposure::Auto`] over the film: the pixels that show no
-    /// emitter, each of weight one (their share of the view, where the radiosity exposure
-    /// weighs the scene's area), and of the quantile
-    /// [`crate::render::tonemap::AUTO_EXPOSURE_QUANTILE`] of their largest band, 1 over it
-    /// (1 when it is zero or there is no such pixel). A quantile of noisy means is far less
-    /// biased than their largest, which the noise pushes up. When a radiosity solution of
-    /// the scene is at hand, its exposure is the one to share.
+    /// An exposure for a view without a radiosity solution, by the rule of
+    /// [`crate::render::tonemap::Exposure::Auto`] over the film: the mean of the largest
+    /// band of the brightest [`crate::render::tonemap::AUTO_EXPOSURE_TOP_AREA`] (2 %) of the
+    /// pixels that show no emitter, each of weight one, is white; 1 when that is zero or
+    /// there is no such pixel. It is a statistic of the view (the share of the picture),
+    /// where the radiosity exposure weighs the whole scene's area, so the two differ where
+    /// the view leaves out the brightest surfaces; when a radiosity solution of the scene is
+    /// at hand, its exposure is the one to share. A mean of many noisy pixels is far less
+    /// biased than their largest, which the noise pushes up.
     pub fn auto_exposure_scale(&self) -> f64 {
         let lit = self
             .film
@@ -290,6 +291,29 @@ impl PathTraced {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // 101 pixels in a row: 98 at radiosity 1, one at 3 (green), one at 5 (red), and an
+    // emitter at 40, left out. The brightest 2 % of the 100 others are the 5 and the 3:
+    // mean 4, scale 1 / 4.
+    #[test]
+    fn auto_exposure_is_the_mean_of_the_brightest_two_percent_of_pixels() {
+        use rayon::prelude::*;
+        let mut values = vec![[1.0; 3]; 101];
+        values[10] = [0.0, 3.0, 1.0];
+        values[50] = [5.0, 2.0, 0.0];
+        values[70] = [40.0; 3];
+        let mut film = Film::new(101, 1, 1, FilmContent::Radiosity);
+        film.par_rows_mut()
+            .for_each(|(_, row)| row.copy_from_slice(&values));
+        let mut emitter = vec![false; 101];
+        emitter[70] = true;
+        let view = |emitter: Vec<bool>, film: Film| {
+            PathTraced::from_parts(film, vec![Rgb::BLACK; 101], vec![0.0; 101], emitter, 4)
+        };
+        assert_eq!(view(emitter, film.clone()).auto_exposure_scale(), 0.25);
+        // Every pixel an emitter: nothing to expose for, scale 1.
+        assert_eq!(view(vec![true; 101], film).auto_exposure_scale(), 1.0);
+    }
 
     #[test]
     fn welford_gives_the_textbook_standard_error() {
