@@ -113,6 +113,10 @@ pub struct SolveOptions {
     /// (default: MAX_PATCH_AREA / 16).
     #[arg(long, value_name = "AREA")]
     pub min_area: Option<f64>,
+    /// Hierarchical: leave out the final gather (each leaf then takes its ancestors'
+    /// irradiance pushed down, as before the gather was added).
+    #[arg(long)]
+    pub no_final_gather: bool,
     /// Progressive: give up after this many shots.
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     pub max_shots: usize,

@@ -192,6 +192,7 @@ fn solver(
                 min_area,
                 tolerance,
                 max_memory_bytes: None,
+                final_gather: !options.no_final_gather,
             })
         }
     })

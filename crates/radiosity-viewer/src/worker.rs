@@ -472,6 +472,7 @@ mod tests {
             min_area: 2000.0,
             tolerance: 1e-6,
             max_memory_bytes: None,
+            final_gather: true,
         };
         let scene = cornell_box().scene;
         let (edits, updates, _) = spawn(

@@ -113,6 +113,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         form_factors: None,
         epsilon: args.epsilon,
         min_area: args.min_area,
+        no_final_gather: false,
     };
     let settings = RenderSettings {
         supersample: args.supersample,

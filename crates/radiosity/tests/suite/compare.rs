@@ -131,6 +131,7 @@ fn two_meshes_and_two_solvers_of_one_scene_differ_by_their_discretisation() {
             min_area: 0.1 / 4.0,
             tolerance: 1e-6,
             max_memory_bytes: None,
+            final_gather: true,
         })),
         &mut keep_going,
         &NoProgress,

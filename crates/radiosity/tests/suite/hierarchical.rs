@@ -27,17 +27,33 @@ fn cornell() -> (Scene, f64) {
     (file.scene, file.settings.max_patch_area)
 }
 
-/// `scene` by hierarchical radiosity, its patches split along the grid of the mesh at
-/// MAX_PATCH_AREA `max_area`.
-fn solve(scene: &Scene, max_area: f64, epsilon: f64, min_area: f64) -> HierarchicalSolution {
-    let bvh = occluder_bvh(scene);
-    let settings = HierarchicalSettings {
+/// Settings with the given epsilon and minimum area, the final gather on or off, the
+/// default tolerance and no memory limit.
+fn settings(epsilon: f64, min_area: f64, final_gather: bool) -> HierarchicalSettings {
+    HierarchicalSettings {
         epsilon,
         min_area,
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: None,
-    };
-    solve_hierarchical(scene, max_area, &bvh, &settings, &NoProgress).unwrap()
+        final_gather,
+    }
+}
+
+/// `scene` by hierarchical radiosity with `settings`, its patches split along the grid of
+/// the mesh at MAX_PATCH_AREA `max_area`.
+fn solve_with(
+    scene: &Scene,
+    max_area: f64,
+    settings: &HierarchicalSettings,
+) -> HierarchicalSolution {
+    let bvh = occluder_bvh(scene);
+    solve_hierarchical(scene, max_area, &bvh, settings, &NoProgress).unwrap()
+}
+
+/// `scene` by hierarchical radiosity with the final gather, its patches split along the
+/// grid of the mesh at MAX_PATCH_AREA `max_area`.
+fn solve(scene: &Scene, max_area: f64, epsilon: f64, min_area: f64) -> HierarchicalSolution {
+    solve_with(scene, max_area, &settings(epsilon, min_area, true))
 }
 
 /// Area-weighted mean B of every input surface, per band.
@@ -160,7 +176,10 @@ fn refined_closed_cube_is_close_to_the_closed_form() {
     // averaged, the sums stay close to 1. Measured at epsilon 0.01: area-weighted mean
     // relative error 3.3e-2, largest 0.19 (a corner leaf); escaped power -0.8 %, -0.4 % and
     // -1.9 % of emitted (red, green, blue: the error of the form-factor sums, amplified by
-    // 1 / (1 - rho)). Tolerances: 5 %, 25 % and 3 %.
+    // 1 / (1 - rho)). Tolerances: 5 %, 25 % and 3 %. Those figures are without the final
+    // gather; with it (evaluating the ancestors' links at each leaf) measured: mean 5.7e-3,
+    // largest 3.5e-2, escaped -0.7 %, -0.3 % and -1.8 %; the bounds still hold the
+    // hierarchy without it.
     let s = solve(&unit_cube(CUBE_E, CUBE_RHO), CUBE_AREA, 0.01, 1.0 / 256.0);
     let (mean, worst) = cube_errors(&s);
     let b = s.report.balance;
@@ -311,6 +330,7 @@ fn refuses_bad_settings() {
             min_area,
             tolerance,
             max_memory_bytes: None,
+            final_gather: true,
         };
         assert!(solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).is_err());
     }
@@ -327,6 +347,7 @@ fn refuses_to_outgrow_its_memory_limit() {
         min_area: 125.0,
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: Some(4 << 20),
+        final_gather: true,
     };
     let err = solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).unwrap_err();
     let text = err.to_string();
@@ -347,7 +368,7 @@ fn refuses_to_outgrow_its_memory_limit() {
 /// per-element comparison.
 fn against_exact_dense(
     max_area: f64,
-    settings: &[(f64, f64)],
+    settings: &[HierarchicalSettings],
 ) -> Vec<radiosity::compare::Comparison> {
     // The dense solve on the plain grid: the hierarchy's leaves do not refine contacts
     // (`refine_contacts`), so against the refined mesh it would differ by the buried
@@ -360,13 +381,10 @@ fn against_exact_dense(
     let emission = prepared.light.emission();
     settings
         .iter()
-        .map(|&(epsilon, min_area)| {
-            let s = solve(
-                &prepared.scene,
-                prepared.settings.max_patch_area,
-                epsilon,
-                min_area,
-            );
+        .map(|settings| {
+            let t = std::time::Instant::now();
+            let s = solve_with(&prepared.scene, prepared.settings.max_patch_area, settings);
+            let elapsed = t.elapsed();
             let c = compare(
                 &prepared.mesh,
                 &dense.radiosity,
@@ -376,7 +394,7 @@ fn against_exact_dense(
             )
             .unwrap();
             eprintln!(
-                "cornell at {max_area} ({} elements), eps {epsilon}: {} leaves, {} links; {c:?}",
+                "cornell at {max_area} ({} elements), {settings:?}: {elapsed:?}, {} leaves, {} links; {c:?}",
                 prepared.mesh.len(),
                 s.report.leaves,
                 s.report.links
@@ -388,6 +406,7 @@ fn against_exact_dense(
 
 #[test]
 fn cornell_box_element_by_element_against_an_exact_dense_solve() {
+    // The hierarchy itself, without the final gather (held with it by the next test).
     // 2,046 elements; leaves down to a quarter of an element. Measured: RMS 0.66 %, mean
     // +0.13 %, largest 11.5 % (an element at a block's footprint, where the two solves'
     // visibility samples differ). The bound is the target of issue #4 (1 % RMS; 1.5x the
@@ -396,7 +415,10 @@ fn cornell_box_element_by_element_against_an_exact_dense_solve() {
     // elements, against contour k = 8) when pairs that sixteen sample pairs called hidden
     // were dropped instead of refined (a footprint element lost the light its uncovered
     // part sees); 0.2 keeps that out.
-    let [c, coarse] = against_exact_dense(1000.0, &[(3e-4, 250.0), (0.05, 250.0)])[..] else {
+    let [c, coarse] = against_exact_dense(
+        1000.0,
+        &[settings(3e-4, 250.0, false), settings(0.05, 250.0, false)],
+    )[..] else {
         unreachable!()
     };
     assert_eq!(c.elements, 2046);
@@ -410,6 +432,28 @@ fn cornell_box_element_by_element_against_an_exact_dense_solve() {
     assert!(coarse.rms < 0.11, "{coarse:?}");
     assert!(coarse.max < 1.2, "{coarse:?}");
     assert!(coarse.bias.abs() < 0.008, "{coarse:?}");
+}
+
+#[test]
+fn default_settings_within_two_percent_of_an_exact_dense_solve() {
+    // Issue #11: hierarchical radiosity at its defaults (epsilon 0.05, minimum area
+    // MAX_PATCH_AREA / 16, the final gather), as `--solver auto` runs it above 20,000
+    // elements, within 2 % RMS element by element of the exact dense solve, here at 2,046
+    // elements. Measured (BENCHMARKS.md): RMS 1.58 %, largest 14.9 %, mean +0.33 %; the
+    // same settings without the final gather 8.9 %, 95 % and -0.09 %. Bounds: the issue's
+    // 2 % (1.27x the measured RMS, for the visibility samples' variation between
+    // refinements); the largest difference 0.3, twice the measured one and a third of it
+    // without the gather (blotches pushed down from coarse links come back above it); the
+    // mean 1 %, 3x the measured one.
+    let max_area = 1000.0;
+    let [c] = against_exact_dense(max_area, &[HierarchicalSettings::defaults_for(max_area)])[..]
+    else {
+        unreachable!()
+    };
+    assert_eq!(c.elements, 2046);
+    assert!(c.rms < 0.02, "{c:?}");
+    assert!(c.max < 0.3, "{c:?}");
+    assert!(c.bias.abs() < 0.01, "{c:?}");
 }
 
 /// True when `x` lies in the convex polygon `poly` (normal `n`), up to `tol` outside.
@@ -428,7 +472,9 @@ fn leaves_nest_with_the_mesh_elements() {
     // the like, none a power of two, so bisection alone would not nest.)
     let scene = cornell_box().scene;
     let mesh = radiosity::mesh::mesh_scene(&scene, 1000.0).unwrap();
-    let s = solve(&scene, 1000.0, 0.03, 250.0);
+    // Without the final gather, which splits every leaf larger than an element down to
+    // elements (no unions would be left to check).
+    let s = solve_with(&scene, 1000.0, &settings(0.03, 250.0, false));
     let corners = |m: &radiosity::mesh::Mesh, e: usize| -> Vec<glam::DVec3> {
         m.corner_positions(e).collect()
     };

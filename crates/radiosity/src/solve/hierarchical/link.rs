@@ -22,6 +22,9 @@ pub(super) struct Link {
     pub(super) oracle: f32,
     /// Unit direction of travel, from q's centre to p's.
     pub(super) dir: [f32; 3],
+    /// The visible fraction included in `g` (1: no sample pair blocked): the final gather
+    /// samples visibility again, from each leaf, only where it is below 1.
+    pub(super) visible: f32,
 }
 
 /// True when some corner of `other` lies strictly in front of `poly`'s plane.
@@ -40,6 +43,23 @@ fn box_in_front(lo: DVec3, hi: DVec3, point: DVec3, normal: DVec3) -> bool {
         if normal.z > 0.0 { hi.z } else { lo.z },
     );
     normal.dot(far - point) > 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE)
+}
+
+/// F from patch p (normal `mp`) to patch q (normal `mq`), unoccluded, by their distance:
+/// where the centres are closer than the sum of the radii, the exact area-averaged F (double
+/// contour integral): the mean over four points misses the peak of F near a shared edge and
+/// is biased low there (5 % on the Cornell box's walls at epsilon 0.01); up to three times
+/// that, the mean of Lambert's exact point value at four points of p, accurate to
+/// O((R / r)^2); beyond, the point-to-point kernel between four points of each.
+pub(super) fn patch_form_factor(np: &Node, mp: DVec3, nq: &Node, mq: DVec3) -> f64 {
+    let r = np.centre.distance(nq.centre);
+    if r < np.radius + nq.radius {
+        crate::form_factor::exact::polygon_to_polygon(np.polygon(), nq.polygon())
+    } else if r > 3.0 * (np.radius + nq.radius) {
+        mean_point_pairs(np.polygon(), mp, nq.polygon(), mq, nq.area)
+    } else {
+        mean_point_to_polygon(np.polygon(), mp, nq.polygon())
+    }
 }
 
 /// What the estimate of a candidate pair says.
@@ -99,13 +119,9 @@ impl Solver<'_> {
                 {
                     return Estimate::Nothing;
                 }
-                // Near pairs (centres closer than twice the sum of the radii) get the exact
-                // area-averaged F (double contour integral): the mean over four points
-                // misses the peak of F near a shared edge and is biased low there (5 % on
-                // the Cornell box's walls at epsilon 0.01). Distant pairs get the mean of four
-                // exact point values, accurate to O((R / r)^2).
+                // Near pairs (centres closer than the sum of the radii) get the exact F
+                // (see `patch_form_factor`).
                 let near = r < np.radius + nq.radius;
-                let far = r > 3.0 * (np.radius + nq.radius);
                 if near && self.split_choice(p, q).is_some() {
                     // The exact F costs about twenty times Lambert's formula at p's centre
                     // and most near pairs are refined: when half of the centre's value
@@ -117,18 +133,13 @@ impl Solver<'_> {
                         g: 0.0,
                         oracle: (0.5 * f_centre * (np.area / nq.area).max(1.0)) as f32,
                         dir: [0.0; 3],
+                        visible: 1.0,
                     };
                     if self.wants_refining(p, &probe, b_ref) {
                         return Estimate::Refine;
                     }
                 }
-                let f_pq = if near {
-                    crate::form_factor::exact::polygon_to_polygon(np.polygon(), nq.polygon())
-                } else if far {
-                    mean_point_pairs(np.polygon(), mp, nq.polygon(), mq, nq.area)
-                } else {
-                    mean_point_to_polygon(np.polygon(), mp, nq.polygon())
-                };
+                let f_pq = patch_form_factor(np, mp, nq, mq);
                 // F_qp for the oracle by reciprocity (A_p F_pq = A_q F_qp).
                 (f_pq, f_pq * (np.area / nq.area).max(1.0))
             }
@@ -164,6 +175,7 @@ impl Solver<'_> {
             g: g as f32,
             oracle: oracle as f32,
             dir: [d.x as f32, d.y as f32, d.z as f32],
+            visible: 1.0,
         };
         let cluster_link = np.is_cluster() || nq.is_cluster();
         if self.wants_refining(p, &link, b_ref) && self.split_choice(p, q).is_some() {
@@ -198,6 +210,7 @@ impl Solver<'_> {
                     (oracle * fraction) as f32
                 },
                 dir: [d.x as f32, d.y as f32, d.z as f32],
+                visible: fraction as f32,
             },
             rays,
         )
