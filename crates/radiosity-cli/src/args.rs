@@ -114,7 +114,8 @@ pub struct SolveOptions {
     #[arg(long, value_name = "AREA")]
     pub min_area: Option<f64>,
     /// Hierarchical: leave out the final gather (each leaf then takes its ancestors'
-    /// irradiance pushed down, as before the gather was added).
+    /// irradiance pushed down, as before the gather was added). It is left out anyway
+    /// above 100,000 elements, where it costs several times the solve.
     #[arg(long)]
     pub no_final_gather: bool,
     /// Progressive: give up after this many shots.

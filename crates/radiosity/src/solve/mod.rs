@@ -45,7 +45,7 @@ pub use radiosity::{keep_going, Observer, Radiosity, SolveReport, Step};
 pub use residual::relative_residual;
 pub use solver::{
     choose, AutoChoice, AutoReason, DenseSolver, GaussSeidelSettings, ProgressiveSettings, Solver,
-    SolverKind, UnknownSolver, AUTO_DENSE_MAX_ELEMENTS,
+    SolverKind, UnknownSolver, AUTO_DENSE_MAX_ELEMENTS, FINAL_GATHER_MAX_ELEMENTS,
 };
 
 use std::time::Instant;
