@@ -109,7 +109,7 @@ fn layout_matches_documentation() {
     // 40 fixed bytes + L = 2 + 4 n^2 = 16.
     assert_eq!(bytes.len(), 58);
     assert_eq!(&bytes[0..8], b"RADFF\0\0\0");
-    assert_eq!(bytes[8..12], 1u32.to_le_bytes());
+    assert_eq!(bytes[8..12], 2u32.to_le_bytes());
     assert_eq!(bytes[12..20], 2u64.to_le_bytes());
     assert_eq!(bytes[20..24], 2u32.to_le_bytes());
     assert_eq!(&bytes[24..26], b"ab");
@@ -321,13 +321,33 @@ fn newer_version_is_refused() {
     let dir = temp_dir("version");
     let (path, fp, _) = valid_file(&dir, 3);
     let mut bytes = std::fs::read(&path).unwrap();
-    bytes[8..12].copy_from_slice(&2u32.to_le_bytes());
+    bytes[8..12].copy_from_slice(&3u32.to_le_bytes());
     std::fs::write(&path, &bytes).unwrap();
     let err = read_form_factors(&path, fp, None).unwrap_err();
     assert!(
         matches!(
             err,
-            FormFactorFileError::UnsupportedVersion { version: 2, .. }
+            FormFactorFileError::UnsupportedVersion { version: 3, .. }
+        ),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn version_1_files_of_the_older_area_rule_are_refused() {
+    // Version 1 files hold the area method's values from before its near pairs were exact:
+    // refused, so that they are computed again rather than solved with stale values.
+    let dir = temp_dir("version1");
+    let (path, fp, _) = valid_file(&dir, 3);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FormFactorFileError::UnsupportedVersion { version: 1, .. }
         ),
         "{err}"
     );
@@ -344,7 +364,7 @@ fn huge_n_is_refused_without_allocating() {
     for n in [1u64 << 40, u64::MAX] {
         let mut bytes = Vec::new();
         bytes.extend_from_slice(&FORM_FACTOR_MAGIC);
-        bytes.extend_from_slice(&1u32.to_le_bytes());
+        bytes.extend_from_slice(&FORM_FACTOR_FILE_VERSION.to_le_bytes());
         bytes.extend_from_slice(&n.to_le_bytes());
         bytes.extend_from_slice(&0u32.to_le_bytes());
         bytes.extend_from_slice(&42u64.to_le_bytes());
