@@ -58,45 +58,40 @@ fn solve(scene: &Scene, max_area: f64, epsilon: f64, min_area: f64) -> Hierarchi
 
 /// Area-weighted mean B of every input surface, per band.
 fn per_surface(mesh: &radiosity::mesh::Mesh, b: &radiosity::solve::Radiosity) -> Vec<[f64; 3]> {
-    mesh.surface_elements
-        .iter()
-        .map(|range| {
-            let mut sum = [0.0; 3];
-            let mut area = 0.0;
-            for e in range.clone() {
-                let a = mesh.elements[e as usize].area;
-                area += a;
-                for (k, s) in sum.iter_mut().enumerate() {
-                    *s += a * b.0[e as usize][k];
-                }
-            }
-            sum.map(|s| s / area)
-        })
-        .collect()
+    weighted_per_surface(mesh, b, |e| mesh.elements[e].area)
 }
 
 /// The area-weighted mean per surface of a solution on `other` projected onto the elements
-/// of `reference` (see [`radiosity::compare::project`]).
+/// of `reference` (see [`radiosity::compare::project`]), each element weighted by the area
+/// of it that `other` covers.
 fn per_surface_projected(
     reference: &radiosity::mesh::Mesh,
     other: &radiosity::mesh::Mesh,
     b: &radiosity::solve::Radiosity,
 ) -> Vec<[f64; 3]> {
     let p = radiosity::compare::project(reference, other, b).unwrap();
-    reference
-        .surface_elements
+    weighted_per_surface(reference, &p.radiosity, |e| p.covered[e])
+}
+
+/// The mean of `b` over each input surface of `mesh`, element e weighted by `weight(e)`.
+fn weighted_per_surface(
+    mesh: &radiosity::mesh::Mesh,
+    b: &radiosity::solve::Radiosity,
+    weight: impl Fn(usize) -> f64,
+) -> Vec<[f64; 3]> {
+    mesh.surface_elements
         .iter()
         .map(|range| {
             let mut sum = [0.0; 3];
-            let mut area = 0.0;
+            let mut total = 0.0;
             for e in range.clone() {
-                let a = p.covered[e as usize];
-                area += a;
+                let w = weight(e as usize);
+                total += w;
                 for (k, s) in sum.iter_mut().enumerate() {
-                    *s += a * p.radiosity.0[e as usize][k];
+                    *s += w * b.0[e as usize][k];
                 }
             }
-            sum.map(|s| s / area)
+            sum.map(|s| s / total)
         })
         .collect()
 }
