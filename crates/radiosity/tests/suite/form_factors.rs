@@ -420,8 +420,8 @@ fn analytic_converges_as_k_squared_even_at_shared_edges() {
 // exact: parallel unit squares half a unit apart (Howell's closed form) and a unit square
 // standing perpendicular half a unit beyond the edge of another (the exact contour
 // integral). The rule's error there, measured 1.1 % (0.4107 against 0.4153) and 0.4 %
-// (0.07582 against 0.07614), falls as the square of the distance beyond; the bound 2 % is
-// what the doc of `NEAR` promises ("about 1 %") with a margin.
+// (0.07582 against 0.07614); the bound 2 % is what the doc of `NEAR` promises ("about
+// 1 %") with a margin.
 #[test]
 fn the_area_rule_half_an_element_apart_is_within_two_percent() {
     let parallel = vec![
