@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use radiosity::pathtrace::{FilmComparison, PathTraceSettings, PathTraced};
-use radiosity::pipeline::{FormFactorStats, Prepared, Solution, SolutionReport};
+use radiosity::pipeline::{AdaptReport, FormFactorStats, Prepared, Solution, SolutionReport};
 use radiosity::scene::{BuildingParams, Scene};
 use radiosity::solve::{Solver, SolverKind};
 
@@ -25,6 +25,32 @@ pub fn form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter:
         stats.row_sums.max,
         stats.reciprocity.max_relative,
         stats.reciprocity.total_relative
+    ));
+}
+
+/// Notes what adaptive subdivision did, round by round.
+pub fn adapt(report: &AdaptReport, reporter: &Reporter) {
+    if report.rounds.is_empty() {
+        reporter.note(&format!(
+            "adaptive subdivision: no visible steps between the {} elements; solved once",
+            report.initial_elements
+        ));
+        return;
+    }
+    let rounds: Vec<String> = report
+        .rounds
+        .iter()
+        .map(|r| {
+            format!(
+                "{} split -> {} elements ({:.2e} new pairs)",
+                r.split, r.elements, r.pairs_integrated as f64
+            )
+        })
+        .collect();
+    reporter.note(&format!(
+        "adaptive subdivision from {} elements: {}",
+        report.initial_elements,
+        rounds.join("; ")
     ));
 }
 

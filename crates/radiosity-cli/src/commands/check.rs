@@ -41,7 +41,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
         (solution, Some(stats))
     } else {
         // Progressive refinement never holds the matrix: no row sums or reciprocity.
-        solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?
+        solve_scene(&prepared, solver, None, None, &mut keep_going, &reporter)?
     };
     report::check(
         &stem,
