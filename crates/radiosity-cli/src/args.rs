@@ -119,8 +119,9 @@ pub struct SolveOptions {
     #[arg(long)]
     pub no_final_gather: bool,
     /// Dense solvers: rounds of adaptive subdivision after the first solve (each splits
-    /// the elements whose luminance steps against a neighbour's, then solves again; default
-    /// 2); 0 solves the mesh once. Not with --form-factors.
+    /// the elements whose luminance steps against a neighbour's, then solves again; 2 is a
+    /// good start for furnished rooms); 0, the default, solves the mesh once. Not with
+    /// --form-factors.
     #[arg(long, value_name = "N")]
     pub adapt_rounds: Option<u32>,
     /// Adaptive subdivision: a step between touching elements is split when it exceeds this

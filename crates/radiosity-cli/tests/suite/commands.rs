@@ -622,3 +622,64 @@ fn compare_works_where_surfaces_lie_on_and_touch_others() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn adapt_rounds_refine_the_mesh_and_refuse_a_form_factor_file() {
+    let dir = scratch_dir("adapt");
+    let scene = example("room.scene");
+    let once = radiosity(
+        &["solve", &scene, "-o", "once.csv", "--adapt-rounds", "0"],
+        &dir,
+    );
+    let twice = radiosity(
+        &["solve", &scene, "-o", "adapted.csv", "--adapt-rounds", "1"],
+        &dir,
+    );
+    assert!(
+        once.status.success() && twice.status.success(),
+        "{}{}",
+        stderr(&once),
+        stderr(&twice)
+    );
+    let rows = |f: &str| {
+        std::fs::read_to_string(dir.join(f))
+            .unwrap()
+            .lines()
+            .count()
+    };
+    // The refined solution has more elements, and says how it got them.
+    assert!(rows("adapted.csv") > rows("once.csv"));
+    let notes = stderr(&twice);
+    assert!(notes.contains("adaptive subdivision from"), "{notes}");
+    // The room's area is kept: the elements are split, none lost (column 3 is the area).
+    let area = |f: &str| -> f64 {
+        std::fs::read_to_string(dir.join(f))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+            .sum()
+    };
+    assert!((area("adapted.csv") - area("once.csv")).abs() < 1e-9 * area("once.csv"));
+
+    let ff = radiosity(&["formfactors", &scene, "-o", "r.ff", "-q"], &dir);
+    assert!(ff.status.success(), "{}", stderr(&ff));
+    let refused = radiosity(
+        &[
+            "solve",
+            &scene,
+            "--form-factors",
+            "r.ff",
+            "--adapt-rounds",
+            "1",
+        ],
+        &dir,
+    );
+    assert!(!refused.status.success());
+    assert!(
+        stderr(&refused).contains("--adapt-rounds cannot be used with --form-factors"),
+        "{}",
+        stderr(&refused)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

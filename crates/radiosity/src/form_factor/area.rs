@@ -35,8 +35,8 @@ pub(super) const NEAR: f64 = 0.5;
 pub(super) const NEAR_STEPS: u32 = 4;
 
 /// Points on each element that judge again a near pair that [`NEAR_STEPS`]^2 points found
-/// partly hidden: about 8 x 8 (so about 4,096 point pairs).
-const FINE_POINTS: usize = 64;
+/// partly hidden: 55 on a rank-1 lattice (see [`sample_polygon`]), so 3,025 point pairs.
+const FINE_POINTS: usize = 55;
 
 /// What an element pair's coupling is computed from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -468,22 +468,60 @@ impl<'a> AreaIntegrator<'a> {
     }
 }
 
-/// About `count` points on the convex polygon `p` with area weights summing to its area:
-/// the fan of triangles from its first corner, each cut into m^2 congruent triangles (m
-/// chosen so that the fan has about that many), at their centroids.
+/// About `count` points on the convex polygon `p` with area weights summing to its area,
+/// for judging visibility: a quadrilateral gets `count` points of the rank-1 (Fibonacci)
+/// lattice u_k = (k + 1/2) / N, v_k = frac(k g / N + 1/2N), g = round(N / phi), mapped
+/// bilinearly and weighted by the Jacobian; any other polygon the fan of triangles from its
+/// first corner, each with its share of the points on the lattice folded into the triangle
+/// ((u, v) -> (1 - u, 1 - v) where u + v > 1). Unlike a k x k grid, whose points share k
+/// columns, every point of the lattice has its own u and its own v, so an edge of a shadow
+/// along either axis is resolved to 1/N of the polygon instead of 1/k (a 0.3 wide strip
+/// hidden by a cover: counted 0.25 wide by an 8 x 8 grid).
 fn sample_polygon(p: &[DVec3], count: usize) -> Vec<(DVec3, f64)> {
-    if p.len() < 3 {
-        return Vec::new();
-    }
-    let fans = p.len() - 2;
-    let want = count as f64 / fans as f64;
-    let m = want.sqrt().round().max(1.0) as u32;
-    let mut out = Vec::with_capacity(fans * (m * m) as usize);
-    for k in 1..p.len() - 1 {
-        let t = [p[0], p[k], p[k + 1]];
-        let w = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length() / (m * m) as f64;
-        if w > 0.0 {
-            crate::mesh::for_each_subtriangle(t, m, |s| out.push(((s[0] + s[1] + s[2]) / 3.0, w)));
+    let lattice = |n: usize| {
+        let g = ((n as f64) / 1.618_033_988_749_895).round().max(1.0);
+        (0..n).map(move |k| {
+            let u = (k as f64 + 0.5) / n as f64;
+            let v = ((k as f64 * g + 0.5) / n as f64).fract();
+            (u, v)
+        })
+    };
+    let mut out = Vec::with_capacity(count + 4);
+    match p.len() {
+        0..=2 => {}
+        4 => {
+            let start = out.len();
+            let mut total = 0.0;
+            for (u, v) in lattice(count.max(1)) {
+                let du = (1.0 - v) * (p[1] - p[0]) + v * (p[2] - p[3]);
+                let dv = (1.0 - u) * (p[3] - p[0]) + u * (p[2] - p[1]);
+                let w = du.cross(dv).length();
+                total += w;
+                out.push((crate::mesh::bilinear(p, u, v), w));
+            }
+            let area = crate::geometry::polygon_area(p);
+            let scale = if total > 0.0 { area / total } else { 0.0 };
+            for (_, w) in &mut out[start..] {
+                *w *= scale;
+            }
+        }
+        k => {
+            let fans = k - 2;
+            let per = count.div_ceil(fans).max(1);
+            for f in 1..k - 1 {
+                let (a, b, c) = (p[0], p[f], p[f + 1]);
+                let w = 0.5 * (b - a).cross(c - a).length() / per as f64;
+                if w > 0.0 {
+                    for (u, v) in lattice(per) {
+                        let (u, v) = if u + v > 1.0 {
+                            (1.0 - u, 1.0 - v)
+                        } else {
+                            (u, v)
+                        };
+                        out.push((a + u * (b - a) + v * (c - a), w));
+                    }
+                }
+            }
         }
     }
     out
