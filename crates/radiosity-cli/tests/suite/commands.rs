@@ -266,6 +266,7 @@ fn check_prints_statistics() {
         "total area",
         "row sums",
         "reciprocity error",
+        "escaped from",
         "stage times",
     ] {
         assert!(text.contains(field), "check output lacks {field}:\n{text}");
