@@ -14,8 +14,12 @@
 //! area integral over the elements. They travel beside the [`Scene`], not in it: the scene
 //! is geometry and materials only.
 
+mod conforming;
 mod contact;
 
+pub use conforming::{DisplayPolygons, DisplayTriangle};
+#[cfg(test)]
+pub(crate) use conforming::split_corner_mesh;
 pub use contact::{
     refine_contacts, ContactReport, CONTACT_DEPTH, CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS,
     PROBE_SLACK,
@@ -23,6 +27,7 @@ pub use contact::{
 
 use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use glam::DVec3;
 
@@ -81,6 +86,8 @@ pub struct Mesh {
     pub surface_vertices: Vec<Range<u32>>,
     neighbour_offsets: Vec<u32>,
     neighbour_list: Vec<u32>,
+    /// The display polygons, found on first use ([`Mesh::display`]).
+    display: OnceLock<DisplayPolygons>,
 }
 
 /// Meshing cannot proceed.
@@ -331,6 +338,13 @@ impl Mesh {
             .corners()
             .iter()
             .map(|&v| self.vertices[v as usize])
+    }
+
+    /// Every element's display polygon (its corners and the T-vertices on its edges) and
+    /// triangles, found on the first call (see [`DisplayPolygons`]). Smooth shading, the
+    /// renderer and the viewer draw these, so that a mesh with T-junctions shows no seams.
+    pub fn display(&self) -> &DisplayPolygons {
+        self.display.get_or_init(|| DisplayPolygons::new(self))
     }
 
     /// The elements that share an edge with element `e` on the same surface.
