@@ -613,9 +613,21 @@ fn floor_and_rug_scene(lift: f64) -> String {
     };
     let y = lift;
     let mut text = String::from("MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\n");
-    text += &patch("Floor", 0.0, [[4., 0., 0.], [0., 0., 0.], [0., 0., 4.], [4., 0., 4.]]);
-    text += &patch("Rug", 0.0, [[3., y, 1.], [1., y, 1.], [1., y, 2.], [3., y, 2.]]);
-    text += &patch("Light", 10.0, [[1., 2., 1.], [3., 2., 1.], [3., 2., 3.], [1., 2., 3.]]);
+    text += &patch(
+        "Floor",
+        0.0,
+        [[4., 0., 0.], [0., 0., 0.], [0., 0., 4.], [4., 0., 4.]],
+    );
+    text += &patch(
+        "Rug",
+        0.0,
+        [[3., y, 1.], [1., y, 1.], [1., y, 2.], [3., y, 2.]],
+    );
+    text += &patch(
+        "Light",
+        10.0,
+        [[1., 2., 1.], [3., 2., 1.], [3., 2., 3.], [1., 2., 3.]],
+    );
     text + "SCENEEND\n"
 }
 
@@ -643,7 +655,10 @@ fn check_lists_surfaces_lying_on_others() {
             .find_map(|l| l.strip_prefix("total area"))
             .and_then(|v| v.trim().parse().ok())
             .unwrap();
-        assert!((area - 20.0).abs() < 1e-9, "lift {lift}: total area {area}\n{text}");
+        assert!(
+            (area - 20.0).abs() < 1e-9,
+            "lift {lift}: total area {area}\n{text}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

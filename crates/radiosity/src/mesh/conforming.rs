@@ -144,13 +144,7 @@ impl DisplayPolygons {
 /// Appends to `polygon` the vertices strictly inside the edge `a` -> `b`, in order from `a`,
 /// when the unshared edges from `a` run along the segment to `b` (a T-edge); nothing for a
 /// boundary edge.
-fn walk_t_edge(
-    mesh: &Mesh,
-    open: &HashMap<u32, Vec<u32>>,
-    a: u32,
-    b: u32,
-    polygon: &mut Vec<u32>,
-) {
+fn walk_t_edge(mesh: &Mesh, open: &HashMap<u32, Vec<u32>>, a: u32, b: u32, polygon: &mut Vec<u32>) {
     let (pa, pb) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
     let ab = pb - pa;
     let len2 = ab.length_squared();
@@ -271,14 +265,21 @@ pub(crate) fn split_corner_mesh() -> Mesh {
     let mut index: HashMap<[u64; 3], u32> = HashMap::new();
     let mut id = |x: f64, y: f64| {
         let p = glam::dvec3(x, y, 0.0);
-        *index.entry(p.to_array().map(f64::to_bits)).or_insert_with(|| {
-            vertices.push(p);
-            vertices.len() as u32 - 1
-        })
+        *index
+            .entry(p.to_array().map(f64::to_bits))
+            .or_insert_with(|| {
+                vertices.push(p);
+                vertices.len() as u32 - 1
+            })
     };
     let mut elements = Vec::new();
     let mut quad = |x0: f64, y0: f64, s: f64| {
-        vec![id(x0, y0), id(x0 + s, y0), id(x0 + s, y0 + s), id(x0, y0 + s)]
+        vec![
+            id(x0, y0),
+            id(x0 + s, y0),
+            id(x0 + s, y0 + s),
+            id(x0, y0 + s),
+        ]
     };
     for (x, y) in [(0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.5, 0.5)] {
         elements.push(quad(x, y, 0.5));
@@ -330,7 +331,10 @@ mod tests {
         assert_eq!(d.t_vertex_count(), 2);
         assert_eq!(d.t_element_count(), 2);
         let at = |e: usize| -> Vec<DVec3> {
-            d.polygon(e).iter().map(|&v| mesh.vertices[v as usize]).collect()
+            d.polygon(e)
+                .iter()
+                .map(|&v| mesh.vertices[v as usize])
+                .collect()
         };
         assert_eq!(
             at(4),
@@ -362,7 +366,11 @@ mod tests {
         // element (to rounding: 1e-12 of unit areas).
         let mesh = split_corner_mesh();
         for (&edge, &count) in &triangle_edges(&mesh, 0) {
-            let want = if on_square_boundary(&mesh, edge, 0.0, 2.0) { 1 } else { 2 };
+            let want = if on_square_boundary(&mesh, edge, 0.0, 2.0) {
+                1
+            } else {
+                2
+            };
             assert_eq!(count, want, "edge {edge:?}");
         }
         check_areas_and_winding(&mesh);

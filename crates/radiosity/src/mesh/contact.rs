@@ -260,7 +260,8 @@ impl<'a> Probe<'a> {
                 clo = clo.min(v);
                 chi = chi.max(v);
             }
-            (clo - DVec3::splat(reach)).cmple(hi).all() && (chi + DVec3::splat(reach)).cmpge(lo).all()
+            (clo - DVec3::splat(reach)).cmple(hi).all()
+                && (chi + DVec3::splat(reach)).cmpge(lo).all()
         });
         if covered {
             return true;
@@ -484,7 +485,12 @@ mod tests {
         // level 1: the floor keeps exactly 16 - 2 = 14 m^2.
         for lift in [0.0, 1e-4] {
             let quad = |x0: f64, x1: f64, z0: f64, z1: f64, y: f64| {
-                vec![dvec3(x0, y, z0), dvec3(x0, y, z1), dvec3(x1, y, z1), dvec3(x1, y, z0)]
+                vec![
+                    dvec3(x0, y, z0),
+                    dvec3(x0, y, z1),
+                    dvec3(x1, y, z1),
+                    dvec3(x1, y, z0),
+                ]
             };
             let scene = Scene {
                 surfaces: vec![

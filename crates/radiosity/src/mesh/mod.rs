@@ -17,9 +17,9 @@
 mod conforming;
 mod contact;
 
-pub use conforming::{DisplayPolygons, DisplayTriangle};
 #[cfg(test)]
 pub(crate) use conforming::split_corner_mesh;
+pub use conforming::{DisplayPolygons, DisplayTriangle};
 pub use contact::{
     refine_contacts, ContactReport, CONTACT_DEPTH, CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS,
     PROBE_SLACK,

@@ -42,10 +42,10 @@ use std::sync::OnceLock;
 
 use glam::DVec3;
 
+use super::renderer::Interpolation;
 use crate::form_factor::exact::point_to_polygon;
 use crate::geometry;
 use crate::light::Rgb;
-use super::renderer::Interpolation;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 use crate::visibility::PolygonBvh;

@@ -636,7 +636,11 @@ mod tests {
             .iter()
             .map(|el| {
                 let c = el.centroid;
-                [1.0 + c.x * c.x + 3.0 * c.y, 2.0 - c.y * c.y, 0.5 + c.x * c.y]
+                [
+                    1.0 + c.x * c.x + 3.0 * c.y,
+                    2.0 - c.y * c.y,
+                    0.5 + c.x * c.y,
+                ]
             })
             .collect();
         let vb = vertex_radiosity(&mesh, &eb);
@@ -661,7 +665,10 @@ mod tests {
             for k in 0..3 {
                 // Both sides are linear along the edge between the same two vertices:
                 // equal to rounding (values of order 10).
-                assert!((a[k] - b[k]).abs() < 1e-12, "y = {y}, band {k}: {a:?} / {b:?}");
+                assert!(
+                    (a[k] - b[k]).abs() < 1e-12,
+                    "y = {y}, band {k}: {a:?} / {b:?}"
+                );
             }
             // What the element's own corners alone gave (bilinear on [1, 2] x [0, 1]):
             // different, so this test would catch the seam.

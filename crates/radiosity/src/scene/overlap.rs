@@ -76,7 +76,11 @@ pub fn lying_on(scene: &Scene, occluders: &PolygonBvh) -> Vec<Overlap> {
             hi = hi.max(v);
         }
         candidates.clear();
-        occluders.overlapping(lo - DVec3::splat(max_gap), hi + DVec3::splat(max_gap), &mut candidates);
+        occluders.overlapping(
+            lo - DVec3::splat(max_gap),
+            hi + DVec3::splat(max_gap),
+            &mut candidates,
+        );
         let mut uppers: Vec<u32> = candidates.iter().map(|&k| occluders.id_of(k)).collect();
         uppers.sort_unstable();
         uppers.dedup();
@@ -179,7 +183,12 @@ mod tests {
             vertices,
         };
         let quad = |x0: f64, x1: f64, z0: f64, z1: f64, y: f64| {
-            vec![dvec3(x0, y, z0), dvec3(x0, y, z1), dvec3(x1, y, z1), dvec3(x1, y, z0)]
+            vec![
+                dvec3(x0, y, z0),
+                dvec3(x0, y, z1),
+                dvec3(x1, y, z1),
+                dvec3(x1, y, z0),
+            ]
         };
         Scene {
             surfaces: vec![
