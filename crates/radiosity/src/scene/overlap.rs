@@ -19,9 +19,11 @@ use super::Scene;
 use crate::geometry;
 use crate::visibility::PolygonBvh;
 
-/// Gaps up to this fraction of the scene's size count as lying on: 1e-3 (5 mm in a room some
-/// 5 m across: a rug; a light panel hung 5 cm below a ceiling is ten times further).
-pub const LYING_ON_GAP: f64 = 1e-3;
+/// Gaps up to this fraction of the upper surface's size (the square root of its area) count
+/// as lying on: 1 %, 17 mm for a 2 x 1.5 m rug (the room's lies 5 mm above its floor); a
+/// 1 x 0.5 m light panel hung 5 cm below a ceiling is seven times further. Relative to the
+/// surface itself, so a large scene does not make its small things lie on each other.
+pub const LYING_ON_GAP: f64 = 1e-2;
 
 /// Gaps up to this fraction of the scene's size count as the same plane: 1e-7, well above the
 /// rounding of coordinates (1e-16 relative) and of the reader's flattening, well below any gap
@@ -55,7 +57,6 @@ impl Overlap {
 pub fn lying_on(scene: &Scene, occluders: &PolygonBvh) -> Vec<Overlap> {
     let scale = occluders.scale();
     let same_plane = SAME_PLANE_GAP * scale;
-    let max_gap = LYING_ON_GAP * scale;
     let normals: Vec<Option<DVec3>> = scene
         .surfaces
         .iter()
@@ -66,6 +67,8 @@ pub fn lying_on(scene: &Scene, occluders: &PolygonBvh) -> Vec<Overlap> {
         .iter()
         .map(|s| geometry::polygon_area(&s.vertices))
         .collect();
+    // The largest gap any surface could lie at: that of the largest.
+    let max_gap = LYING_ON_GAP * areas.iter().copied().fold(0.0, f64::max).sqrt();
     let mut out = Vec::new();
     let mut candidates = Vec::new();
     for (s, lower) in scene.surfaces.iter().enumerate() {
@@ -104,7 +107,7 @@ pub fn lying_on(scene: &Scene, occluders: &PolygonBvh) -> Vec<Overlap> {
             let on_top = if gap.abs() <= same_plane {
                 areas[tu] < areas[s] || (areas[tu] == areas[s] && tu > s)
             } else {
-                gap > 0.0 && gap <= max_gap
+                gap > 0.0 && gap <= LYING_ON_GAP * areas[tu].sqrt()
             };
             if !on_top {
                 continue;
@@ -217,7 +220,7 @@ mod tests {
 
     #[test]
     fn far_above_facing_away_or_beside_is_not_lying_on() {
-        // 0.1 above (the floor is some 5.7 across: 1.7 % of it), facing down, or moved off
+        // 0.1 above (the 2 x 1 rug is some 1.4 across: 7 % of it), facing down, or moved off
         // the floor's edge.
         let mut high = floor_and_rug(0.1);
         let mut flipped = floor_and_rug(0.0);
