@@ -124,7 +124,7 @@ impl<'m> Renderer<'m> {
         scene: &Scene,
         settings: &super::RenderSettings,
     ) -> Renderer<'m> {
-        let mut renderer = Renderer::new(mesh);
+        let mut renderer = Renderer::new(mesh).with_surfaces_on_top(scene);
         if settings.direct_light {
             renderer = renderer.with_direct_light(scene);
         }
@@ -137,6 +137,40 @@ impl<'m> Renderer<'m> {
     /// The mesh being rendered.
     pub fn mesh(&self) -> &'m Mesh {
         self.mesh
+    }
+
+    /// From now on a ray that meets a surface of `scene` (from which the mesh was cut) and
+    /// one lying on it ([`crate::scene::lying_on`]: a rug in the floor's plane) at the same
+    /// distance sees the one on top: the elements of the surfaces on top are found as if
+    /// [`crate::scene::overlap::SAME_PLANE_GAP`] of the scene's size in front of their plane
+    /// (1e-7: far above the rounding of a ray's distance, far below a pixel). Without it, a
+    /// mesh that keeps the floor under the rug (hierarchical radiosity's leaves) shows the
+    /// floor through the rug wherever rounding picks it.
+    pub fn with_surfaces_on_top(mut self, scene: &Scene) -> Renderer<'m> {
+        let occluders = PolygonBvh::over_surfaces(scene);
+        let pairs = crate::scene::lying_on(scene, &occluders);
+        if pairs.is_empty() {
+            return self;
+        }
+        let mut on_top = vec![false; scene.surfaces.len()];
+        for o in &pairs {
+            on_top[o.upper as usize] = true;
+        }
+        let lift = crate::scene::overlap::SAME_PLANE_GAP * occluders.scale();
+        let polygons: Vec<Vec<DVec3>> = (0..self.mesh.len())
+            .map(|e| {
+                let el = &self.mesh.elements[e];
+                let up = if on_top.get(el.surface as usize) == Some(&true) {
+                    lift * el.normal
+                } else {
+                    DVec3::ZERO
+                };
+                self.mesh.corner_positions(e).map(|p| p + up).collect()
+            })
+            .collect();
+        let ids: Vec<u32> = (0..self.mesh.len() as u32).collect();
+        self.bvh = PolygonBvh::new(&polygons, &ids);
+        self
     }
 
     /// Smooth shading from now on gathers the direct light of `scene` (from which the mesh
@@ -677,6 +711,60 @@ mod tests {
             largest_old_jump = largest_old_jump.max((old - b[0]).abs());
         }
         assert!(largest_old_jump > 0.05, "{largest_old_jump}");
+    }
+
+    #[test]
+    fn a_rug_in_the_floors_plane_is_seen_over_it() {
+        // The floor meshed whole under a rug in its plane (as hierarchical radiosity's leaves
+        // keep it): every ray that meets the plane well inside the rug (1 cm in from its
+        // outline, against rounding at the outline) must see the rug, never the floor.
+        let quad = |x0: f64, x1: f64, z0: f64, z1: f64| {
+            vec![
+                dvec3(x0, 0., z0),
+                dvec3(x0, 0., z1),
+                dvec3(x1, 0., z1),
+                dvec3(x1, 0., z0),
+            ]
+        };
+        let s = scene(vec![
+            surface("floor", 0.0, quad(0., 4., 0., 4.)),
+            surface("rug", 0.0, quad(1.1, 3.1, 1.1, 2.3)),
+        ]);
+        let mesh = mesh_scene(&s, 0.25).unwrap();
+        let eb: Vec<[f64; 3]> = mesh
+            .elements
+            .iter()
+            .map(|el| [el.surface as f64, 0.0, 0.0])
+            .collect();
+        let r = Renderer::new(&mesh).with_surfaces_on_top(&s);
+        let cam = Camera {
+            eye: dvec3(2.0, 1.5, -2.0),
+            look_at: dvec3(2.0, 0.0, 1.7),
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+            width: 160,
+            height: 120,
+        };
+        let film = r.film(&cam, &eb, &[], Shading::Flat, 1, &NoProgress);
+        let screen = cam.screen();
+        let (mut inside, mut floor) = (0, 0);
+        for y in 0..cam.height as usize {
+            for x in 0..cam.width as usize {
+                let dir = cam.direction_in(screen, x as f64 + 0.5, y as f64 + 0.5);
+                if dir.y >= 0.0 {
+                    continue;
+                }
+                let p = cam.eye + (-cam.eye.y / dir.y) * dir;
+                if p.x > 1.11 && p.x < 3.09 && p.z > 1.11 && p.z < 2.29 {
+                    inside += 1;
+                    if film.pixel(x, y)[0][0] != 1.0 {
+                        floor += 1;
+                    }
+                }
+            }
+        }
+        assert!(inside > 1000, "{inside}");
+        assert_eq!(floor, 0, "{floor} of {inside} rug pixels show the floor");
     }
 
     #[test]
