@@ -18,11 +18,13 @@
 //! for the generation of accurate radiosity solutions", SIGGRAPH 1991, section 4: the
 //! T-vertices are added to the neighbouring elements' polygons before display).
 //!
-//! T-vertices are found from the mesh's topology: an edge no other element shares is either on
-//! the surface's boundary or a T-edge, and along a T-edge A-B the small elements' own unshared
-//! edges run A-M1, M1-M2, ..., Mk-B. The walk from A along unshared edges that stay on the
-//! segment A-B finds them. It needs the elements of one surface to share vertices where their
-//! corners coincide, which every mesh builder does (by exact position).
+//! T-vertices are found from the mesh's topology and geometry: an edge no other element shares
+//! is either on the surface's boundary or a T-edge, and a T-vertex M inside a T-edge A-B is an
+//! end of the small elements' own unshared edges along it (A-M, M-B, or only one of them where
+//! a piece beyond was dropped as buried). So only unshared edges are searched, and only the
+//! ends of unshared edges, kept per surface in a grid of cubes, are candidates. It needs the
+//! elements of one surface to share vertices where their corners coincide, which every mesh
+//! builder does (by exact position).
 
 use std::collections::HashMap;
 
@@ -69,13 +71,6 @@ impl DisplayPolygons {
                 *uses.entry((a.min(b), a.max(b))).or_default() += 1;
             }
         }
-        let mut open: HashMap<u32, Vec<u32>> = HashMap::new();
-        for (&(a, b), &n) in &uses {
-            if n == 1 {
-                open.entry(a).or_default().push(b);
-                open.entry(b).or_default().push(a);
-            }
-        }
 
         let mut out = DisplayPolygons {
             polygon_offsets: Vec::with_capacity(mesh.len() + 1),
@@ -88,14 +83,18 @@ impl DisplayPolygons {
         out.polygon_offsets.push(0);
         out.triangle_offsets.push(0);
         let mut polygon = Vec::new();
-        for el in &mesh.elements {
+        let mut grid = EndGrid::default();
+        for (e, el) in mesh.elements.iter().enumerate() {
+            if mesh.surface_elements[el.surface as usize].start as usize == e {
+                grid = EndGrid::new(mesh, el.surface as usize, &uses);
+            }
             let c = el.corners();
             polygon.clear();
             for i in 0..c.len() {
                 let (a, b) = (c[i], c[(i + 1) % c.len()]);
                 polygon.push(a);
                 if uses[&(a.min(b), a.max(b))] == 1 {
-                    walk_t_edge(mesh, &open, a, b, &mut polygon);
+                    grid.inside_edge(mesh, a, b, &mut polygon);
                 }
             }
             let inserted = polygon.len() - c.len();
@@ -141,44 +140,92 @@ impl DisplayPolygons {
     }
 }
 
-/// Appends to `polygon` the vertices strictly inside the edge `a` -> `b`, in order from `a`,
-/// when the unshared edges from `a` run along the segment to `b` (a T-edge); nothing for a
-/// boundary edge.
-fn walk_t_edge(mesh: &Mesh, open: &HashMap<u32, Vec<u32>>, a: u32, b: u32, polygon: &mut Vec<u32>) {
-    let (pa, pb) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
-    let ab = pb - pa;
-    let len2 = ab.length_squared();
-    if len2 <= 0.0 {
-        return;
-    }
-    let tol = ON_EDGE_TOLERANCE;
-    let start = polygon.len();
-    let (mut here, mut t_here) = (a, 0.0);
-    loop {
-        // The next vertex along the segment, reached by an unshared edge from `here`.
-        let mut next: Option<(u32, f64)> = None;
-        for &q in open.get(&here).map_or(&[][..], |v| v.as_slice()) {
-            let d = mesh.vertices[q as usize] - pa;
-            let t = d.dot(ab) / len2;
-            let off_line = (d - t * ab).length_squared() / len2;
-            if off_line <= tol * tol && t > t_here + tol && t <= 1.0 + tol {
-                if next.is_none_or(|(_, best)| t < best) {
-                    next = Some((q, t));
+/// The ends of one surface's unshared edges (the only vertices that can lie inside another
+/// element's edge) in a uniform grid of cubes, for the search along an edge.
+#[derive(Default)]
+struct EndGrid {
+    cell: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl EndGrid {
+    /// The grid of surface `s`'s unshared edge ends; cubes as large as the median unshared
+    /// edge, or 1/64 of the longest if that is larger (so no edge crosses more than 64).
+    fn new(mesh: &Mesh, s: usize, uses: &HashMap<(u32, u32), u32>) -> EndGrid {
+        let mut lengths = Vec::new();
+        let mut ends = Vec::new();
+        for e in mesh.surface_elements[s].clone() {
+            let c = mesh.elements[e as usize].corners();
+            for i in 0..c.len() {
+                let (a, b) = (c[i], c[(i + 1) % c.len()]);
+                if uses[&(a.min(b), a.max(b))] == 1 {
+                    lengths.push((mesh.vertices[b as usize] - mesh.vertices[a as usize]).length());
+                    ends.extend([a, b]);
                 }
             }
         }
-        match next {
-            Some((q, _)) if q == b => return,
-            Some((q, t)) if t < 1.0 - tol => {
-                polygon.push(q);
-                (here, t_here) = (q, t);
-            }
-            // The walk left the segment or ended on a copy of b: not a T-edge after all.
-            _ => {
-                polygon.truncate(start);
-                return;
+        if lengths.is_empty() {
+            return EndGrid::default();
+        }
+        lengths.sort_by(f64::total_cmp);
+        let cell = lengths[lengths.len() / 2].max(lengths[lengths.len() - 1] / 64.0);
+        if !(cell > 0.0 && cell.is_finite()) {
+            return EndGrid::default();
+        }
+        ends.sort_unstable();
+        ends.dedup();
+        let mut grid = EndGrid {
+            cell,
+            cells: HashMap::new(),
+        };
+        for v in ends {
+            let key = grid.key(mesh.vertices[v as usize]);
+            grid.cells.entry(key).or_default().push(v);
+        }
+        grid
+    }
+
+    fn key(&self, p: DVec3) -> [i64; 3] {
+        (p / self.cell).floor().as_i64vec3().to_array()
+    }
+
+    /// Appends to `polygon` the unshared edge ends strictly inside the edge `a` -> `b` (within
+    /// [`ON_EDGE_TOLERANCE`] of its length), in order from `a`.
+    fn inside_edge(&self, mesh: &Mesh, a: u32, b: u32, polygon: &mut Vec<u32>) {
+        if self.cells.is_empty() {
+            return;
+        }
+        let (pa, pb) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
+        let ab = pb - pa;
+        let len2 = ab.length_squared();
+        if len2 <= 0.0 {
+            return;
+        }
+        let tol = ON_EDGE_TOLERANCE;
+        let mut found: Vec<(f64, u32)> = Vec::new();
+        // Points along the edge a cube apart, and the 27 cubes round each.
+        let steps = (len2.sqrt() / self.cell).ceil() as usize;
+        for k in 0..=steps {
+            let centre = self.key(pa + ab * (k as f64 / steps.max(1) as f64));
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let key = [centre[0] + dx, centre[1] + dy, centre[2] + dz];
+                        for &q in self.cells.get(&key).map_or(&[][..], |v| v.as_slice()) {
+                            let d = mesh.vertices[q as usize] - pa;
+                            let t = d.dot(ab) / len2;
+                            let off_line = (d - t * ab).length_squared() / len2;
+                            if off_line <= tol * tol && t > tol && t < 1.0 - tol {
+                                found.push((t, q));
+                            }
+                        }
+                    }
+                }
             }
         }
+        found.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        found.dedup_by_key(|x| x.1);
+        polygon.extend(found.into_iter().map(|(_, q)| q));
     }
 }
 
@@ -512,6 +559,47 @@ mod tests {
             assert!(count <= 2, "edge {p} - {q} used {count} times");
             if count == 1 {
                 assert!(on_outline || near_hole, "open edge {p} - {q}");
+            }
+        }
+    }
+
+    #[test]
+    fn refined_room_has_no_vertex_inside_a_triangle_edge() {
+        // examples/room.scene, contact-refined: floor pieces three levels deep next to whole
+        // elements, some pieces beyond a T-vertex dropped as buried. By brute force over every
+        // display triangle edge and every vertex of its surface: none lies strictly inside
+        // an edge (to 1e-9 of its length, the detection's own tolerance being the same).
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/room.scene");
+        let file = crate::scene::read_scene(&path).unwrap();
+        let grid = mesh_scene(&file.scene, file.settings.max_patch_area).unwrap();
+        let bvh = crate::visibility::PolygonBvh::over_surfaces(&file.scene);
+        let (mesh, _) = crate::mesh::refine_contacts(&grid, &file.scene, &bvh);
+        assert!(mesh.display().t_vertex_count() > 100);
+        check_areas_and_winding(&mesh);
+        for s in 0..file.scene.surfaces.len() {
+            let points: Vec<DVec3> = mesh.surface_vertices[s]
+                .clone()
+                .map(|i| mesh.vertices[i as usize])
+                .collect();
+            for e in mesh.surface_elements[s].clone() {
+                for t in mesh.display().triangles(e as usize) {
+                    for k in 0..3 {
+                        let a = mesh.vertices[t.vertices[k] as usize];
+                        let b = mesh.vertices[t.vertices[(k + 1) % 3] as usize];
+                        let ab = b - a;
+                        for &p in &points {
+                            let u = (p - a).dot(ab) / ab.length_squared();
+                            if u > 1e-9 && u < 1.0 - 1e-9 {
+                                let off = (p - (a + u * ab)).length();
+                                assert!(
+                                    off > 1e-9 * ab.length(),
+                                    "surface {s}: {p} lies on the edge {a} - {b}"
+                                );
+                            }
+                        }
+                    }
+                }
             }
         }
     }
