@@ -13,10 +13,11 @@
 //! of neighbouring elements then share whole edges, so the display is watertight inside every
 //! surface, and a T-vertex is a corner of every element it touches, so the radiosity shared by
 //! all display vertices ([`crate::shade::vertex_radiosity`]) is interpolated continuously
-//! across the edge. This is the usual fix for T-junctions in radiosity meshes (Baum, Mann,
-//! Smith and Winget, "Making radiosity usable: automatic preprocessing and meshing techniques
-//! for the generation of accurate radiosity solutions", SIGGRAPH 1991, section 4: the
-//! T-vertices are added to the neighbouring elements' polygons before display).
+//! across the edge. This is the usual fix for T-junctions in radiosity meshes, the
+//! "anchoring" of Baum, Mann, Smith and Winget, "Making radiosity usable: automatic
+//! preprocessing and meshing techniques for the generation of accurate radiosity solutions",
+//! SIGGRAPH 1991: the T-vertices become corners of the neighbouring elements' display
+//! triangles.
 //!
 //! T-vertices are found from the mesh's topology and geometry: an edge no other element shares
 //! is either on the surface's boundary or a T-edge, and a T-vertex M inside a T-edge A-B is an
