@@ -162,8 +162,8 @@ pub fn colour_vertices(
     let display = mesh.display();
     let mut out = Vec::with_capacity(3 * display.all_triangles().len());
     let f = |b: [f64; 3]| b.map(|x| x as f32);
-    for e in 0..mesh.len() {
-        let eb = f(element_b[e]);
+    for (e, &b) in element_b.iter().enumerate().take(mesh.len()) {
+        let eb = f(b);
         for t in display.triangles(e) {
             for &v in &t.vertices {
                 let vb = vertex_b.get(v as usize).map_or(eb, |&b| f(b));
