@@ -54,6 +54,40 @@ pub fn adapt(report: &AdaptReport, reporter: &Reporter) {
     ));
 }
 
+/// Prints the note on surfaces lying on others (a rug in or just above a floor's plane):
+/// how many pairs, and which, by index and name, with the gap and the area covered.
+fn lying_on(prepared: &Prepared) {
+    let scene = &prepared.scene;
+    let pairs = radiosity::scene::lying_on(scene, &prepared.occluders);
+    if pairs.is_empty() {
+        return;
+    }
+    let scale = prepared.occluders.scale();
+    let same_plane = pairs.iter().filter(|o| o.same_plane(scale)).count();
+    outln!(
+        "lying on          {} surface(s) lie on others ({} in the same plane), their covered \
+         parts left out of the mesh:",
+        pairs.len(),
+        same_plane
+    );
+    const SHOWN: usize = 10;
+    for o in pairs.iter().take(SHOWN) {
+        let name = |s: u32| &scene.surfaces[s as usize].name;
+        outln!(
+            "                  surface {} {:?} on surface {} {:?}: gap {:.3e}, covering {:.6}",
+            o.upper,
+            name(o.upper),
+            o.lower,
+            name(o.lower),
+            o.gap,
+            o.covered_area
+        );
+    }
+    if pairs.len() > SHOWN {
+        outln!("                  ... and {} more", pairs.len() - SHOWN);
+    }
+}
+
 /// Prints the `check` report of `solution` (the stage times from `reporter`); `stats` are
 /// the form factors' statistics when the solve used a matrix.
 pub fn check(
@@ -84,6 +118,7 @@ pub fn check(
             contacts.buried_area
         );
     }
+    lying_on(prepared);
     outln!("MAX_PATCH_AREA    {}", prepared.settings.max_patch_area);
     outln!("INTEGRAL_STEPS    {}", prepared.settings.integral_steps);
     outln!("method            {}", prepared.method());

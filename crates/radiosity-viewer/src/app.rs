@@ -609,7 +609,8 @@ impl ViewerApp {
             }
             if let Some(mesh) = &self.mesh {
                 if self.gpu_mesh_pending {
-                    gpu.renderer.set_mesh(&rs.device, mesh);
+                    let on_top = crate::gpu::on_top_surfaces(&self.modeller.scene);
+                    gpu.renderer.set_mesh(&rs.device, mesh, &on_top);
                     self.gpu_mesh_pending = false;
                     self.colours_dirty = true;
                 }

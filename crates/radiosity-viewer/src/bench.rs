@@ -111,7 +111,7 @@ pub fn tiled(
     (DVec3, DVec3),
 ) {
     let vertex_b = shade::vertex_radiosity(mesh, element_b);
-    let g = geometry_vertices(mesh);
+    let g = geometry_vertices(mesh, &[]);
     let c = colour_vertices(mesh, element_b, &vertex_b);
     let (lo, hi) = mesh_bounds(mesh);
     let step = 1.25 * (hi - lo).x.max((hi - lo).z);
@@ -199,7 +199,7 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
     let scale = Exposure::Auto.scale(&prepared.scene, mesh, b.as_arrays());
     let camera = Camera::for_scene(&prepared.scene, 1280, 800);
     let mut renderer = MeshRenderer::new(&gpu.device);
-    renderer.set_mesh(&gpu.device, mesh);
+    renderer.set_mesh(&gpu.device, mesh, &[]);
     let target_tex = Target::new(&gpu.device, camera.width, camera.height);
     let style = Style {
         exposure_scale: scale,
@@ -291,7 +291,7 @@ pub fn run_all(
     let vb = shade::vertex_radiosity(&mesh, &b);
     let ft = frame_time(
         &gpu,
-        &geometry_vertices(&mesh),
+        &geometry_vertices(&mesh, &[]),
         &colour_vertices(&mesh, &b, &vb),
         mesh_bounds(&mesh),
         &camera,
@@ -308,7 +308,7 @@ pub fn run_all(
     log(&out);
     if big_triangles > 0 {
         let (_, fine, fb, fscale) = solved_cornell(cornell_max_area_for(10_000))?;
-        let per_copy = geometry_vertices(&fine).len() / 3;
+        let per_copy = geometry_vertices(&fine, &[]).len() / 3;
         let copies = big_triangles.div_ceil(per_copy);
         let (v, c, bounds) = tiled(&fine, &fb, copies);
         let cam = Camera::outside(bounds, 1280, 800);

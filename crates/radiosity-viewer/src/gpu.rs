@@ -16,6 +16,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, DVec4};
 use radiosity::mesh::Mesh;
 use radiosity::render::{Camera, Shading};
+use radiosity::scene::Scene;
 use wgpu::util::DeviceExt;
 
 /// The colour format of every [`Target`]: 8 bits per channel, not sRGB (the shader applies
@@ -93,14 +94,15 @@ struct ViewUniform {
     pad: [f32; 3],
 }
 
-/// Geometry of one vertex: position and `surface << 3 | edge mask`.
+/// Geometry of one vertex: position and `surface << 4 | on top << 3 | edge mask`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GeometryVertex {
     /// Position, scene units.
     pub position: [f32; 3],
-    /// Surface index shifted left by 3, or'd with the mask of the triangle's element edges
-    /// (bit k: the edge opposite the triangle's vertex k).
+    /// Surface index shifted left by 4; bit 3 set for a surface that lies on another (drawn
+    /// a little towards the eye, see [`on_top_surfaces`]); bits 0-2 the mask of the
+    /// triangle's element edges (bit k: the edge opposite the triangle's vertex k).
     pub info: u32,
 }
 
@@ -115,37 +117,34 @@ pub struct ColourVertex {
     pub element_b: [f32; 3],
 }
 
-/// For every triangle the mesh is drawn with, its element index (a quadrilateral element is
-/// two triangles, (0, 1, 2) and (0, 2, 3)).
+/// For every triangle the mesh is drawn with, its element index. The triangles are those of
+/// the elements' display polygons ([`Mesh::display`]): a quadrilateral element is two
+/// triangles, (0, 1, 2) and (0, 2, 3), and an element with T-vertices on its edges (next to
+/// smaller elements) is cut so that its triangles use them, which leaves no cracks.
 pub fn triangle_elements(mesh: &Mesh) -> Vec<u32> {
-    let mut out = Vec::with_capacity(2 * mesh.len());
-    for (e, el) in mesh.elements.iter().enumerate() {
-        out.push(e as u32);
-        if el.is_quad() {
-            out.push(e as u32);
-        }
+    let display = mesh.display();
+    let mut out = Vec::with_capacity(display.all_triangles().len());
+    for e in 0..mesh.len() {
+        out.extend(std::iter::repeat_n(e as u32, display.triangles(e).len()));
     }
     out
 }
 
 /// The triangles of `mesh` as vertices, three per triangle, in [`triangle_elements`] order.
-pub fn geometry_vertices(mesh: &Mesh) -> Vec<GeometryVertex> {
-    let mut out = Vec::with_capacity(6 * mesh.len());
-    let pos = |v: u32| mesh.vertices[v as usize].as_vec3().to_array();
-    for el in &mesh.elements {
-        let c = el.corners();
-        let surface = el.surface << 3;
-        // (corners, mask of element edges: bit k = the edge opposite vertex k)
-        let tris: &[([usize; 3], u32)] = if el.is_quad() {
-            &[([0, 1, 2], 0b101), ([0, 2, 3], 0b011)]
-        } else {
-            &[([0, 1, 2], 0b111)]
-        };
-        for (corners, mask) in tris {
-            for &k in corners {
+/// `on_top` flags, per surface, those that lie on another ([`on_top_surfaces`]; may be
+/// empty: none).
+pub fn geometry_vertices(mesh: &Mesh, on_top: &[bool]) -> Vec<GeometryVertex> {
+    let display = mesh.display();
+    let mut out = Vec::with_capacity(3 * display.all_triangles().len());
+    for (e, el) in mesh.elements.iter().enumerate() {
+        let top = on_top.get(el.surface as usize).copied().unwrap_or(false);
+        let surface = el.surface << 4 | (top as u32) << 3;
+        for t in display.triangles(e) {
+            // The mask of element edges: bit k = the edge opposite vertex k.
+            for &v in &t.vertices {
                 out.push(GeometryVertex {
-                    position: pos(c[k]),
-                    info: surface | mask,
+                    position: mesh.vertices[v as usize].as_vec3().to_array(),
+                    info: surface | t.outline as u32,
                 });
             }
         }
@@ -160,19 +159,14 @@ pub fn colour_vertices(
     element_b: &[[f64; 3]],
     vertex_b: &[[f64; 3]],
 ) -> Vec<ColourVertex> {
-    let mut out = Vec::with_capacity(6 * mesh.len());
+    let display = mesh.display();
+    let mut out = Vec::with_capacity(3 * display.all_triangles().len());
     let f = |b: [f64; 3]| b.map(|x| x as f32);
-    for (e, el) in mesh.elements.iter().enumerate() {
-        let c = el.corners();
-        let eb = f(element_b[e]);
-        let tris: &[[usize; 3]] = if el.is_quad() {
-            &[[0, 1, 2], [0, 2, 3]]
-        } else {
-            &[[0, 1, 2]]
-        };
-        for corners in tris {
-            for &k in corners {
-                let vb = vertex_b.get(c[k] as usize).map_or(eb, |&b| f(b));
+    for (e, &b) in element_b.iter().enumerate().take(mesh.len()) {
+        let eb = f(b);
+        for t in display.triangles(e) {
+            for &v in &t.vertices {
+                let vb = vertex_b.get(v as usize).map_or(eb, |&b| f(b));
                 out.push(ColourVertex {
                     vertex_b: vb,
                     element_b: eb,
@@ -183,8 +177,26 @@ pub fn colour_vertices(
     out
 }
 
+/// Per surface of `scene`, true when it lies on another ([`radiosity::scene::lying_on`]: a
+/// rug in or just above a floor). The shader draws these a hundred-thousandth of their
+/// distance nearer the eye, so that where a depth buffer cannot separate them from the
+/// surface below (in its plane, or the pieces straddling their outline that contact
+/// refinement keeps) they win, instead of flickering through it.
+pub fn on_top_surfaces(scene: &Scene) -> Vec<bool> {
+    let mut on_top = vec![false; scene.surfaces.len()];
+    let bvh = radiosity::visibility::PolygonBvh::over_surfaces(scene);
+    for o in radiosity::scene::lying_on(scene, &bvh) {
+        on_top[o.upper as usize] = true;
+    }
+    on_top
+}
+
 /// The view-projection matrix of `camera` (wgpu clip space: depth in [0, 1]) for a scene
 /// with bounding box `bounds`: the near and far planes enclose the box as seen from the eye.
+/// Depth is reversed, 1 at the near plane and 0 at the far one, so that with a float depth
+/// buffer its precision is relative (some 1e-7 of the distance) at every distance: with depth
+/// 0 at the near plane, a rug 5 mm above a floor 5 m away was within one step of it and
+/// flickered through.
 pub fn view_projection(camera: &Camera, bounds: (DVec3, DVec3)) -> DMat4 {
     let (lo, hi) = bounds;
     let (forward, _, up) = camera.basis();
@@ -211,13 +223,13 @@ pub fn view_projection(camera: &Camera, bounds: (DVec3, DVec3)) -> DMat4 {
         DVec4::new(right.z, up.z, -forward.z, 0.0),
         DVec4::new(-right.dot(e), -up.dot(e), forward.dot(e), 1.0),
     );
-    // Perspective with depth 0 at `near` and 1 at `far` (wgpu's clip space).
+    // Perspective with depth 1 at `near` and 0 at `far` (reversed, in wgpu's clip space).
     let h = 1.0 / (0.5 * camera.fov_y_degrees.to_radians()).tan();
     let proj = DMat4::from_cols(
         DVec4::new(h / aspect, 0.0, 0.0, 0.0),
         DVec4::new(0.0, h, 0.0, 0.0),
-        DVec4::new(0.0, 0.0, far / (near - far), -1.0),
-        DVec4::new(0.0, 0.0, near * far / (near - far), 0.0),
+        DVec4::new(0.0, 0.0, near / (far - near), -1.0),
+        DVec4::new(0.0, 0.0, near * far / (far - near), 0.0),
     );
     proj * view
 }
@@ -432,7 +444,8 @@ impl MeshRenderer {
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
                 depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
+                // Reversed depth (see `view_projection`): nearer is greater.
+                depth_compare: Some(wgpu::CompareFunction::Greater),
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
@@ -461,9 +474,9 @@ impl MeshRenderer {
         }
     }
 
-    /// Uploads the mesh's triangles (once per mesh).
-    pub fn set_mesh(&mut self, device: &wgpu::Device, mesh: &Mesh) {
-        self.set_triangles(device, &geometry_vertices(mesh), mesh_bounds(mesh));
+    /// Uploads the mesh's triangles (once per mesh); `on_top` as for [`geometry_vertices`].
+    pub fn set_mesh(&mut self, device: &wgpu::Device, mesh: &Mesh, on_top: &[bool]) {
+        self.set_triangles(device, &geometry_vertices(mesh, on_top), mesh_bounds(mesh));
     }
 
     /// Uploads triangles given as vertices (three per triangle; see [`geometry_vertices`])
@@ -557,7 +570,7 @@ impl MeshRenderer {
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &target.depth_view,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: wgpu::LoadOp::Clear(0.0),
                     store: wgpu::StoreOp::Discard,
                 }),
                 stencil_ops: None,
@@ -681,8 +694,22 @@ impl Headless {
         camera: &Camera,
         style: &Style,
     ) -> Result<image::RgbaImage, GpuError> {
+        self.render_with_on_top(mesh, &[], element_b, vertex_b, camera, style)
+    }
+
+    /// [`Headless::render`] with the surfaces flagged in `on_top` drawn as lying on others
+    /// (see [`geometry_vertices`]), as the window draws them.
+    pub fn render_with_on_top(
+        &self,
+        mesh: &Mesh,
+        on_top: &[bool],
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        camera: &Camera,
+        style: &Style,
+    ) -> Result<image::RgbaImage, GpuError> {
         let mut renderer = MeshRenderer::new(&self.device);
-        renderer.set_mesh(&self.device, mesh);
+        renderer.set_mesh(&self.device, mesh, on_top);
         renderer.set_colours(
             &self.device,
             &self.queue,
@@ -702,15 +729,81 @@ mod tests {
     use radiosity::scene::cornell_box;
 
     #[test]
+    fn refined_room_has_no_t_junctions_in_its_triangles() {
+        // The room's floor is split round the furniture three levels deep next to whole
+        // elements. No triangle the viewer draws may have a vertex of its own surface inside
+        // one of its edges (a T-junction: the rasteriser leaves pinholes along such an
+        // edge). Checked by brute force over every edge and vertex of each surface.
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/room.scene");
+        let file = radiosity::io::scene_file::read_scene(&path).unwrap();
+        let grid = radiosity::mesh::mesh_scene(&file.scene, file.settings.max_patch_area).unwrap();
+        let bvh = radiosity::visibility::PolygonBvh::over_surfaces(&file.scene);
+        let (mesh, report) = radiosity::mesh::refine_contacts(&grid, &file.scene, &bvh);
+        assert!(report.split > 0, "{report:?}");
+        let v = geometry_vertices(&mesh, &[]);
+        assert_eq!(v.len(), 3 * triangle_elements(&mesh).len());
+        let mut checked = 0;
+        for s in 0..file.scene.surfaces.len() {
+            let points: Vec<glam::Vec3> = mesh.surface_vertices[s]
+                .clone()
+                .map(|i| mesh.vertices[i as usize].as_vec3())
+                .collect();
+            for t in v.chunks_exact(3).filter(|t| (t[0].info >> 4) as usize == s) {
+                for k in 0..3 {
+                    let a = glam::Vec3::from(t[k].position);
+                    let b = glam::Vec3::from(t[(k + 1) % 3].position);
+                    let ab = b - a;
+                    for &p in &points {
+                        let u = (p - a).dot(ab) / ab.length_squared();
+                        // Strictly inside the edge, within f32 rounding of it (positions
+                        // of a few metres: 1e-6 m is ten times their rounding).
+                        if u > 1e-4 && u < 1.0 - 1e-4 {
+                            let off = (p - (a + u * ab)).length();
+                            assert!(off > 1e-6, "surface {s}: {p} lies on the edge {a} - {b}");
+                        }
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked}");
+    }
+
+    #[test]
     fn quads_are_two_triangles_without_the_diagonal_in_wireframe() {
         let file = cornell_box();
         let mesh = radiosity::mesh::mesh_scene(&file.scene, file.settings.max_patch_area).unwrap();
-        let v = geometry_vertices(&mesh);
+        let v = geometry_vertices(&mesh, &[]);
         assert_eq!(v.len(), 3 * triangle_elements(&mesh).len());
         let quads = mesh.elements.iter().filter(|e| e.is_quad()).count();
         assert_eq!(v.len(), 3 * (mesh.len() + quads));
         let c = colour_vertices(&mesh, &vec![[1.0; 3]; mesh.len()], &[]);
         assert_eq!(c.len(), v.len());
+    }
+
+    #[test]
+    fn depth_separates_a_rug_5_mm_above_a_floor_5_m_away() {
+        // The room's case: eye 5 m from a floor, a rug 5 mm nearer, a scene 10 m across.
+        // In f32, as the shader computes it, the two depths must differ by many steps of the
+        // depth buffer's float (here at least 100 ulps), and the nearer must be greater.
+        let cam = Camera {
+            eye: DVec3::ZERO,
+            look_at: DVec3::new(0.0, 0.0, -1.0),
+            up: DVec3::Y,
+            fov_y_degrees: 60.0,
+            width: 64,
+            height: 64,
+        };
+        let m = view_projection(&cam, (DVec3::splat(-5.0), DVec3::splat(5.0))).as_mat4();
+        let depth = |d: f32| {
+            let c = m * glam::Vec4::new(0.0, 0.0, -d, 1.0);
+            c.z / c.w
+        };
+        let (floor, rug) = (depth(5.0), depth(4.995));
+        assert!(rug > floor, "{rug} {floor}");
+        let ulps = rug.to_bits() as i64 - floor.to_bits() as i64;
+        assert!(ulps >= 100, "{ulps} steps between {rug} and {floor}");
     }
 
     #[test]

@@ -3,7 +3,11 @@
 //! [`vertex_radiosity`] gives each mesh vertex the area-weighted mean radiosity of the
 //! elements that have it as a corner. The paper averages the (up to four) coplanar
 //! neighbours of a quadrilateral patch's corner; this is the same rule for any conforming
-//! mesh of triangles and quadrilaterals. Vertices belong to one surface each (see
+//! mesh of triangles and quadrilaterals. On a mesh with T-junctions (quadtree refinement) a
+//! vertex that lies inside another element's edge (a T-vertex) counts that element as one of
+//! its own: the averaging runs over display polygons ([`crate::mesh::DisplayPolygons`]), so
+//! the value at a T-vertex is the one every element touching it interpolates, and smooth
+//! shading is continuous across the edge. Vertices belong to one surface each (see
 //! [`crate::mesh`]), so the averaging never crosses a surface boundary and smooth shading
 //! has no seams inside a surface.
 //!
@@ -15,7 +19,9 @@ use crate::mesh::Mesh;
 pub use crate::render::tonemap::{encode, expose, tone_map, Exposure, GammaEncoder};
 
 /// The radiosity at every vertex of `mesh`: the area-weighted mean of `element_b` over the
-/// elements that have the vertex as a corner (paper 2.5's neighbour averaging, generalised).
+/// elements that touch the vertex, as a corner or with the vertex inside one of their edges
+/// (a T-vertex: it is a corner of their display polygons, [`Mesh::display`]) (paper 2.5's
+/// neighbour averaging, generalised).
 ///
 /// Element areas are the weights, so on a regular grid an interior vertex gets the plain
 /// mean of its four elements, and a field linear in position is reproduced exactly there.
@@ -33,8 +39,9 @@ pub fn vertex_radiosity(mesh: &Mesh, element_b: &[[f64; 3]]) -> Vec<[f64; 3]> {
     );
     let mut sum = vec![[0.0f64; 3]; mesh.vertices.len()];
     let mut weight = vec![0.0f64; mesh.vertices.len()];
-    for (el, b) in mesh.elements.iter().zip(element_b) {
-        for &v in el.corners() {
+    let display = mesh.display();
+    for (e, (el, b)) in mesh.elements.iter().zip(element_b).enumerate() {
+        for &v in display.polygon(e) {
             let v = v as usize;
             weight[v] += el.area;
             for k in 0..3 {

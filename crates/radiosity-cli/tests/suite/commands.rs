@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::fixtures::{example, radiosity, scratch_dir, stderr};
+use crate::fixtures::{example, radiosity, scratch_dir, stderr, stdout};
 
 #[test]
 fn render_writes_png_of_requested_size() {
@@ -682,5 +682,67 @@ fn adapt_rounds_refine_the_mesh_and_refuse_a_form_factor_file() {
         "{}",
         stderr(&refused)
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A 4 x 4 floor, a 2 x 1 rug `lift` above it and a light panel over them, as a scene file.
+fn floor_and_rug_scene(lift: f64) -> String {
+    let patch = |name: &str, e: f64, corners: [[f64; 3]; 4]| {
+        let mut text = format!("PATCHBEGIN\n#{name}\nVERTICES 4\nEr {e}\nEg {e}\nEb {e}\n");
+        text += "Rr 0.5\nRg 0.5\nRb 0.5\n";
+        for (i, [x, y, z]) in corners.iter().enumerate() {
+            text += &format!("VERTEX{i} {x} {y} {z}\n");
+        }
+        text + "PATCHEND\n"
+    };
+    let y = lift;
+    let mut text = String::from("MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\n");
+    text += &patch(
+        "Floor",
+        0.0,
+        [[4., 0., 0.], [0., 0., 0.], [0., 0., 4.], [4., 0., 4.]],
+    );
+    text += &patch(
+        "Rug",
+        0.0,
+        [[3., y, 1.], [1., y, 1.], [1., y, 2.], [3., y, 2.]],
+    );
+    text += &patch(
+        "Light",
+        10.0,
+        [[1., 2., 1.], [3., 2., 1.], [3., 2., 3.], [1., 2., 3.]],
+    );
+    text + "SCENEEND\n"
+}
+
+#[test]
+fn check_lists_surfaces_lying_on_others() {
+    // Issue #11: a rug exactly in the floor's plane, or 1e-4 above it, is reported by
+    // index and name, and the floor under it is left out: the total area is the floor's 16
+    // + the rug's 2 + the light's 4, less the 2 under the rug (the rug's outline lies on the
+    // lines of the floor's 1 x 1 grid: nothing is split, so this is exact to rounding).
+    let dir = scratch_dir("lying_on");
+    for (lift, same_plane) in [(0.0, 1), (1e-4, 0)] {
+        let path = dir.join(format!("rug_{lift}.scene"));
+        std::fs::write(&path, floor_and_rug_scene(lift)).unwrap();
+        let out = radiosity(&["check", path.to_str().unwrap()], &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = stdout(&out);
+        let note = format!("1 surface(s) lie on others ({same_plane} in the same plane)");
+        assert!(text.contains(&note), "lift {lift}:\n{text}");
+        assert!(
+            text.contains("surface 1 \"Rug\" on surface 0 \"Floor\""),
+            "lift {lift}:\n{text}"
+        );
+        let area: f64 = text
+            .lines()
+            .find_map(|l| l.strip_prefix("total area"))
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap();
+        assert!(
+            (area - 20.0).abs() < 1e-9,
+            "lift {lift}: total area {area}\n{text}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -17,6 +17,10 @@
 //! grid instead of cutting along the exact outline: after three levels the pieces that still
 //! straddle the outline are 1/8 of an element across.
 //!
+//! A point is also buried when a surface lying on its own (a rug in the floor's plane or a
+//! hair above it, [`crate::scene::lying_on`]) covers it: the rays start above the plane and
+//! cannot see such a cover.
+//!
 //! A point is buried when all but [`PROBE_SLACK`] of [`PROBE_DIRECTIONS`] rays from it (the
 //! normal and six directions 60 degrees from it) first hit the back of a face. Only elements with another
 //! surface nearby in front of them are probed (a box query), so the cost is the contacts',
@@ -103,12 +107,12 @@ pub fn refine_contacts(
             if !probe.has_cover_nearby(el.surface, &corners, el.normal) {
                 return None;
             }
-            match probe.cover(&corners, el.normal) {
+            match probe.cover(el.surface, &corners, el.normal) {
                 Cover::Open => None,
                 Cover::Buried => Some(Vec::new()),
                 Cover::Partly => {
                     let mut pieces = Vec::new();
-                    probe.split_into(corners, el.normal, 1, &mut pieces);
+                    probe.split_into(el.surface, corners, el.normal, 1, &mut pieces);
                     Some(pieces)
                 }
             }
@@ -147,6 +151,9 @@ struct Probe<'a> {
     /// How far above a surface the rays start: far below any gap worth resolving, far above
     /// rounding (1e-7 of the scene's size).
     lift: f64,
+    /// Per surface, the surfaces that lie on it ([`crate::scene::lying_on`]: in its plane or
+    /// a hair above it, where the rays cannot see them): a point under one is buried.
+    covers: Vec<Vec<u32>>,
 }
 
 impl<'a> Probe<'a> {
@@ -164,7 +171,22 @@ impl<'a> Probe<'a> {
                 .map(|s| s.vertices.as_slice())
                 .collect(),
             lift: 1e-7 * occluders.scale(),
+            covers: {
+                let mut covers = vec![Vec::new(); scene.surfaces.len()];
+                for o in crate::scene::lying_on(scene, occluders) {
+                    covers[o.lower as usize].push(o.upper);
+                }
+                covers
+            },
         }
+    }
+
+    /// True when a surface lying on `surface` covers the point `p` of it.
+    fn under_cover(&self, surface: u32, p: DVec3) -> bool {
+        let n = self.normals[surface as usize];
+        self.covers[surface as usize]
+            .iter()
+            .any(|&t| crate::scene::overlap::covers(self.polygons[t as usize], n, p))
     }
 
     /// True when another surface reaches within a twentieth of the element's size of it and
@@ -186,6 +208,19 @@ impl<'a> Probe<'a> {
             hi + DVec3::splat(reach),
             &mut candidates,
         );
+        // A surface lying on this one, whose box reaches the element's.
+        let covered = self.covers[surface as usize].iter().any(|&t| {
+            let (mut clo, mut chi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for &v in self.polygons[t as usize] {
+                clo = clo.min(v);
+                chi = chi.max(v);
+            }
+            (clo - DVec3::splat(reach)).cmple(hi).all()
+                && (chi + DVec3::splat(reach)).cmpge(lo).all()
+        });
+        if covered {
+            return true;
+        }
         let origin = corners[0];
         candidates.into_iter().any(|k| {
             let s = self.occluders.id_of(k);
@@ -223,9 +258,9 @@ impl<'a> Probe<'a> {
         })
     }
 
-    /// How much of the piece `corners` (3 or 4 corners) is buried, judged at
-    /// its 4 x 4 sample points.
-    fn cover(&self, corners: &[DVec3], normal: DVec3) -> Cover {
+    /// How much of the piece `corners` (3 or 4 corners) of `surface` is buried, judged at
+    /// its 4 x 4 sample points: under a surface lying on it, or by the probe rays.
+    fn cover(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> Cover {
         let k = PROBE_GRID;
         let mut points = Vec::with_capacity((k * k) as usize);
         if corners.len() == 4 {
@@ -242,7 +277,7 @@ impl<'a> Probe<'a> {
         }
         let (mut buried, mut open) = (false, false);
         for p in points {
-            if self.buried(p, normal) {
+            if self.under_cover(surface, p) || self.buried(p, normal) {
                 buried = true;
             } else {
                 open = true;
@@ -263,17 +298,18 @@ impl<'a> Probe<'a> {
     /// buried and `level` is below [`CONTACT_DEPTH`].
     fn split_into(
         &self,
+        surface: u32,
         corners: Vec<DVec3>,
         normal: DVec3,
         level: u32,
         out: &mut Vec<Vec<DVec3>>,
     ) {
         for child in quarters(&corners) {
-            match self.cover(&child, normal) {
+            match self.cover(surface, &child, normal) {
                 Cover::Open => out.push(child),
                 Cover::Buried => {}
                 Cover::Partly if level >= CONTACT_DEPTH => out.push(child),
-                Cover::Partly => self.split_into(child, normal, level + 1, out),
+                Cover::Partly => self.split_into(surface, child, normal, level + 1, out),
             }
         }
     }
@@ -394,6 +430,43 @@ mod tests {
         let (mesh, _) = refine(&scene);
         let kept = floor_area(&mesh);
         assert!(kept >= 14.0 && kept <= 14.0 + 6.0 / 8.0, "{kept}");
+    }
+
+    #[test]
+    fn a_rug_in_the_floors_plane_or_a_hair_above_it_buries_what_it_covers() {
+        // Floor [0, 4]^2 (1 x 1 elements) and a rug over [0.5, 2.5] x [1, 2], exactly in the
+        // floor's plane or 1e-4 above it (there the probe rays' BVH skips boxes a ray leaves
+        // within 1e-4 of its origin). The rug covers 2 m^2, on dyadic lines of the grid at
+        // level 1: the floor keeps exactly 16 - 2 = 14 m^2.
+        for lift in [0.0, 1e-4] {
+            let quad = |x0: f64, x1: f64, z0: f64, z1: f64, y: f64| {
+                vec![
+                    dvec3(x0, y, z0),
+                    dvec3(x0, y, z1),
+                    dvec3(x1, y, z1),
+                    dvec3(x1, y, z0),
+                ]
+            };
+            let scene = Scene {
+                surfaces: vec![
+                    surface("floor", quad(0., 4., 0., 4., 0.)),
+                    surface("rug", quad(0.5, 2.5, 1., 2., lift)),
+                ],
+                camera: None,
+            };
+            let (mesh, report) = refine(&scene);
+            assert!(
+                (floor_area(&mesh) - 14.0).abs() < 1e-9,
+                "lift {lift}: floor {} ({report:?})",
+                floor_area(&mesh)
+            );
+            // The rug itself is whole.
+            let rug: f64 = mesh.surface_elements[1]
+                .clone()
+                .map(|e| mesh.elements[e as usize].area)
+                .sum();
+            assert!((rug - 2.0).abs() < 1e-12, "lift {lift}: rug {rug}");
+        }
     }
 
     #[test]

@@ -15,9 +15,13 @@
 //! is geometry and materials only.
 
 mod adapt;
+mod conforming;
 mod contact;
 
 pub use adapt::{mark_steps, split_marked, AdaptSettings, Origin};
+#[cfg(test)]
+pub(crate) use conforming::split_corner_mesh;
+pub use conforming::{DisplayPolygons, DisplayTriangle};
 pub use contact::{
     refine_contacts, ContactReport, CONTACT_DEPTH, CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS,
     PROBE_SLACK,
@@ -25,6 +29,7 @@ pub use contact::{
 
 use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::OnceLock;
 
 use glam::DVec3;
 
@@ -83,6 +88,8 @@ pub struct Mesh {
     pub surface_vertices: Vec<Range<u32>>,
     neighbour_offsets: Vec<u32>,
     neighbour_list: Vec<u32>,
+    /// The display polygons, found on first use ([`Mesh::display`]).
+    display: OnceLock<DisplayPolygons>,
 }
 
 /// Meshing cannot proceed.
@@ -386,6 +393,13 @@ impl Mesh {
             .corners()
             .iter()
             .map(|&v| self.vertices[v as usize])
+    }
+
+    /// Every element's display polygon (its corners and the T-vertices on its edges) and
+    /// triangles, found on the first call (see [`DisplayPolygons`]). Smooth shading, the
+    /// renderer and the viewer draw these, so that a mesh with T-junctions shows no seams.
+    pub fn display(&self) -> &DisplayPolygons {
+        self.display.get_or_init(|| DisplayPolygons::new(self))
     }
 
     /// The elements that share an edge with element `e` on the same surface.

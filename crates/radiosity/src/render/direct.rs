@@ -42,6 +42,7 @@ use std::sync::OnceLock;
 
 use glam::DVec3;
 
+use super::renderer::Interpolation;
 use crate::form_factor::exact::point_to_polygon;
 use crate::geometry;
 use crate::light::Rgb;
@@ -260,7 +261,8 @@ pub struct DirectCorrection<'m> {
     mesh: &'m Mesh,
     /// Reflectance per surface.
     reflectance: Vec<Rgb>,
-    /// Per vertex, the elements that have it as a corner (CSR offsets and list).
+    /// Per vertex, the elements that touch it (have it as a corner of their display polygon,
+    /// T-vertices included: the rule of `vertex_radiosity`), as CSR offsets and list.
     vertex_offsets: Vec<u32>,
     vertex_elements: Vec<u32>,
     /// Per element, its average direct irradiance, once computed.
@@ -272,9 +274,10 @@ pub struct DirectCorrection<'m> {
 impl<'m> DirectCorrection<'m> {
     /// The correction for `mesh`, which was cut from `scene`.
     pub fn new(scene: &Scene, mesh: &'m Mesh) -> DirectCorrection<'m> {
+        let display = mesh.display();
         let mut counts = vec![0u32; mesh.vertices.len() + 1];
-        for el in &mesh.elements {
-            for &c in el.corners() {
+        for e in 0..mesh.len() {
+            for &c in display.polygon(e) {
                 counts[c as usize + 1] += 1;
             }
         }
@@ -283,8 +286,8 @@ impl<'m> DirectCorrection<'m> {
         }
         let mut fill = counts.clone();
         let mut list = vec![0u32; counts[mesh.vertices.len()] as usize];
-        for (e, el) in mesh.elements.iter().enumerate() {
-            for &c in el.corners() {
+        for e in 0..mesh.len() {
+            for &c in display.polygon(e) {
                 list[fill[c as usize] as usize] = e as u32;
                 fill[c as usize] += 1;
             }
@@ -342,17 +345,17 @@ impl<'m> DirectCorrection<'m> {
         })
     }
 
-    /// The correction at `x` on element `e`, whose corners have the interpolation weights
-    /// `weights` (as smooth shading uses them); `salt` jitters the shadow rays' strata (the
+    /// The correction at `x` on element `e`, where smooth shading interpolates the vertices
+    /// and weights `weights` (see [`super::renderer::interpolation`]); `salt` jitters the shadow rays' strata (the
     /// renderer passes the pixel's index).
-    pub fn at(&self, e: usize, x: DVec3, weights: &[f64], salt: u64) -> Rgb {
+    pub fn at(&self, e: usize, x: DVec3, weights: &Interpolation, salt: u64) -> Rgb {
         let el = &self.mesh.elements[e];
         let rho = self.reflectance[el.surface as usize];
         if rho.max_band() <= 0.0 || self.light.is_empty() {
             return Rgb::default();
         }
         let mut smooth = Rgb::default();
-        for (&c, &w) in el.corners().iter().zip(weights) {
+        for (c, w) in weights.pairs() {
             smooth += self.vertex(c as usize) * w;
         }
         let here = self.light.irradiance(x, el.normal, salt);
@@ -448,7 +451,8 @@ mod tests {
         let s = scene(vec![floor, light]);
         let mesh = crate::mesh::mesh_scene(&s, 0.01).unwrap();
         let c = DirectCorrection::new(&s, &mesh);
-        let d = c.at(0, mesh.elements[0].centroid, &[0.25; 4], 0);
+        let x = mesh.elements[0].centroid;
+        let d = c.at(0, x, &crate::render::interpolation(&mesh, 0, x), 0);
         // D is about 1 (the light nearly fills the hemisphere); rho = 0.5.
         assert!(d[0].abs() < 1e-3, "{d:?}");
     }

@@ -36,7 +36,9 @@ pub mod tonemap;
 pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
 pub use direct::{DirectCorrection, DirectLight, COARSE_RAYS};
 pub use film::{sample_offset, Film, FilmContent};
-pub use renderer::{barycentric, inverse_bilinear, Renderer, Shading};
+pub use renderer::{
+    barycentric, interpolation, inverse_bilinear, Interpolation, Renderer, Shading,
+};
 
 /// The PNG writer, at the path the command line uses; it lives in [`crate::io::png`].
 pub use crate::io::png::write_png;

@@ -53,7 +53,7 @@ pub struct Renderer<'m> {
     /// Bounding box of all vertices (min, max).
     bounds: (DVec3, DVec3),
     /// Per element, bit i set when edge i (corner i to corner i + 1) is on the boundary of
-    /// its surface (no other element shares it).
+    /// its surface (no other element lies beyond it, whole or in pieces).
     boundary_edges: Vec<u8>,
     /// Smooth shading's direct light gathered per ray, when asked for
     /// ([`Renderer::with_direct_light`]).
@@ -71,24 +71,40 @@ impl<'m> Renderer<'m> {
             lo = lo.min(*v);
             hi = hi.max(*v);
         }
-        let edge = |el: &crate::mesh::Element, i: usize| {
-            let c = el.corners();
-            let (a, b) = (c[i], c[(i + 1) % c.len()]);
+        // Edges of the display polygons (T-vertices included), so that an element's edge
+        // with smaller elements on its far side is not taken for the surface's boundary.
+        let display = mesh.display();
+        let edge = |polygon: &[u32], k: usize| {
+            let (a, b) = (polygon[k], polygon[(k + 1) % polygon.len()]);
             (a.min(b), a.max(b))
         };
         let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
-        for el in &mesh.elements {
-            for i in 0..el.corners().len() {
-                *uses.entry(edge(el, i)).or_default() += 1;
+        for e in 0..mesh.len() {
+            let polygon = display.polygon(e);
+            for k in 0..polygon.len() {
+                *uses.entry(edge(polygon, k)).or_default() += 1;
             }
         }
         let boundary_edges = mesh
             .elements
             .iter()
-            .map(|el| {
-                (0..el.corners().len())
-                    .filter(|&i| uses[&edge(el, i)] == 1)
-                    .fold(0u8, |m, i| m | (1 << i))
+            .enumerate()
+            .map(|(e, el)| {
+                // Element edge i starts at corner i; its first display edge says whether
+                // another element lies beyond it.
+                let polygon = display.polygon(e);
+                let corners = el.corners();
+                let mut mask = 0u8;
+                let mut i = 0;
+                for k in 0..polygon.len() {
+                    if i < corners.len() && polygon[k] == corners[i] {
+                        if uses[&edge(polygon, k)] == 1 {
+                            mask |= 1 << i;
+                        }
+                        i += 1;
+                    }
+                }
+                mask
             })
             .collect();
         Renderer {
@@ -108,7 +124,7 @@ impl<'m> Renderer<'m> {
         scene: &Scene,
         settings: &super::RenderSettings,
     ) -> Renderer<'m> {
-        let mut renderer = Renderer::new(mesh);
+        let mut renderer = Renderer::new(mesh).with_surfaces_on_top(scene);
         if settings.direct_light {
             renderer = renderer.with_direct_light(scene);
         }
@@ -121,6 +137,40 @@ impl<'m> Renderer<'m> {
     /// The mesh being rendered.
     pub fn mesh(&self) -> &'m Mesh {
         self.mesh
+    }
+
+    /// From now on a ray that meets a surface of `scene` (from which the mesh was cut) and
+    /// one lying on it ([`crate::scene::lying_on`]: a rug in the floor's plane) at the same
+    /// distance sees the one on top: the elements of the surfaces on top are found as if
+    /// [`crate::scene::overlap::SAME_PLANE_GAP`] of the scene's size in front of their plane
+    /// (1e-7: far above the rounding of a ray's distance, far below a pixel). Without it, a
+    /// mesh that keeps the floor under the rug (hierarchical radiosity's leaves) shows the
+    /// floor through the rug wherever rounding picks it.
+    pub fn with_surfaces_on_top(mut self, scene: &Scene) -> Renderer<'m> {
+        let occluders = PolygonBvh::over_surfaces(scene);
+        let pairs = crate::scene::lying_on(scene, &occluders);
+        if pairs.is_empty() {
+            return self;
+        }
+        let mut on_top = vec![false; scene.surfaces.len()];
+        for o in &pairs {
+            on_top[o.upper as usize] = true;
+        }
+        let lift = crate::scene::overlap::SAME_PLANE_GAP * occluders.scale();
+        let polygons: Vec<Vec<DVec3>> = (0..self.mesh.len())
+            .map(|e| {
+                let el = &self.mesh.elements[e];
+                let up = if on_top.get(el.surface as usize) == Some(&true) {
+                    lift * el.normal
+                } else {
+                    DVec3::ZERO
+                };
+                self.mesh.corner_positions(e).map(|p| p + up).collect()
+            })
+            .collect();
+        let ids: Vec<u32> = (0..self.mesh.len() as u32).collect();
+        self.bvh = PolygonBvh::new(&polygons, &ids);
+        self
     }
 
     /// Smooth shading from now on gathers the direct light of `scene` (from which the mesh
@@ -318,34 +368,16 @@ impl<'m> Renderer<'m> {
         let value = match shading {
             Shading::Flat => element_b[e],
             Shading::Smooth => {
-                // Interpolation weights of the element's corners at x (no allocation: this
-                // runs once per ray).
-                let c = el.corners();
-                let mut p = [DVec3::ZERO; 4];
-                for (slot, v) in p.iter_mut().zip(self.mesh.corner_positions(e)) {
-                    *slot = v;
-                }
-                let weights: [f64; 4] = if el.is_quad() {
-                    let (u, v) = inverse_bilinear(&p, x);
-                    [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v]
-                } else {
-                    let w = barycentric(&p[..3], x);
-                    [w[0], w[1], w[2], 0.0]
-                };
-                let mut sum = [0.0; 3];
-                for (i, &w) in weights.iter().enumerate().take(c.len()) {
-                    let b = vertex_b[c[i] as usize];
-                    for k in 0..3 {
-                        sum[k] += w * b[k];
+                // Interpolation weights at x (no allocation: this runs once per ray).
+                let weights = interpolation(self.mesh, e, x);
+                let sum = weights.of(vertex_b);
+                match &self.direct {
+                    Some(direct) => {
+                        let d = direct.at(e, x, &weights, salt);
+                        std::array::from_fn(|k| (sum[k] + d[k]).max(0.0))
                     }
+                    None => sum,
                 }
-                if let Some(direct) = &self.direct {
-                    let d = direct.at(e, x, &weights[..c.len()], salt);
-                    for k in 0..3 {
-                        sum[k] = (sum[k] + d[k]).max(0.0);
-                    }
-                }
-                sum
             }
             Shading::Wireframe => {
                 // A shared edge is drawn from both of its elements, half a pixel into each;
@@ -394,6 +426,86 @@ fn segment_distance(x: DVec3, a: DVec3, b: DVec3) -> f64 {
         0.0
     };
     (x - (a + s * ab)).length()
+}
+
+/// The vertices smooth shading interpolates at a point of an element, with their weights
+/// (non-negative, summing to 1): up to four, see [`interpolation`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interpolation {
+    vertices: [u32; 4],
+    weights: [f64; 4],
+    len: usize,
+}
+
+impl Interpolation {
+    /// The (vertex index, weight) pairs.
+    pub fn pairs(&self) -> impl Iterator<Item = (u32, f64)> + '_ {
+        self.vertices[..self.len]
+            .iter()
+            .copied()
+            .zip(self.weights[..self.len].iter().copied())
+    }
+
+    /// The weighted sum of the per-vertex values `vertex_b` (one per mesh vertex).
+    pub fn of(&self, vertex_b: &[[f64; 3]]) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for (v, w) in self.pairs() {
+            let b = vertex_b[v as usize];
+            for k in 0..3 {
+                sum[k] += w * b[k];
+            }
+        }
+        sum
+    }
+}
+
+/// Smooth shading's interpolation at the point `x` of element `e` (paper 2.5): bilinear in
+/// the corners of a quadrilateral ([`inverse_bilinear`]), barycentric in those of a triangle;
+/// on an element with T-vertices on its edges ([`Mesh::display`]), barycentric in the display
+/// triangle that holds x, so that along an edge the value runs linearly between consecutive
+/// display vertices, as it does on the smaller elements on the other side (no seam).
+pub fn interpolation(mesh: &Mesh, e: usize, x: DVec3) -> Interpolation {
+    let el = &mesh.elements[e];
+    let c = el.corners();
+    let display = mesh.display();
+    let mut out = Interpolation {
+        vertices: [0; 4],
+        weights: [0.0; 4],
+        len: 0,
+    };
+    if display.polygon(e).len() == c.len() {
+        let mut p = [DVec3::ZERO; 4];
+        for (slot, v) in p.iter_mut().zip(mesh.corner_positions(e)) {
+            *slot = v;
+        }
+        out.weights = if el.is_quad() {
+            let (u, v) = inverse_bilinear(&p, x);
+            [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v]
+        } else {
+            let w = barycentric(&p[..3], x);
+            [w[0], w[1], w[2], 0.0]
+        };
+        out.vertices[..c.len()].copy_from_slice(c);
+        out.len = c.len();
+        return out;
+    }
+    // The display triangle that holds x: the one whose smallest barycentric weight is
+    // largest (x may lie a rounding error outside every triangle, on an edge).
+    let mut best = (f64::NEG_INFINITY, [DVec3::ZERO; 3], [0u32; 3]);
+    for t in display.triangles(e) {
+        let p = t.vertices.map(|v| mesh.vertices[v as usize]);
+        if let Some(w) = barycentric_unclamped(&p, x) {
+            let least = w[0].min(w[1]).min(w[2]);
+            if least > best.0 {
+                best = (least, p, t.vertices);
+            }
+        }
+    }
+    let w = barycentric(&best.1, x);
+    out.vertices[..3].copy_from_slice(&best.2);
+    out.weights[..3].copy_from_slice(&w);
+    out.len = 3;
+    out
 }
 
 /// The parameters (u, v) in [0, 1]^2 at which the bilinear patch with corners `q`
@@ -462,22 +574,31 @@ pub fn inverse_bilinear(q: &[DVec3], p: DVec3) -> (f64, f64) {
 /// triangle's plane), clamped to be non-negative and renormalised to sum to 1, so a point
 /// just outside maps to the nearest edge.
 pub fn barycentric(t: &[DVec3], p: DVec3) -> [f64; 3] {
-    let (v0, v1, v2) = (t[1] - t[0], t[2] - t[0], p - t[0]);
-    let (d00, d01, d11) = (v0.dot(v0), v0.dot(v1), v1.dot(v1));
-    let (d20, d21) = (v2.dot(v0), v2.dot(v1));
-    let denom = d00 * d11 - d01 * d01;
-    if denom == 0.0 {
+    let Some(w) = barycentric_unclamped(t, p) else {
         return [1.0 / 3.0; 3];
-    }
-    let w1 = (d11 * d20 - d01 * d21) / denom;
-    let w2 = (d00 * d21 - d01 * d20) / denom;
-    let w = [(1.0 - w1 - w2).max(0.0), w1.max(0.0), w2.max(0.0)];
+    };
+    let w = w.map(|x| x.max(0.0));
     let s = w[0] + w[1] + w[2];
     if s > 0.0 {
         w.map(|x| x / s)
     } else {
         [1.0 / 3.0; 3]
     }
+}
+
+/// The barycentric weights of (the projection of) `p` in triangle `t`, negative outside it;
+/// `None` for a triangle of no area.
+fn barycentric_unclamped(t: &[DVec3], p: DVec3) -> Option<[f64; 3]> {
+    let (v0, v1, v2) = (t[1] - t[0], t[2] - t[0], p - t[0]);
+    let (d00, d01, d11) = (v0.dot(v0), v0.dot(v1), v1.dot(v1));
+    let (d20, d21) = (v2.dot(v0), v2.dot(v1));
+    let denom = d00 * d11 - d01 * d01;
+    if denom == 0.0 {
+        return None;
+    }
+    let w1 = (d11 * d20 - d01 * d21) / denom;
+    let w2 = (d00 * d21 - d01 * d20) / denom;
+    Some([1.0 - w1 - w2, w1, w2])
 }
 
 #[cfg(test)]
@@ -533,6 +654,117 @@ mod tests {
         // Outside points clamp onto the quad.
         let (u, v) = inverse_bilinear(&quads[0], dvec3(1.5, -0.5, 0.0));
         assert_eq!((u, v), (1.0, 0.0));
+    }
+
+    #[test]
+    fn smooth_shading_is_continuous_across_a_t_edge() {
+        // (b) The 2 x 2 grid with its lower left quad split in four: along the T-edge x = 1,
+        // y in [0, 1], the whole quad [1, 2] x [0, 1] (element 4) and the small quads
+        // [0.5, 1] x [0, 0.5] and [0.5, 1] x [0.5, 1] (elements 1, 3) must interpolate the
+        // same value at the same point.
+        let mesh = crate::mesh::split_corner_mesh();
+        // A radiosity that varies from element to element (from the centroid, not linear, so
+        // no interpolation reproduces it by accident).
+        let eb: Vec<[f64; 3]> = mesh
+            .elements
+            .iter()
+            .map(|el| {
+                let c = el.centroid;
+                [
+                    1.0 + c.x * c.x + 3.0 * c.y,
+                    2.0 - c.y * c.y,
+                    0.5 + c.x * c.y,
+                ]
+            })
+            .collect();
+        let vb = vertex_radiosity(&mesh, &eb);
+        // The T-vertex (1, 0.5) averages the three elements that touch it, weighted by area:
+        // elements 1 and 3 (0.25 each) and element 4 (1), the rule of paper 2.5.
+        let t = mesh
+            .vertices
+            .iter()
+            .position(|&v| v == dvec3(1.0, 0.5, 0.0))
+            .unwrap();
+        for k in 0..3 {
+            let want = (0.25 * eb[1][k] + 0.25 * eb[3][k] + eb[4][k]) / 1.5;
+            assert!((vb[t][k] - want).abs() < 1e-14, "band {k}: {:?}", vb[t]);
+        }
+        let mut largest_old_jump: f64 = 0.0;
+        for i in 0..=20 {
+            let y = i as f64 / 20.0;
+            let x = dvec3(1.0, y, 0.0);
+            let small = if y <= 0.5 { 1 } else { 3 };
+            let a = interpolation(&mesh, 4, x).of(&vb);
+            let b = interpolation(&mesh, small, x).of(&vb);
+            for k in 0..3 {
+                // Both sides are linear along the edge between the same two vertices:
+                // equal to rounding (values of order 10).
+                assert!(
+                    (a[k] - b[k]).abs() < 1e-12,
+                    "y = {y}, band {k}: {a:?} / {b:?}"
+                );
+            }
+            // What the element's own corners alone gave (bilinear on [1, 2] x [0, 1]):
+            // different, so this test would catch the seam.
+            let c = mesh.elements[4].corners();
+            let old = (1.0 - y) * vb[c[0] as usize][0] + y * vb[c[3] as usize][0];
+            largest_old_jump = largest_old_jump.max((old - b[0]).abs());
+        }
+        assert!(largest_old_jump > 0.05, "{largest_old_jump}");
+    }
+
+    #[test]
+    fn a_rug_in_the_floors_plane_is_seen_over_it() {
+        // The floor meshed whole under a rug in its plane (as hierarchical radiosity's leaves
+        // keep it): every ray that meets the plane well inside the rug (1 cm in from its
+        // outline, against rounding at the outline) must see the rug, never the floor.
+        let quad = |x0: f64, x1: f64, z0: f64, z1: f64| {
+            vec![
+                dvec3(x0, 0., z0),
+                dvec3(x0, 0., z1),
+                dvec3(x1, 0., z1),
+                dvec3(x1, 0., z0),
+            ]
+        };
+        let s = scene(vec![
+            surface("floor", 0.0, quad(0., 4., 0., 4.)),
+            surface("rug", 0.0, quad(1.1, 3.1, 1.1, 2.3)),
+        ]);
+        let mesh = mesh_scene(&s, 0.25).unwrap();
+        let eb: Vec<[f64; 3]> = mesh
+            .elements
+            .iter()
+            .map(|el| [el.surface as f64, 0.0, 0.0])
+            .collect();
+        let r = Renderer::new(&mesh).with_surfaces_on_top(&s);
+        let cam = Camera {
+            eye: dvec3(2.0, 1.5, -2.0),
+            look_at: dvec3(2.0, 0.0, 1.7),
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+            width: 160,
+            height: 120,
+        };
+        let film = r.film(&cam, &eb, &[], Shading::Flat, 1, &NoProgress);
+        let screen = cam.screen();
+        let (mut inside, mut floor) = (0, 0);
+        for y in 0..cam.height as usize {
+            for x in 0..cam.width as usize {
+                let dir = cam.direction_in(screen, x as f64 + 0.5, y as f64 + 0.5);
+                if dir.y >= 0.0 {
+                    continue;
+                }
+                let p = cam.eye + (-cam.eye.y / dir.y) * dir;
+                if p.x > 1.11 && p.x < 3.09 && p.z > 1.11 && p.z < 2.29 {
+                    inside += 1;
+                    if film.pixel(x, y)[0][0] != 1.0 {
+                        floor += 1;
+                    }
+                }
+            }
+        }
+        assert!(inside > 1000, "{inside}");
+        assert_eq!(floor, 0, "{floor} of {inside} rug pixels show the floor");
     }
 
     #[test]

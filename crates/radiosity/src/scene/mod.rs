@@ -14,15 +14,18 @@
 //! [`cornell_box`] is the built-in Cornell box (`examples/cornell_box.scene`, compiled in),
 //! [`building`] generates furnished buildings of any size (both come with their settings, as
 //! a [`SceneFile`]), and the box primitive's faces are made here (module `shape`).
+//! [`lying_on`] finds the surfaces that lie on others (a rug on a floor; module `overlap`).
 
 use glam::DVec3;
 
 mod builtin;
 pub mod generate;
+pub mod overlap;
 pub(crate) mod shape;
 
 pub use builtin::cornell_box;
 pub use generate::{building, BuildingParams};
+pub use overlap::{lying_on, Overlap};
 
 /// The scene file's reader, writer, contents and error, at the paths the command line and
 /// the viewer use; they live in [`crate::io::scene_file`].
