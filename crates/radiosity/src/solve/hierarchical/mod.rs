@@ -115,6 +115,7 @@
 #![allow(clippy::needless_range_loop)] // bands and bins read best as indices
 
 mod bins;
+mod contact;
 mod export;
 mod gather;
 mod link;
@@ -188,6 +189,14 @@ pub struct HierarchicalReport {
     pub rays: u64,
     /// Bytes held by nodes and links at the end (an estimate from their sizes).
     pub memory_bytes: u64,
+    /// Patches marked buried by contact refinement (whole cells and pieces; not among the
+    /// leaves).
+    pub buried_patches: usize,
+    /// Their area (scene units squared).
+    pub buried_area: f64,
+    /// True when the scene had more cells than [`crate::mesh::CONTACT_MAX_ELEMENTS`] and
+    /// contacts were not refined.
+    pub contacts_skipped: bool,
     /// Where the emitted power went (see the module documentation).
     pub balance: EnergyBalance,
     /// Wall-clock time of the whole solve (linking, refinement and sweeps).
@@ -304,6 +313,8 @@ pub fn solve_hierarchical(
     solver.root_count = solver.nodes.len();
     let mut all_roots: Vec<u32> = (0..solver.nodes.len() as u32).collect();
     solver.top = solver.build_clusters(&mut all_roots);
+    // Leaves along contacts split as the dense pipeline's mesh, buried pieces marked.
+    let contacts = solver.refine_contacts(scene, max_patch_area);
     let total_area: f64 = scene
         .surfaces
         .iter()
@@ -372,7 +383,11 @@ pub fn solve_hierarchical(
     // pushed down); the leaves as a mesh; where the emitted power went.
     let h_of = match gathered {
         Some(h_of) => h_of,
-        None => export::arriving_irradiance(&mut solver),
+        None => {
+            let mut h_of = export::arriving_irradiance(&mut solver);
+            solver.gather_contacts(&mut h_of);
+            h_of
+        }
     };
     let (mesh, radiosity, leaf_ids) = export::leaves_to_mesh(&solver, scene);
     let balance = export::energy_account(&solver, &leaf_ids, &h_of);
@@ -389,6 +404,9 @@ pub fn solve_hierarchical(
         residual,
         rays: solver.rays,
         memory_bytes,
+        buried_patches: contacts.buried,
+        buried_area: contacts.buried_area,
+        contacts_skipped: contacts.skipped,
         balance,
         elapsed: start.elapsed(),
     };

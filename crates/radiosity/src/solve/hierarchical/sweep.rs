@@ -82,6 +82,13 @@ impl Solver<'_> {
         };
         let h: [f64; 3] = std::array::from_fn(|k| h_down[k] + node.gathered[k]);
         let old = self.b[n as usize];
+        if node.buried {
+            // Nothing reaches a buried patch and it sends nothing; its leaves' spread is
+            // left out of its parent's (they are not among the leaves shown).
+            self.b[n as usize] = [0.0; 3];
+            self.b_span[n as usize] = (f64::INFINITY, f64::NEG_INFINITY);
+            return [0.0; 3];
+        }
         if node.child_count == 0 {
             let s = node.surface as usize;
             let new: [f64; 3] =
