@@ -118,6 +118,21 @@ pub struct SolveOptions {
     /// above 100,000 elements, where it costs several times the solve.
     #[arg(long)]
     pub no_final_gather: bool,
+    /// Dense solvers: rounds of adaptive subdivision after the first solve (each splits
+    /// the elements whose luminance steps against a neighbour's, then solves again; 2 is a
+    /// good start for furnished rooms); 0, the default, solves the mesh once. Not with
+    /// --form-factors.
+    #[arg(long, value_name = "N")]
+    pub adapt_rounds: Option<u32>,
+    /// Adaptive subdivision: a step between touching elements is split when it exceeds this
+    /// fraction of the brighter one's luminance (and 5 % of white).
+    #[arg(long, default_value_t = 0.3, value_name = "FRACTION")]
+    pub adapt_contrast: f64,
+    /// Adaptive subdivision: the refined mesh has at most this many elements (default: twice
+    /// the mesh's, at most 20,000, and no more new form-factor pairs than n^2, about twice
+    /// the first matrix's, or 4 million; given, only this limit holds).
+    #[arg(long, value_name = "N")]
+    pub adapt_max_elements: Option<usize>,
     /// Progressive: give up after this many shots.
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     pub max_shots: usize,

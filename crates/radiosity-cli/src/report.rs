@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use radiosity::pathtrace::{FilmComparison, PathTraceSettings, PathTraced};
-use radiosity::pipeline::{FormFactorStats, Prepared, Solution, SolutionReport};
+use radiosity::pipeline::{AdaptReport, FormFactorStats, Prepared, Solution, SolutionReport};
 use radiosity::scene::{BuildingParams, Scene};
 use radiosity::solve::{Solver, SolverKind};
 
@@ -28,6 +28,32 @@ pub fn form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter:
     ));
 }
 
+/// Notes what adaptive subdivision did, round by round.
+pub fn adapt(report: &AdaptReport, reporter: &Reporter) {
+    if report.rounds.is_empty() {
+        reporter.note(&format!(
+            "adaptive subdivision: no visible steps between the {} elements; solved once",
+            report.initial_elements
+        ));
+        return;
+    }
+    let rounds: Vec<String> = report
+        .rounds
+        .iter()
+        .map(|r| {
+            format!(
+                "{} split -> {} elements ({:.2e} new pairs)",
+                r.split, r.elements, r.pairs_integrated as f64
+            )
+        })
+        .collect();
+    reporter.note(&format!(
+        "adaptive subdivision from {} elements: {}",
+        report.initial_elements,
+        rounds.join("; ")
+    ));
+}
+
 /// Prints the `check` report of `solution` (the stage times from `reporter`); `stats` are
 /// the form factors' statistics when the solve used a matrix.
 pub fn check(
@@ -36,6 +62,7 @@ pub fn check(
     solver: &Solver,
     solution: &Solution,
     stats: Option<&FormFactorStats>,
+    escaped_by_surface: Option<&[[f64; 3]]>,
     reporter: &Reporter,
 ) {
     let scene = &prepared.scene;
@@ -134,6 +161,9 @@ pub fn check(
         b.escaped[0],
         b.relative_error()
     );
+    if let (Some(by_surface), true) = (escaped_by_surface, b.emitted[0] > 0.0) {
+        where_escaped(scene, by_surface, b.emitted[0]);
+    }
     if let SolutionReport::Progressive(_) = solution.report {
         outln!(
             "                  (progressive: the unshot power is neither absorbed nor escaped yet)"
@@ -142,6 +172,50 @@ pub fn check(
     outln!("stage times:");
     for (stage, d) in reporter.timings() {
         outln!("  {:<14}{}", stage.name(), format_duration(d));
+    }
+}
+
+/// The surfaces through which most power escapes (red band, as the energy line), or is
+/// counted twice where rows sum above 1: the five largest of each sign, as shares of the
+/// emitted power.
+fn where_escaped(scene: &radiosity::scene::Scene, by_surface: &[[f64; 3]], emitted: f64) {
+    let mut ranked: Vec<(f64, usize)> = by_surface
+        .iter()
+        .enumerate()
+        .map(|(s, e)| (e[0] / emitted, s))
+        .filter(|(share, _)| share.abs() >= 1e-4)
+        .collect();
+    ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let name = |s: usize| {
+        let n = &scene.surfaces[s].name;
+        if n.is_empty() {
+            format!("surface {s}")
+        } else {
+            format!("surface {s} ({n})")
+        }
+    };
+    let lost: Vec<String> = ranked
+        .iter()
+        .filter(|r| r.0 > 0.0)
+        .take(5)
+        .map(|&(share, s)| format!("{:.2} % {}", 100.0 * share, name(s)))
+        .collect();
+    let twice: Vec<String> = ranked
+        .iter()
+        .rev()
+        .filter(|r| r.0 < 0.0)
+        .take(5)
+        .map(|&(share, s)| format!("{:.2} % {}", -100.0 * share, name(s)))
+        .collect();
+    outln!(
+        "escaped from      {} (of emitted; rows below 1: light into gaps, openings or the backs of faces)",
+        if lost.is_empty() { "no surface".to_string() } else { lost.join(", ") }
+    );
+    if !twice.is_empty() {
+        outln!(
+            "counted twice by  {} (of emitted; rows above 1: near pairs' visibility misjudged)",
+            twice.join(", ")
+        );
     }
 }
 

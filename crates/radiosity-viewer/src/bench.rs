@@ -191,6 +191,7 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
         solver,
         form_factors: FormFactors::Matrix(&f),
         start,
+        adapt: None,
     };
     let b = pipeline::solve(&prepared, &request(None), &mut keep_going, &NoProgress)
         .map_err(|e| e.to_string())?

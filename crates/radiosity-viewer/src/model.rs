@@ -126,6 +126,7 @@ mod tests {
             })),
             form_factors: FormFactors::Matrix(f),
             start,
+            adapt: None,
         };
         let solution = pipeline::solve(prepared, &request, &mut keep_going, &NoProgress).unwrap();
         let SolutionReport::Matrix(report) = solution.report else {

@@ -314,6 +314,7 @@ fn run(
                 .as_ref()
                 .map_or(FormFactors::Compute, FormFactors::Matrix),
             start: last.as_deref(),
+            adapt: None,
         };
         let result = pipeline::solve(&prepared, &request, &mut observer, progress);
         if let Some(r) = interrupted {

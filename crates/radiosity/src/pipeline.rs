@@ -10,14 +10,18 @@ use std::time::Instant;
 
 use crate::form_factor::{
     self, FormFactorContext, FormFactorMatrix, FormFactorMethod, OutOfMemory, RayCounter,
-    Reciprocity, RowSums,
+    Reciprocity, Reuse, RowSums,
 };
 use crate::io::form_factor_file::{
     mesh_fingerprint, read_form_factors, write_form_factors, FormFactorFileError,
 };
 use crate::light::{check_surface, ElementLight, LightError, Rgb};
-use crate::mesh::{mesh_scene, refine_contacts, ContactReport, Mesh, MeshError, MeshSettings};
+use crate::mesh::{
+    mark_steps, mesh_scene, refine_contacts, split_marked, AdaptSettings, ContactReport, Mesh,
+    MeshError, MeshSettings, Origin,
+};
 use crate::progress::{run_stage, Progress, Stage};
+use crate::render::tonemap::{lit_radiosity_top_mean, AUTO_EXPOSURE_TOP_AREA};
 use crate::scene::Scene;
 use crate::solve::{
     self, energy_balance, EnergyBalance, HierarchicalReport, Observer, ProgressiveReport,
@@ -59,6 +63,10 @@ pub enum PipelineError {
         /// [`MAX_INTEGRATION_POINTS`].
         limit: f64,
     },
+    /// Adaptive subdivision was asked for with form factors that are not computed: it
+    /// needs the form factors of meshes that do not exist yet.
+    #[error("adaptive subdivision computes its form factors: it cannot use a form-factor matrix or file")]
+    AdaptNeedsComputedFormFactors,
     /// Form factors were given to a solver that computes its own.
     #[error("{solver} computes its own form factors: it cannot use a form-factor matrix")]
     FormFactorsUnused {
@@ -146,8 +154,32 @@ pub struct Solution {
     /// the power still unshot is neither absorbed nor escaped (so the relative error is the
     /// unshot fraction).
     pub balance: EnergyBalance,
-    /// What computing the form factors found, when they were computed for this solve.
+    /// What computing the form factors found, when they were computed for this solve (with
+    /// adaptive subdivision: the last round's matrix, the rays and seconds of all rounds).
     pub form_factors: Option<FormFactorStats>,
+    /// What adaptive subdivision did, when it was asked for.
+    pub adapt: Option<AdaptReport>,
+}
+
+/// What adaptive subdivision did: one entry per round of refinement.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AdaptReport {
+    /// Elements of the mesh solved first (the prepared mesh).
+    pub initial_elements: usize,
+    /// Per round: the elements split and the element count after the split.
+    pub rounds: Vec<AdaptRound>,
+}
+
+/// One round of adaptive subdivision.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptRound {
+    /// Elements split in four.
+    pub split: usize,
+    /// Elements of the refined mesh.
+    pub elements: usize,
+    /// Form-factor pairs integrated in this round (the rest were taken from the matrix
+    /// before).
+    pub pairs_integrated: u64,
 }
 
 /// How a solve went, by kind of solver.
@@ -184,6 +216,9 @@ pub struct SolveRequest<'a> {
     /// A starting solution on the prepared mesh (Gauss-Seidel's warm start); the other
     /// solvers start from B = E.
     pub start: Option<&'a [Rgb]>,
+    /// Adaptive subdivision between solves ([`crate::mesh::mark_steps`]), for the dense
+    /// solvers on computed form factors; `None` solves the prepared mesh once.
+    pub adapt: Option<AdaptSettings>,
 }
 
 impl<'a> SolveRequest<'a> {
@@ -193,6 +228,7 @@ impl<'a> SolveRequest<'a> {
             solver,
             form_factors: FormFactors::Compute,
             start: None,
+            adapt: None,
         }
     }
 }
@@ -392,6 +428,12 @@ pub fn solve(
     }
     match &request.solver {
         Solver::Dense(dense) => {
+            if let Some(adapt) = &request.adapt {
+                if !matches!(request.form_factors, FormFactors::Compute) {
+                    return Err(PipelineError::AdaptNeedsComputedFormFactors);
+                }
+                return solve_adaptive(prepared, dense, request.start, adapt, observer, progress);
+            }
             let computed;
             let (f, stats) = match request.form_factors {
                 FormFactors::Matrix(f) => (f, None),
@@ -414,6 +456,7 @@ pub fn solve(
                 report: SolutionReport::Matrix(report),
                 balance,
                 form_factors: stats,
+                adapt: None,
             })
         }
         Solver::Progressive(settings) => {
@@ -431,6 +474,7 @@ pub fn solve(
                 balance: report.balance,
                 report: SolutionReport::Progressive(report),
                 form_factors: None,
+                adapt: None,
             })
         }
         Solver::Hierarchical(settings) => {
@@ -447,9 +491,116 @@ pub fn solve(
                 balance: h.report.balance,
                 report: SolutionReport::Hierarchical(h.report),
                 form_factors: None,
+                adapt: None,
             })
         }
     }
+}
+
+/// A dense solve with adaptive subdivision: solve the prepared mesh, split the elements
+/// that step against a neighbour ([`mark_steps`], white the radiosity automatic exposure
+/// shows white), solve again from the last solution (each child starting from its
+/// parent's radiosity), for up to `adapt.rounds` rounds or until nothing is marked. Each
+/// round integrates only the form factors of pairs with a new element and takes the others
+/// from the matrix before ([`form_factor::compute_matrix_reusing`]).
+fn solve_adaptive(
+    prepared: &Prepared,
+    dense: &solve::DenseSolver,
+    start: Option<&[Rgb]>,
+    adapt: &AdaptSettings,
+    observer: &mut Observer,
+    progress: &dyn Progress,
+) -> Result<Solution, PipelineError> {
+    let scene = &prepared.scene;
+    let mut mesh = prepared.mesh.clone();
+    let mut light = prepared.light.clone();
+    let (mut f, first) = prepared.form_factors(progress)?;
+    let (mut rays, mut seconds) = (first.rays, first.seconds);
+    let (mut radiosity, mut report) = solve::solve(&f, &light, dense, start, observer, progress)?;
+    let mut adapted = AdaptReport {
+        initial_elements: mesh.len(),
+        rounds: Vec::new(),
+    };
+    let mut pairs_left = adapt.max_new_pairs;
+    for _ in 0..adapt.rounds {
+        let b = radiosity.as_arrays();
+        let refined = run_stage(progress, Stage::Adapt, 0, || {
+            let white = lit_radiosity_top_mean(scene, &mesh, b, AUTO_EXPOSURE_TOP_AREA)?;
+            let luminance: Vec<f64> = radiosity.as_slice().iter().map(|b| b.luminance()).collect();
+            let marks = mark_steps(&mesh, &luminance, white, adapt, pairs_left);
+            let split = marks.iter().filter(|&&m| m).count();
+            (split > 0).then(|| (split, split_marked(&mesh, scene.surfaces.len(), &marks)))
+        });
+        let Some((split, (next, origin))) = refined else {
+            break;
+        };
+        form_factor::check_dense_fits(
+            "the form-factor matrix (f32) of the refined mesh",
+            next.len(),
+            4.0,
+            form_factor::available_memory_bytes(),
+        )?;
+        let kept: Vec<Option<u32>> = origin
+            .iter()
+            .map(|o| match *o {
+                Origin::Kept(i) => Some(i),
+                Origin::Child(_) => None,
+            })
+            .collect();
+        let ctx = FormFactorContext {
+            mesh: &next,
+            occluders: &prepared.occluders,
+        };
+        let counter = RayCounter::default();
+        let clock = Instant::now();
+        let reuse = Reuse {
+            matrix: &f,
+            kept: &kept,
+        };
+        let next_f = form_factor::compute_matrix_reusing(
+            &ctx,
+            prepared.method(),
+            Some(reuse),
+            &counter,
+            progress,
+        )?;
+        seconds += clock.elapsed().as_secs_f64();
+        rays += counter.get();
+        let n = next.len() as u64;
+        let fresh = kept.iter().filter(|k| k.is_none()).count() as u64;
+        let kept_count = n - fresh;
+        let pairs_integrated = n * (n - 1) / 2 - kept_count * kept_count.saturating_sub(1) / 2;
+        pairs_left = pairs_left.saturating_sub(pairs_integrated);
+        let start: Vec<Rgb> = origin
+            .iter()
+            .map(|o| radiosity.as_slice()[o.parent() as usize])
+            .collect();
+        light = ElementLight::of_mesh(&next, scene)?;
+        f = next_f;
+        (radiosity, report) = solve::solve(&f, &light, dense, Some(&start), observer, progress)?;
+        mesh = Arc::new(next);
+        adapted.rounds.push(AdaptRound {
+            split,
+            elements: mesh.len(),
+            pairs_integrated,
+        });
+    }
+    let areas: Vec<f64> = mesh.elements.iter().map(|e| e.area).collect();
+    let balance = energy_balance(&f, &areas, &light, radiosity.as_slice());
+    let stats = FormFactorStats {
+        rays,
+        seconds,
+        row_sums: f.row_sums(),
+        reciprocity: f.reciprocity(&areas),
+    };
+    Ok(Solution {
+        mesh,
+        radiosity,
+        report: SolutionReport::Matrix(report),
+        balance,
+        form_factors: Some(stats),
+        adapt: Some(adapted),
+    })
 }
 
 impl Solution {

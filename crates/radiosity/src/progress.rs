@@ -20,6 +20,9 @@ pub enum Stage {
     Contacts,
     /// Computing form factors (work unit: one element pair of the upper triangle).
     FormFactors,
+    /// Finding the elements to split between the solves of adaptive subdivision
+    /// ([`crate::mesh::mark_steps`]) and splitting them.
+    Adapt,
     /// Solving the radiosity system (work unit: one band or one iteration).
     Solve,
     /// Computing vertex radiosities.
@@ -41,6 +44,7 @@ impl Stage {
             Stage::Bvh => "bvh",
             Stage::Contacts => "contacts",
             Stage::FormFactors => "form factors",
+            Stage::Adapt => "adapt",
             Stage::Solve => "solve",
             Stage::Shade => "shade",
             Stage::Render => "render",

@@ -114,6 +114,9 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         epsilon: args.epsilon,
         min_area: args.min_area,
         no_final_gather: false,
+        adapt_rounds: None,
+        adapt_contrast: 0.3,
+        adapt_max_elements: None,
     };
     let settings = RenderSettings {
         supersample: args.supersample,
@@ -122,7 +125,14 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let reporter = Reporter::new(true);
     let start = std::time::Instant::now();
     let (prepared, _, solver) = prepare_solve(&scene_args, &options, &reporter)?;
-    let (solution, stats) = solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?;
+    let (solution, stats) = solve_scene(
+        &prepared,
+        solver,
+        crate::setup::adapt(&options, &prepared, &solver)?,
+        None,
+        &mut keep_going,
+        &reporter,
+    )?;
     let rays = match (&stats, &solution.report) {
         (Some(s), _) => s.rays,
         (None, SolutionReport::Progressive(r)) => r.rays,

@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use radiosity::pipeline::{self as pipeline, FormFactors, SolveRequest};
-use radiosity::solve::keep_going;
+use radiosity::solve::{escaped_by_surface, keep_going};
 
 use super::solve_scene;
 use crate::args::CheckArgs;
@@ -19,7 +19,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
     // `check` always prints its report; --quiet only silences the progress bars.
     let reporter = Reporter::new(true);
     let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
-    let (solution, stats) = if solver.needs_matrix() {
+    let (solution, stats, escaped) = if solver.needs_matrix() {
         let (f, stats) = match args.solve.form_factors.as_deref() {
             Some(path) => {
                 let f = prepared.load_form_factors(path, &reporter)?;
@@ -38,10 +38,20 @@ pub fn run(args: CheckArgs) -> Result<()> {
             ..SolveRequest::new(solver)
         };
         let solution = pipeline::solve(&prepared, &request, &mut keep_going, &reporter)?;
-        (solution, Some(stats))
+        let surface_of: Vec<u32> = solution.mesh.elements.iter().map(|e| e.surface).collect();
+        let escaped = escaped_by_surface(
+            &f,
+            &prepared.areas(),
+            &surface_of,
+            prepared.scene.surfaces.len(),
+            solution.radiosity.as_slice(),
+        );
+        (solution, Some(stats), Some(escaped))
     } else {
         // Progressive refinement never holds the matrix: no row sums or reciprocity.
-        solve_scene(&prepared, solver, None, &mut keep_going, &reporter)?
+        let (solution, stats) =
+            solve_scene(&prepared, solver, None, None, &mut keep_going, &reporter)?;
+        (solution, stats, None)
     };
     report::check(
         &stem,
@@ -49,6 +59,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
         &solver,
         &solution,
         stats.as_ref(),
+        escaped.as_deref(),
         &reporter,
     );
     Ok(())

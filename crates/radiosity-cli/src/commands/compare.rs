@@ -23,6 +23,12 @@ pub fn run(args: CompareArgs) -> Result<()> {
     let (solution, _) = solve_scene(
         &prepared,
         solver,
+        // The solver against the reference on one mesh: adaptive subdivision only when
+        // --adapt-rounds asks for it.
+        match args.solve.adapt_rounds {
+            Some(_) => crate::setup::adapt(&args.solve, &prepared, &solver)?,
+            None => None,
+        },
         args.solve.form_factors.as_deref(),
         &mut |_| ControlFlow::Continue(()),
         &reporter,

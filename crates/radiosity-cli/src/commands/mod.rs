@@ -15,7 +15,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use image::RgbImage;
-use radiosity::mesh::Mesh;
+use radiosity::mesh::{AdaptSettings, Mesh};
 use radiosity::pipeline::{
     self as pipeline, FormFactorStats, FormFactors, Prepared, Solution, SolveRequest,
 };
@@ -34,6 +34,7 @@ use crate::report;
 pub fn solve_scene(
     prepared: &Prepared,
     solver: Solver,
+    adapt: Option<AdaptSettings>,
     file: Option<&Path>,
     observer: &mut Observer,
     reporter: &Reporter,
@@ -56,9 +57,13 @@ pub fn solve_scene(
     }
     let request = SolveRequest {
         form_factors,
+        adapt,
         ..SolveRequest::new(solver)
     };
     let solution = pipeline::solve(prepared, &request, observer, reporter)?;
+    if let Some(a) = &solution.adapt {
+        report::adapt(a, reporter);
+    }
     if let Some(stats) = &solution.form_factors {
         report::form_factor_stats(prepared, stats, reporter);
     }

@@ -68,6 +68,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (solution, _) = solve_scene(
         &prepared,
         solver,
+        crate::setup::adapt(&args.solve, &prepared, &solver)?,
         args.solve.form_factors.as_deref(),
         &mut observer,
         &reporter,

@@ -17,6 +17,7 @@ pub fn run(args: SolveArgs) -> Result<()> {
     let (solution, _) = solve_scene(
         &prepared,
         solver,
+        crate::setup::adapt(&args.solve, &prepared, &solver)?,
         args.solve.form_factors.as_deref(),
         &mut |_| ControlFlow::Continue(()),
         &reporter,

@@ -74,7 +74,17 @@ fn render_default_output_name_and_shadings() {
 fn solve_writes_csv_with_exact_header_and_one_row_per_element() {
     let dir = scratch_dir("solve");
     let out = radiosity(
-        &["solve", &example("triangles.scene"), "-o", "tri.csv", "-q"],
+        // One solve on the file's own mesh (no adaptive subdivision), whose element count
+        // `check` prints.
+        &[
+            "solve",
+            &example("triangles.scene"),
+            "-o",
+            "tri.csv",
+            "-q",
+            "--adapt-rounds",
+            "0",
+        ],
         &dir,
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -96,7 +106,15 @@ fn solve_writes_csv_with_exact_header_and_one_row_per_element() {
 
     // The same solution as JSON.
     let out = radiosity(
-        &["solve", &example("triangles.scene"), "-o", "tri.json", "-q"],
+        &[
+            "solve",
+            &example("triangles.scene"),
+            "-o",
+            "tri.json",
+            "-q",
+            "--adapt-rounds",
+            "0",
+        ],
         &dir,
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -113,8 +131,12 @@ fn form_factor_file_round_trip_and_refusals() {
     let out = radiosity(&["formfactors", &scene, "-o", "t.ff", "-q"], &dir);
     assert!(out.status.success(), "{}", stderr(&out));
 
-    // Solving from the file gives the same numbers as computing afresh.
-    let a = radiosity(&["solve", &scene, "-o", "a.csv", "-q"], &dir);
+    // Solving from the file gives the same numbers as computing afresh on the same mesh
+    // (adaptive subdivision, which makes new meshes, left out).
+    let a = radiosity(
+        &["solve", &scene, "-o", "a.csv", "-q", "--adapt-rounds", "0"],
+        &dir,
+    );
     let b = radiosity(
         &[
             "solve",
@@ -244,6 +266,7 @@ fn check_prints_statistics() {
         "total area",
         "row sums",
         "reciprocity error",
+        "escaped from",
         "stage times",
     ] {
         assert!(text.contains(field), "check output lacks {field}:\n{text}");
@@ -598,5 +621,66 @@ fn compare_works_where_surfaces_lie_on_and_touch_others() {
             assert!(rms <= bound, "{stem} {solver}: RMS {rms} %");
         }
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn adapt_rounds_refine_the_mesh_and_refuse_a_form_factor_file() {
+    let dir = scratch_dir("adapt");
+    let scene = example("room.scene");
+    let once = radiosity(
+        &["solve", &scene, "-o", "once.csv", "--adapt-rounds", "0"],
+        &dir,
+    );
+    let twice = radiosity(
+        &["solve", &scene, "-o", "adapted.csv", "--adapt-rounds", "1"],
+        &dir,
+    );
+    assert!(
+        once.status.success() && twice.status.success(),
+        "{}{}",
+        stderr(&once),
+        stderr(&twice)
+    );
+    let rows = |f: &str| {
+        std::fs::read_to_string(dir.join(f))
+            .unwrap()
+            .lines()
+            .count()
+    };
+    // The refined solution has more elements, and says how it got them.
+    assert!(rows("adapted.csv") > rows("once.csv"));
+    let notes = stderr(&twice);
+    assert!(notes.contains("adaptive subdivision from"), "{notes}");
+    // The room's area is kept: the elements are split, none lost (column 3 is the area).
+    let area = |f: &str| -> f64 {
+        std::fs::read_to_string(dir.join(f))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+            .sum()
+    };
+    assert!((area("adapted.csv") - area("once.csv")).abs() < 1e-9 * area("once.csv"));
+
+    let ff = radiosity(&["formfactors", &scene, "-o", "r.ff", "-q"], &dir);
+    assert!(ff.status.success(), "{}", stderr(&ff));
+    let refused = radiosity(
+        &[
+            "solve",
+            &scene,
+            "--form-factors",
+            "r.ff",
+            "--adapt-rounds",
+            "1",
+        ],
+        &dir,
+    );
+    assert!(!refused.status.success());
+    assert!(
+        stderr(&refused).contains("--adapt-rounds cannot be used with --form-factors"),
+        "{}",
+        stderr(&refused)
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

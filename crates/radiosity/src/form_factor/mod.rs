@@ -419,12 +419,57 @@ pub fn compute_matrix(
     rays: &RayCounter,
     progress: &dyn Progress,
 ) -> Result<FormFactorMatrix, OutOfMemory> {
+    compute_matrix_reusing(ctx, method, None, rays, progress)
+}
+
+/// A matrix computed before on a mesh that shares elements with the one at hand: after
+/// adaptive subdivision most elements are unchanged, and so are the form factors between
+/// them.
+#[derive(Clone, Copy, Debug)]
+pub struct Reuse<'a> {
+    /// The matrix on the mesh before, computed by the same method.
+    pub matrix: &'a FormFactorMatrix,
+    /// For each element of the mesh at hand, its index in the mesh before where it is the
+    /// same element (same corners, same surface), else `None`.
+    pub kept: &'a [Option<u32>],
+}
+
+/// [`compute_matrix`], taking from `reuse` the entries between elements that both were in
+/// the mesh before, for the reciprocal pair methods (area, contour, analytic: each entry
+/// depends on its two elements and the scene's occluders alone, so the copy is bit for bit
+/// what integrating again would give). The other methods, whose rows depend on the whole
+/// mesh, compute everything. Progress counts the pairs integrated.
+pub fn compute_matrix_reusing(
+    ctx: &FormFactorContext,
+    method: FormFactorMethod,
+    reuse: Option<Reuse>,
+    rays: &RayCounter,
+    progress: &dyn Progress,
+) -> Result<FormFactorMatrix, OutOfMemory> {
     let n = ctx.mesh.len();
     let mut matrix = FormFactorMatrix::zeros(n)?;
     let areas: Vec<f64> = ctx.mesh.elements.iter().map(|e| e.area).collect();
     let engine = Engine::new(ctx, method);
     if let (true, Engine::Pairs(integrator)) = (method.is_reciprocal(), &engine) {
-        let pairs = (n as u64) * (n as u64).saturating_sub(1) / 2;
+        let kept = |i: usize| reuse.and_then(|r| r.kept.get(i).copied().flatten());
+        let fresh: Vec<bool> = (0..n).map(|i| kept(i).is_none()).collect();
+        // Pairs to integrate: j > i with i or j fresh.
+        let fresh_after: Vec<u64> = {
+            let mut after = vec![0u64; n + 1];
+            for i in (0..n).rev() {
+                after[i] = after[i + 1] + fresh[i] as u64;
+            }
+            after
+        };
+        let pairs: u64 = (0..n)
+            .map(|i| {
+                if fresh[i] {
+                    (n - i - 1) as u64
+                } else {
+                    fresh_after[i + 1]
+                }
+            })
+            .sum();
         run_stage(progress, Stage::FormFactors, pairs, || {
             // Upper triangle, row by row, straight into the matrix: F_ij = G_ij / A_i, j > i.
             matrix
@@ -432,11 +477,28 @@ pub fn compute_matrix(
                 .par_chunks_mut(n.max(1))
                 .enumerate()
                 .for_each_init(Scratch::default, |scratch, (i, row)| {
-                    let g = integrator.couplings(i, i + 1..n, rays, &mut scratch.area);
-                    for (f, g) in row[i + 1..].iter_mut().zip(g) {
-                        *f = (g / areas[i]) as f32;
+                    let mut done = 0u64;
+                    let mut j = i + 1;
+                    while j < n {
+                        if let (Some(oi), Some(oj), Some(r)) = (kept(i), kept(j), reuse) {
+                            row[j] = r.matrix.data[oi as usize * r.matrix.n + oj as usize];
+                            j += 1;
+                            continue;
+                        }
+                        // The run of columns from j that must be integrated.
+                        let end = if fresh[i] {
+                            n
+                        } else {
+                            (j..n).find(|&c| !fresh[c]).unwrap_or(n)
+                        };
+                        let g = integrator.couplings(i, j..end, rays, &mut scratch.area);
+                        for (f, g) in row[j..end].iter_mut().zip(g) {
+                            *f = (g / areas[i]) as f32;
+                        }
+                        done += (end - j) as u64;
+                        j = end;
                     }
-                    progress.advance((n - i - 1) as u64);
+                    progress.advance(done);
                 });
             // Lower triangle by reciprocity: F_ji = A_i F_ij / A_j.
             for i in 0..n {

@@ -22,8 +22,6 @@
 //! surface nearby in front of them are probed (a box query), so the cost is the contacts',
 //! not the whole mesh's.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -134,50 +132,7 @@ pub fn refine_contacts(
         return (mesh.clone(), report);
     }
 
-    // Rebuild surface by surface, sharing vertices by position so that the pieces conform
-    // with each other and with the elements left whole (T-junctions remain where a split
-    // element meets one that was not).
-    let surfaces = (0..scene.surfaces.len())
-        .map(|s| {
-            let mut vertices: Vec<DVec3> = Vec::new();
-            let mut index: HashMap<[u64; 3], u32> = HashMap::new();
-            let mut id = |p: DVec3, vertices: &mut Vec<DVec3>| {
-                *index
-                    .entry(p.to_array().map(f64::to_bits))
-                    .or_insert_with(|| {
-                        vertices.push(p);
-                        vertices.len() as u32 - 1
-                    })
-            };
-            let mut elements: Vec<Vec<u32>> = Vec::new();
-            let range = mesh.surface_elements[s].clone();
-            for e in range.clone() {
-                let e = e as usize;
-                match &refined[e] {
-                    None => {
-                        let ids = mesh
-                            .corner_positions(e)
-                            .map(|p| id(p, &mut vertices))
-                            .collect();
-                        elements.push(ids);
-                    }
-                    Some(pieces) => {
-                        for piece in pieces {
-                            elements.push(piece.iter().map(|&p| id(p, &mut vertices)).collect());
-                        }
-                    }
-                }
-            }
-            let normal = range
-                .clone()
-                .next()
-                .map(|e| mesh.elements[e as usize].normal)
-                .or_else(|| geometry::polygon_normal(&scene.surfaces[s].vertices))
-                .unwrap_or(DVec3::Z);
-            (vertices, elements, normal)
-        })
-        .collect();
-    let refined_mesh = Mesh::from_surfaces(surfaces);
+    let refined_mesh = mesh.with_pieces(scene.surfaces.len(), &refined);
     report.elements = refined_mesh.len();
     (refined_mesh, report)
 }
@@ -328,7 +283,7 @@ impl<'a> Probe<'a> {
 /// The four children of a quadrilateral (at its bilinear midpoints) or a triangle (at its
 /// edge midpoints), wound as the parent. Edge midpoints are computed from the edge's two
 /// ends alone, so neighbouring pieces compute bit-identical shared corners.
-fn quarters(c: &[DVec3]) -> Vec<Vec<DVec3>> {
+pub(super) fn quarters(c: &[DVec3]) -> Vec<Vec<DVec3>> {
     let mid = |a: DVec3, b: DVec3| 0.5 * (a + b);
     if c.len() == 4 {
         let (a, b, cc, d) = (c[0], c[1], c[2], c[3]);

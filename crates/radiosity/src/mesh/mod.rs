@@ -14,8 +14,10 @@
 //! area integral over the elements. They travel beside the [`Scene`], not in it: the scene
 //! is geometry and materials only.
 
+mod adapt;
 mod contact;
 
+pub use adapt::{mark_steps, split_marked, AdaptSettings, Origin};
 pub use contact::{
     refine_contacts, ContactReport, CONTACT_DEPTH, CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS,
     PROBE_SLACK,
@@ -312,6 +314,59 @@ impl Mesh {
         }
         mesh.build_neighbours();
         mesh
+    }
+}
+
+impl Mesh {
+    /// This mesh with some elements replaced: `pieces[e]` is `None` where element e stays
+    /// as it is, else the polygons it becomes (3 or 4 corners each, wound as e; none drops
+    /// it). Surfaces keep their order and each element's pieces take its place, so the new
+    /// elements come in the order of the old ones they came from. Vertices are shared by
+    /// exact position within a surface, so pieces conform with each other and with the
+    /// elements left whole wherever their corners coincide (T-junctions remain where a
+    /// split element meets one that was not). `surfaces` is the scene's surface count.
+    pub(crate) fn with_pieces(&self, surfaces: usize, pieces: &[Option<Vec<Vec<DVec3>>>]) -> Mesh {
+        let surfaces = (0..surfaces)
+            .map(|s| {
+                let mut vertices: Vec<DVec3> = Vec::new();
+                let mut index: HashMap<[u64; 3], u32> = HashMap::new();
+                let mut id = |p: DVec3, vertices: &mut Vec<DVec3>| {
+                    *index
+                        .entry(p.to_array().map(f64::to_bits))
+                        .or_insert_with(|| {
+                            vertices.push(p);
+                            vertices.len() as u32 - 1
+                        })
+                };
+                let mut elements: Vec<Vec<u32>> = Vec::new();
+                let range = self.surface_elements.get(s).cloned().unwrap_or(0..0);
+                for e in range.clone() {
+                    let e = e as usize;
+                    match &pieces[e] {
+                        None => {
+                            let ids = self
+                                .corner_positions(e)
+                                .map(|p| id(p, &mut vertices))
+                                .collect();
+                            elements.push(ids);
+                        }
+                        Some(pieces) => {
+                            for piece in pieces {
+                                elements
+                                    .push(piece.iter().map(|&p| id(p, &mut vertices)).collect());
+                            }
+                        }
+                    }
+                }
+                let normal = range
+                    .clone()
+                    .next()
+                    .map(|e| self.elements[e as usize].normal)
+                    .unwrap_or(DVec3::Z);
+                (vertices, elements, normal)
+            })
+            .collect();
+        Mesh::from_surfaces(surfaces)
     }
 }
 

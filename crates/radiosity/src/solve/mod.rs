@@ -32,7 +32,7 @@ mod solver;
 #[cfg(test)]
 pub(crate) mod tests;
 
-pub use energy::{energy_balance, EnergyBalance};
+pub use energy::{energy_balance, escaped_by_surface, EnergyBalance};
 pub use error::SolveError;
 pub use hierarchical::{
     solve_hierarchical, HierarchicalReport, HierarchicalSettings, HierarchicalSolution,

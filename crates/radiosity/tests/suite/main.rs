@@ -3,6 +3,7 @@
 
 mod fixtures;
 
+mod adaptive;
 mod compare;
 mod exposure;
 mod form_factors;

@@ -16,13 +16,13 @@ pub(super) const ON_PLANE: f64 = 1e-12;
 /// A polygon, copied (scaled and maybe clipped) onto the stack when small, otherwise onto the
 /// heap. (The size difference between the variants is the point.)
 #[allow(clippy::large_enum_variant)]
-pub(super) enum Corners {
+pub(crate) enum Corners {
     Stack([DVec3; STACK_CORNERS + 1], usize),
     Heap(Vec<DVec3>),
 }
 
 impl Corners {
-    pub(super) fn as_slice(&self) -> &[DVec3] {
+    pub(crate) fn as_slice(&self) -> &[DVec3] {
         match self {
             Corners::Stack(a, n) => &a[..*n],
             Corners::Heap(v) => v,
@@ -33,7 +33,7 @@ impl Corners {
 /// Clips `poly` to the closed half-space `normal . (v - origin) >= 0` (Sutherland-Hodgman),
 /// mapping every corner v to (v - `shift`) * `inv_scale`. Returns `None` if no corner lies
 /// strictly in front (beyond `ON_PLANE`), so nothing of positive area remains.
-pub(super) fn clip_front(
+pub(crate) fn clip_front(
     poly: &[DVec3],
     normal: DVec3,
     origin: DVec3,

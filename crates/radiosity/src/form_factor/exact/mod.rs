@@ -100,6 +100,7 @@ mod quadrature;
 #[cfg(test)]
 mod test_util;
 
+pub(crate) use clip::clip_front;
 pub use contour::polygon_to_polygon;
 pub use lambert::point_to_polygon;
 
