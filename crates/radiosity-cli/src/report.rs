@@ -167,6 +167,15 @@ pub fn check(
                 report.rays,
                 report.elapsed.as_secs_f64()
             );
+            if report.contacts_skipped {
+                outln!("leaf contacts     not refined (more elements than the contact refinement takes)");
+            } else {
+                outln!(
+                    "leaf contacts     {} buried pieces dropped, {:.4e} area",
+                    report.buried_patches,
+                    report.buried_area
+                );
+            }
         }
         SolutionReport::Progressive(report) => {
             outln!(

@@ -74,7 +74,7 @@ pub struct ContactReport {
 
 /// How much of a piece of surface is buried.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Cover {
+pub(crate) enum Cover {
     Open,
     Partly,
     Buried,
@@ -141,8 +141,9 @@ pub fn refine_contacts(
     (refined_mesh, report)
 }
 
-/// The rays and box queries that decide what is buried.
-struct Probe<'a> {
+/// The rays and box queries that decide what is buried (hierarchical radiosity uses it
+/// too, on its quadtrees' patches: `solve/hierarchical/contact.rs`).
+pub(crate) struct Probe<'a> {
     occluders: &'a PolygonBvh,
     /// Unit front normal of every surface.
     normals: Vec<DVec3>,
@@ -157,7 +158,7 @@ struct Probe<'a> {
 }
 
 impl<'a> Probe<'a> {
-    fn new(scene: &'a Scene, occluders: &'a PolygonBvh) -> Probe<'a> {
+    pub(crate) fn new(scene: &'a Scene, occluders: &'a PolygonBvh) -> Probe<'a> {
         Probe {
             occluders,
             normals: scene
@@ -194,7 +195,7 @@ impl<'a> Probe<'a> {
     /// wholly behind the plane, or lying in it, cannot cover it; a cover standing further
     /// off, such as the top of a bottomless box whose sides are far from this element, is
     /// missed: the scenes' boxes have all six faces.)
-    fn has_cover_nearby(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> bool {
+    pub(crate) fn has_cover_nearby(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> bool {
         let size = geometry::polygon_area(corners).sqrt();
         let reach = 0.05 * size + self.lift;
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
@@ -260,7 +261,7 @@ impl<'a> Probe<'a> {
 
     /// How much of the piece `corners` (3 or 4 corners) of `surface` is buried, judged at
     /// its 4 x 4 sample points: under a surface lying on it, or by the probe rays.
-    fn cover(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> Cover {
+    pub(crate) fn cover(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> Cover {
         let k = PROBE_GRID;
         let mut points = Vec::with_capacity((k * k) as usize);
         if corners.len() == 4 {

@@ -26,6 +26,7 @@ pub use contact::{
     refine_contacts, ContactReport, CONTACT_DEPTH, CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS,
     PROBE_SLACK,
 };
+pub(crate) use contact::{Cover, Probe};
 
 use std::collections::HashMap;
 use std::ops::Range;

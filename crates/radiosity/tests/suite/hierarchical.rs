@@ -172,8 +172,10 @@ fn refined_closed_cube_is_close_to_the_closed_form() {
     // relative error 3.3e-2, largest 0.19 (a corner leaf); escaped power -0.8 %, -0.4 % and
     // -1.9 % of emitted (red, green, blue: the error of the form-factor sums, amplified by
     // 1 / (1 - rho)). Tolerances: 5 %, 25 % and 3 %. Those figures are without the final
-    // gather; with it (evaluating the ancestors' links at each leaf) measured: mean 5.7e-3,
-    // largest 3.5e-2, escaped -0.7 %, -0.3 % and -1.8 %; the bounds still hold the
+    // gather; with it (evaluating the ancestors' links at each leaf, iterated to the
+    // tolerance) measured: mean 2.3e-3, largest 8.2e-3, escaped -0.36 %, -0.26 % and
+    // -0.61 % (with two passes of it, as before: 5.7e-3, 3.5e-2, -0.7 %, -0.3 % and
+    // -1.8 %); the bounds still hold the
     // hierarchy without it.
     let s = solve(&unit_cube(CUBE_E, CUBE_RHO), CUBE_AREA, 0.01, 1.0 / 256.0);
     let (mean, worst) = cube_errors(&s);
@@ -193,6 +195,34 @@ fn refined_closed_cube_is_close_to_the_closed_form() {
 }
 
 #[test]
+fn closed_room_balances_energy_at_the_defaults() {
+    // Issue #11: in a closed room every watt emitted is absorbed, so the energy account's
+    // escaped power must be zero (emitted = absorbed). The closed unit cube lit by its
+    // ceiling (face5), every face reflecting half, at MAX_PATCH_AREA 0.01 (600 elements)
+    // and the defaults. Measured: escaped -0.33 % of emitted in every band (-1.3 % with
+    // the two gather passes of before, -3.2 % without the gather: the hierarchy's links
+    // from coarse sources send their mean radiosity with their mean form factor, which
+    // overshoots where both peak together, near the corners). Bound: the issue's 0.5 %.
+    let scene = lit_closed_cube(|i| if i == 5 { [1.0; 3] } else { [0.0; 3] }, [0.5; 3]);
+    let max_area = 0.01;
+    let s = solve_with(
+        &scene,
+        max_area,
+        &HierarchicalSettings::defaults_for(max_area),
+    );
+    let b = s.report.balance;
+    let escaped: Vec<f64> = (0..3).map(|k| b.escaped[k] / b.emitted[k]).collect();
+    eprintln!(
+        "closed cube at the defaults: {} leaves, escaped {escaped:?}",
+        s.report.leaves
+    );
+    for e in escaped {
+        assert!(e.abs() < 0.005, "escaped {e:e}");
+    }
+    assert!(b.relative_error() < 1e-5, "{b:?}");
+}
+
+#[test]
 fn cornell_box_agrees_with_the_dense_solve() {
     const EPS: f64 = 0.01;
     let (scene, max_area) = cornell();
@@ -201,8 +231,7 @@ fn cornell_box_agrees_with_the_dense_solve() {
     let s = solve(&scene, max_area, EPS, 500.0);
     let elapsed = t.elapsed();
     // Per surface over the dense mesh's elements, which leave out the floor under the
-    // blocks (contact refinement drops it as buried); the hierarchy's leaves there are
-    // dark and would lower its floor's mean against the dense one's.
+    // blocks (contact refinement drops it as buried, and so does the hierarchy).
     let h = per_surface_projected(&dense.mesh, &s.mesh, &s.radiosity);
     let rms = relative_rms(&scene, &h, &dense.per_surface);
     let c = compare(
@@ -223,14 +252,15 @@ fn cornell_box_agrees_with_the_dense_solve() {
         "cornell eps {EPS} min 500: {elapsed:?}, {} leaves, {} clusters, {} links, {} rounds, {} sweeps, {} rays; per-surface relative RMS {rms:.3e}; per element {c:?}",
         s.report.leaves, s.report.clusters, s.report.links, s.report.rounds, s.report.iterations, s.report.rays
     );
-    // Measured: per-surface relative RMS 1.4e-2; per dense element (the hierarchical
-    // solution averaged over each dense element) RMS 5.0e-2, largest 0.37, mean +0.4e-2,
-    // 7,928 leaves. At this epsilon it is mostly the BF tolerance itself (see the exact
-    // comparison below for small epsilon), and the dense area k = 2 reference's own error
-    // (1.2 % RMS at 2,046 elements). The bounds leave 1.5x margin for the visibility
+    // Measured: per-surface relative RMS 6.1e-3; per dense element (the hierarchical
+    // solution averaged over each dense element) RMS 1.3e-2, largest 1.44 (a piece along
+    // a block's footprint), mean -0.1e-2, 8,178 leaves. Before the hierarchy refined
+    // contacts and iterated its final gather: 1.4e-2, 5.0e-2, 0.37 and +0.4e-2. What is
+    // left is mostly the dense area k = 2 reference's own error (1.2 % RMS at 2,046
+    // elements) and the BF tolerance. The bounds leave 2x margin for the visibility
     // sampling's variation between refinements.
-    assert!(rms < 0.02, "per-surface relative RMS {rms:e}");
-    assert!(c.rms < 0.08, "per-element relative RMS {:e}", c.rms);
+    assert!(rms < 0.012, "per-surface relative RMS {rms:e}");
+    assert!(c.rms < 0.026, "per-element relative RMS {:e}", c.rms);
     assert!(c.bias.abs() < 0.01, "mean difference {:e}", c.bias);
     // Energy: emitted = absorbed + escaped to the solve tolerance; the box is open at the
     // front, so much of the power escapes.
@@ -286,16 +316,22 @@ fn smaller_epsilon_refines_more() {
     assert!(fine.report.links > coarse.report.links);
     assert_eq!(fine.mesh.len(), fine.report.leaves);
     assert_eq!(fine.radiosity.len(), fine.report.leaves);
-    // The leaves tile every surface.
+    // The leaves tile every surface but the pieces buried under the blocks, which contact
+    // refinement drops: no more than each surface, and with the buried area, all of them.
+    let mut total = 0.0;
     for (i, s) in scene.surfaces.iter().enumerate() {
         let range = fine.mesh.surface_elements[i].clone();
         let area: f64 = range.map(|e| fine.mesh.elements[e as usize].area).sum();
         let want = radiosity::geometry::polygon_area(&s.vertices);
-        assert!(
-            (area - want).abs() < 1e-9 * want,
-            "surface {i}: {area} vs {want}"
-        );
+        assert!(area <= want * (1.0 + 1e-9), "surface {i}: {area} vs {want}");
+        total += want - area;
     }
+    let buried = fine.report.buried_area;
+    assert!(buried > 0.0);
+    assert!(
+        (total - buried).abs() < 1e-9 * buried,
+        "{total} vs {buried}"
+    );
 }
 
 #[test]
@@ -365,12 +401,9 @@ fn against_exact_dense(
     max_area: f64,
     settings: &[HierarchicalSettings],
 ) -> Vec<radiosity::compare::Comparison> {
-    // The dense solve on the plain grid: the hierarchy's leaves do not refine contacts
-    // (`refine_contacts`), so against the refined mesh it would differ by the buried
-    // pieces along the blocks' footprints (measured: 2.4 % RMS instead of 0.7 %).
-    let prepared = prepared_cornell(max_area, None);
-    let grid = radiosity::mesh::mesh_scene(&prepared.scene, max_area).unwrap();
-    let mut prepared = prepared.with_mesh(grid).unwrap();
+    // The dense solve on the contact-refined mesh (`refine_contacts`), as `compare` runs
+    // it: the hierarchy refines its leaves along the contacts the same way.
+    let mut prepared = prepared_cornell(max_area, None);
     prepared.method = radiosity::form_factor::FormFactorMethod::Contour { steps: 4 };
     let dense = dense_gauss_seidel(&prepared);
     let emission = prepared.light.emission();
@@ -401,53 +434,60 @@ fn against_exact_dense(
 
 #[test]
 fn cornell_box_element_by_element_against_an_exact_dense_solve() {
-    // The hierarchy itself, without the final gather (held with it by the next test).
-    // 2,046 elements; leaves down to a quarter of an element. Measured: RMS 0.66 %, mean
-    // +0.13 %, largest 11.5 % (an element at a block's footprint, where the two solves'
-    // visibility samples differ). The bound is the target of issue #4 (1 % RMS; 1.5x the
-    // measured value, for the visibility samples' variation between refinements); the
-    // mean bound is 2x the measured one. The largest difference was 29 % (at 1,638
+    // The hierarchy itself, without the final gather (held with it by the next test), on
+    // the contact-refined mesh (2,484 elements; the hierarchy refines its leaves along the
+    // blocks' footprints the same way); leaves down to a quarter of an element. Measured:
+    // RMS 0.63 %, mean -0.18 %, largest 24.8 % (a piece 1/64 of an element along a
+    // footprint, where the two solves' sixteen visibility samples differ most). Before the
+    // hierarchy refined contacts: 2.4 % RMS against this mesh (0.66 % against the plain
+    // grid). The bound is the target of issue #4 (1 % RMS; 1.6x the measured value, for
+    // the visibility samples' variation between refinements); the mean bound is 2x the
+    // measured one, the largest 1.4x. The largest difference was 29 % (at 1,638
     // elements, against contour k = 8) when pairs that sixteen sample pairs called hidden
     // were dropped instead of refined (a footprint element lost the light its uncovered
-    // part sees); 0.2 keeps that out.
+    // part sees).
     let [c, coarse] = against_exact_dense(
         1000.0,
         &[settings(3e-4, 250.0, false), settings(0.05, 250.0, false)],
     )[..] else {
         unreachable!()
     };
-    assert_eq!(c.elements, 2046);
+    assert_eq!(c.elements, 2484);
     assert!(c.rms < 0.01, "{c:?}");
-    assert!(c.bias.abs() < 0.003, "{c:?}");
-    assert!(c.max < 0.2, "{c:?}");
-    // The CLI's default epsilon, 0.05: measured RMS 8.8 %, largest 89 %, mean -0.15 %.
-    // Before a cluster's oracle counted the directions its members see the other node
-    // from, 12.8 %, 177 % and -1.6 % (a triangle of the red wall at 15 % of its
-    // radiosity); the bounds (1.25x, 1.35x, 5x) are between the two.
+    assert!(c.bias.abs() < 0.004, "{c:?}");
+    assert!(c.max < 0.35, "{c:?}");
+    // The CLI's default epsilon, 0.05: measured RMS 8.4 %, largest 87 %, mean -0.86 %
+    // (8.8 %, 89 % and -0.15 % on the plain grid before contacts were refined). Before a
+    // cluster's oracle counted the directions its members see the other node from,
+    // 12.8 %, 177 % and -1.6 % (a triangle of the red wall at 15 % of its radiosity); the
+    // RMS and largest bounds (1.3x, 1.4x) are between the two, the mean's 1.4x the
+    // measured one.
     assert!(coarse.rms < 0.11, "{coarse:?}");
     assert!(coarse.max < 1.2, "{coarse:?}");
-    assert!(coarse.bias.abs() < 0.008, "{coarse:?}");
+    assert!(coarse.bias.abs() < 0.012, "{coarse:?}");
 }
 
 #[test]
 fn default_settings_within_two_percent_of_an_exact_dense_solve() {
     // Issue #11: hierarchical radiosity at its defaults (epsilon 0.05, minimum area
-    // MAX_PATCH_AREA / 16, the final gather), as `--solver auto` runs it above 20,000
-    // elements, within 2 % RMS element by element of the exact dense solve, here at 2,046
-    // elements. Measured (BENCHMARKS.md): RMS 1.58 %, largest 14.9 %, mean +0.33 %; the
-    // same settings without the final gather 8.9 %, 95 % and -0.09 %. Bounds: the issue's
-    // 2 % (1.27x the measured RMS, for the visibility samples' variation between
-    // refinements); the largest difference 0.3, twice the measured one and a third of it
-    // without the gather (blotches pushed down from coarse links come back above it); the
-    // mean 1 %, 3x the measured one.
+    // MAX_PATCH_AREA / 16, the final gather iterated to the tolerance), as `--solver auto`
+    // runs it above 20,000 elements, within 2 % RMS element by element of the exact dense
+    // solve on the contact-refined mesh, here at 2,484 elements. Measured (BENCHMARKS.md):
+    // RMS 1.20 %, largest 41.9 %, mean +0.21 %; before the hierarchy refined contacts
+    // 2.94 %, 159 % and -0.03 % (1.58 % RMS against the plain grid). The largest
+    // differences are at pieces 1/64 of an element along the blocks' footprints, where the
+    // two solves' sixteen visibility samples differ. Bounds: the issue's 2 % (1.7x the
+    // measured RMS, for the visibility samples' variation between refinements); the
+    // largest difference 0.6, 1.4x the measured one and well below the 1.59 before
+    // contacts were refined; the mean 1 %, 5x the measured one.
     let max_area = 1000.0;
     let [c] = against_exact_dense(max_area, &[HierarchicalSettings::defaults_for(max_area)])[..]
     else {
         unreachable!()
     };
-    assert_eq!(c.elements, 2046);
+    assert_eq!(c.elements, 2484);
     assert!(c.rms < 0.02, "{c:?}");
-    assert!(c.max < 0.3, "{c:?}");
+    assert!(c.max < 0.6, "{c:?}");
     assert!(c.bias.abs() < 0.01, "{c:?}");
 }
 

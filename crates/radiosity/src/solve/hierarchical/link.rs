@@ -99,6 +99,9 @@ impl Solver<'_> {
     /// Estimates the link p <- q.
     pub(super) fn estimate(&self, p: u32, q: u32, b_ref: f64, scratch: &mut Vec<u32>) -> Estimate {
         let (np, nq) = (&self.nodes[p as usize], &self.nodes[q as usize]);
+        if np.buried || nq.buried {
+            return Estimate::Nothing;
+        }
         let v = np.centre - nq.centre;
         let r = v.length();
         if self.too_close(np, nq) {

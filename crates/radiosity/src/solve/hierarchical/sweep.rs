@@ -82,6 +82,13 @@ impl Solver<'_> {
         };
         let h: [f64; 3] = std::array::from_fn(|k| h_down[k] + node.gathered[k]);
         let old = self.b[n as usize];
+        if node.buried {
+            // Nothing reaches a buried patch and it sends nothing; its leaves' spread is
+            // left out of its parent's (they are not among the leaves shown).
+            self.b[n as usize] = [0.0; 3];
+            self.b_span[n as usize] = (f64::INFINITY, f64::NEG_INFINITY);
+            return [0.0; 3];
+        }
         if node.child_count == 0 {
             let s = node.surface as usize;
             let new: [f64; 3] =
@@ -118,13 +125,46 @@ impl Solver<'_> {
         change
     }
 
+    /// Every cluster's irradiance bins gathered through its links from the radiosity and
+    /// power bins the nodes hold now.
+    pub(super) fn cluster_incident(&self) -> Vec<[[f64; 6]; 3]> {
+        let (nodes, clusters, root_count) = (&self.nodes, &self.clusters, self.root_count);
+        let (b, cluster_of) = (&self.b, &self.cluster_of);
+        clusters
+            .par_iter()
+            .enumerate()
+            .map(|(c, _)| {
+                let mut inc = [[0.0; 6]; 3];
+                // The cluster's node: clusters are made in order after the roots.
+                let n = &nodes[root_count + c];
+                for l in &n.links {
+                    let c = cluster_of[l.source as usize];
+                    let d = DVec3::new(l.dir[0] as f64, l.dir[1] as f64, l.dir[2] as f64);
+                    let x = if c != NONE {
+                        cluster_emission(&clusters[c as usize].power, d)
+                    } else {
+                        b[l.source as usize]
+                    };
+                    for k in 0..3 {
+                        // Light travelling along d lands on surfaces facing -d.
+                        let w = l.g as f64 * d[k].abs();
+                        let slot = bin(k, -d[k]);
+                        for band in 0..3 {
+                            inc[band][slot] += w * x[band];
+                        }
+                    }
+                }
+                inc
+            })
+            .collect()
+    }
+
     /// Gather / push-pull sweeps until the power that changes is below the tolerance;
     /// returns the sweeps made and the last residual (fraction of emitted power).
     pub(super) fn solve(&mut self, emitted: [f64; 3]) -> Result<(usize, f64), SolveError> {
         for sweep in 1..=MAX_SWEEPS {
             let nodes = &self.nodes;
             let clusters = &self.clusters;
-            let root_count = self.root_count;
             let (b, cluster_of) = (&self.b, &self.cluster_of);
             let gathered: Vec<[f64; 3]> = nodes
                 .par_iter()
@@ -148,33 +188,7 @@ impl Solver<'_> {
                     g
                 })
                 .collect();
-            let incident: Vec<[[f64; 6]; 3]> = clusters
-                .par_iter()
-                .enumerate()
-                .map(|(c, _)| {
-                    let mut inc = [[0.0; 6]; 3];
-                    // The cluster's node: clusters are made in order after the roots.
-                    let n = &nodes[root_count + c];
-                    for l in &n.links {
-                        let c = cluster_of[l.source as usize];
-                        let d = DVec3::new(l.dir[0] as f64, l.dir[1] as f64, l.dir[2] as f64);
-                        let x = if c != NONE {
-                            cluster_emission(&clusters[c as usize].power, d)
-                        } else {
-                            b[l.source as usize]
-                        };
-                        for k in 0..3 {
-                            // Light travelling along d lands on surfaces facing -d.
-                            let w = l.g as f64 * d[k].abs();
-                            let slot = bin(k, -d[k]);
-                            for band in 0..3 {
-                                inc[band][slot] += w * x[band];
-                            }
-                        }
-                    }
-                    inc
-                })
-                .collect();
+            let incident = self.cluster_incident();
             for (n, g) in self.nodes.iter_mut().zip(gathered) {
                 n.gathered = g;
             }

@@ -38,6 +38,13 @@ pub(super) struct Node {
     pub(super) links: Vec<Link>,
     /// A patch's gathered irradiance.
     pub(super) gathered: [f64; 3],
+    /// A patch wholly buried under or inside other surfaces (see the `contact` module): it
+    /// carries no light.
+    pub(super) buried: bool,
+    /// A patch in a cell that is partly buried (the cell and every piece of it): its links'
+    /// visibility, sampled from coarser receivers, says little about it, so the final
+    /// gather samples it again from the leaf.
+    pub(super) straddles: bool,
 }
 
 impl Node {
@@ -103,6 +110,8 @@ impl Solver<'_> {
             area: geometry::polygon_area(poly),
             links: Vec::new(),
             gathered: [0.0; 3],
+            buried: false,
+            straddles: false,
         });
         self.b.push(b);
         self.b_span.push((max3(b), max3(b)));
@@ -198,6 +207,8 @@ impl Solver<'_> {
             area,
             links: Vec::new(),
             gathered: [0.0; 3],
+            buried: false,
+            straddles: false,
         });
         self.b.push([0.0; 3]);
         self.b_span.push((0.0, 0.0));
@@ -279,9 +290,14 @@ impl Solver<'_> {
             }
         }
         let count = node.count as usize;
+        let straddles = node.straddles;
         let children: Vec<u32> = made
             .iter()
-            .map(|(poly, grid)| self.new_patch(surface, &poly[..count], *grid, b))
+            .map(|(poly, grid)| {
+                let c = self.new_patch(surface, &poly[..count], *grid, b);
+                self.nodes[c as usize].straddles = straddles;
+                c
+            })
             .collect();
         let node = &mut self.nodes[n as usize];
         node.children[..children.len()].copy_from_slice(&children);
@@ -294,8 +310,12 @@ impl Solver<'_> {
         (n as usize) < self.root_count
     }
 
+    /// The leaves under `n` that are not buried (the elements a solve returns).
     pub(super) fn leaves_of(&self, n: u32, out: &mut Vec<u32>) {
         let node = &self.nodes[n as usize];
+        if node.buried {
+            return;
+        }
         if node.child_count == 0 {
             out.push(n);
         } else {
