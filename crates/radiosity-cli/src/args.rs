@@ -115,7 +115,7 @@ pub struct SolveOptions {
     pub min_area: Option<f64>,
     /// Hierarchical: leave out the final gather (each leaf then takes its ancestors'
     /// irradiance pushed down, as before the gather was added). It is left out anyway
-    /// above 100,000 elements, where it costs several times the solve.
+    /// above 250,000 elements, where it costs several times the solve.
     #[arg(long)]
     pub no_final_gather: bool,
     /// Dense solvers: rounds of adaptive subdivision after the first solve (each splits

@@ -159,9 +159,13 @@ impl Solver<'_> {
             .collect()
     }
 
-    /// Gather / push-pull sweeps until the power that changes is below the tolerance;
-    /// returns the sweeps made and the last residual (fraction of emitted power).
-    pub(super) fn solve(&mut self, emitted: [f64; 3]) -> Result<(usize, f64), SolveError> {
+    /// Gather / push-pull sweeps until the power that changes is below `tolerance` (a
+    /// fraction of the emitted power); returns the sweeps made and the last residual.
+    pub(super) fn solve(
+        &mut self,
+        emitted: [f64; 3],
+        tolerance: f64,
+    ) -> Result<(usize, f64), SolveError> {
         for sweep in 1..=MAX_SWEEPS {
             let nodes = &self.nodes;
             let clusters = &self.clusters;
@@ -200,7 +204,7 @@ impl Solver<'_> {
                 .filter(|&k| emitted[k] > 0.0)
                 .map(|k| change[k] / emitted[k])
                 .fold(0.0, f64::max);
-            if residual <= self.settings.tolerance {
+            if residual <= tolerance {
                 return Ok((sweep, residual));
             }
         }
