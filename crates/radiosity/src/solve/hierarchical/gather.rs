@@ -221,12 +221,8 @@ impl Solver<'_> {
         self.gather_from_patch(l, q, link.visible < 1.0 || straddles, terms, scratch);
     }
 
-    /// The final gather (see the module documentation): sets every leaf's radiosity to
-    /// E + rho H from the irradiance H gathered at the leaf, iterated with the gathered
-    /// terms to the solve's tolerance (or [`GATHER_PASSES`] passes where the terms are too
-    /// many to keep), and returns each leaf's H.
-    pub(super) fn final_gather(&mut self) -> HashMap<u32, [f64; 3]> {
-        self.split_leaves_to_cells();
+    /// Every patch's parent (`NONE` for roots and clusters) and the leaves of every root.
+    fn parents_and_leaves(&self) -> (Vec<u32>, Vec<u32>) {
         let mut parent = vec![NONE; self.nodes.len()];
         for (i, n) in self.nodes.iter().enumerate() {
             if !n.is_cluster() {
@@ -235,11 +231,21 @@ impl Solver<'_> {
                 }
             }
         }
-        let from_clusters = self.irradiance_from_clusters();
         let mut leaves = Vec::new();
         for r in 0..self.root_count as u32 {
             self.leaves_of(r, &mut leaves);
         }
+        (parent, leaves)
+    }
+
+    /// The final gather (see the module documentation): sets every leaf's radiosity to
+    /// E + rho H from the irradiance H gathered at the leaf, iterated with the gathered
+    /// terms to the solve's tolerance (or [`GATHER_PASSES`] passes where the terms are too
+    /// many to keep), and returns each leaf's H.
+    pub(super) fn final_gather(&mut self) -> HashMap<u32, [f64; 3]> {
+        self.split_leaves_to_cells();
+        let (parent, leaves) = self.parents_and_leaves();
+        let from_clusters = self.irradiance_from_clusters();
         let emitted: [f64; 3] = std::array::from_fn(|k| {
             leaves
                 .iter()
@@ -318,19 +324,8 @@ impl Solver<'_> {
     /// light a piece half under a block as if it were in the open. `h_of` (each leaf's
     /// irradiance) is updated for them.
     pub(super) fn gather_contacts(&mut self, h_of: &mut HashMap<u32, [f64; 3]>) {
-        let mut parent = vec![NONE; self.nodes.len()];
-        for (i, n) in self.nodes.iter().enumerate() {
-            if !n.is_cluster() {
-                for &c in n.children() {
-                    parent[c as usize] = i as u32;
-                }
-            }
-        }
+        let (parent, mut leaves) = self.parents_and_leaves();
         let from_clusters = self.irradiance_from_clusters();
-        let mut leaves = Vec::new();
-        for r in 0..self.root_count as u32 {
-            self.leaves_of(r, &mut leaves);
-        }
         leaves.retain(|&l| self.nodes[l as usize].straddles);
         if leaves.is_empty() {
             return;
