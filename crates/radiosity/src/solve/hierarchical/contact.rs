@@ -58,6 +58,26 @@ impl Solver<'_> {
         on_grid || (node.grid == [0, 0] && node.area > cell_area * (1.0 + 1e-9))
     }
 
+    /// Sets every patch's `open_area`: its area less that of its buried descendants, from
+    /// the leaves up (roots are the first `root_count` nodes; clusters are left as they are).
+    pub(super) fn set_open_areas(&mut self) {
+        fn open(nodes: &mut [super::tree::Node], n: usize) -> f64 {
+            let (count, children) = (nodes[n].child_count as usize, nodes[n].children);
+            let a = if nodes[n].buried {
+                0.0
+            } else if count == 0 {
+                nodes[n].area
+            } else {
+                (0..count).map(|c| open(nodes, children[c] as usize)).sum()
+            };
+            nodes[n].open_area = a;
+            a
+        }
+        for r in 0..self.root_count {
+            open(&mut self.nodes, r);
+        }
+    }
+
     /// Splits the patches along the contacts and marks the buried ones (see the module
     /// documentation); `max_patch_area` is the scene's MAX_PATCH_AREA, the largest cell.
     pub(super) fn refine_contacts(&mut self, scene: &Scene, max_patch_area: f64) -> ContactCount {

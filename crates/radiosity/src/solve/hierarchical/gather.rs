@@ -78,7 +78,7 @@ impl Solver<'_> {
             let cn = &self.nodes[c as usize];
             let cb = self.b[c as usize];
             for k in 0..3 {
-                sum[k] += cn.area * cb[k];
+                sum[k] += cn.open_area * cb[k];
             }
             if is_cluster {
                 if cn.is_cluster() {
@@ -93,13 +93,18 @@ impl Solver<'_> {
                     for band in 0..3 {
                         for k in 0..3 {
                             power[band][super::bins::bin(k, m[k])] +=
-                                cn.area * cb[band] * m[k].abs();
+                                cn.open_area * cb[band] * m[k].abs();
                         }
                     }
                 }
             }
         }
-        let area = self.nodes[n as usize].area;
+        // Patches: the mean over the open area (see `push_pull`); clusters: over all.
+        let area = if is_cluster {
+            self.nodes[n as usize].area
+        } else {
+            self.nodes[n as usize].open_area
+        };
         self.b[n as usize] = sum.map(|s| if area > 0.0 { s / area } else { 0.0 });
         if is_cluster {
             let c = self.nodes[n as usize].cluster as usize;

@@ -333,6 +333,7 @@ pub fn solve_hierarchical(
     solver.top = solver.build_clusters(&mut all_roots);
     // Leaves along contacts split as the dense pipeline's mesh, buried pieces marked.
     let contacts = solver.refine_contacts(scene, max_patch_area);
+    solver.set_open_areas();
     let total_area: f64 = scene
         .surfaces
         .iter()

@@ -35,6 +35,10 @@ pub(super) struct Node {
     pub(super) centre: DVec3,
     pub(super) radius: f64,
     pub(super) area: f64,
+    /// The area of a patch less its buried descendants' (see the `contact` module): where
+    /// the light its links bring is spread when pushed down (= `area` where nothing under
+    /// it is buried, 0 for a buried patch).
+    pub(super) open_area: f64,
     pub(super) links: Vec<Link>,
     /// A patch's gathered irradiance.
     pub(super) gathered: [f64; 3],
@@ -108,6 +112,7 @@ impl Solver<'_> {
             centre,
             radius,
             area: geometry::polygon_area(poly),
+            open_area: geometry::polygon_area(poly),
             links: Vec::new(),
             gathered: [0.0; 3],
             buried: false,
@@ -205,6 +210,7 @@ impl Solver<'_> {
             centre,
             radius: 0.5 * (hi - lo).length(),
             area,
+            open_area: area,
             links: Vec::new(),
             gathered: [0.0; 3],
             buried: false,
