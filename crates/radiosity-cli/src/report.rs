@@ -28,6 +28,30 @@ pub fn form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter:
     ));
 }
 
+/// Notes where the emitted power went (the largest band's share): absorbed, and escaped
+/// (light that reached no element: through openings, into gaps and the backs of faces, or
+/// counted twice where negative), so every solve says how far its light can be trusted.
+/// `check` prints the same account in full and says where the escaped part goes.
+pub fn energy_note(solution: &Solution, reporter: &Reporter) {
+    let b = &solution.balance;
+    let Some(band) = (0..3)
+        .filter(|&k| b.emitted[k] > 0.0)
+        .max_by(|&x, &y| b.emitted[x].total_cmp(&b.emitted[y]))
+    else {
+        return;
+    };
+    let share = |x: f64| 100.0 * x / b.emitted[band];
+    let mut text = format!(
+        "energy: of the emitted power {:.2} % absorbed, {:.2} % escaped",
+        share(b.absorbed[band]),
+        share(b.escaped[band])
+    );
+    if let SolutionReport::Progressive(_) = solution.report {
+        text.push_str(" (the rest is still unshot)");
+    }
+    reporter.note(&text);
+}
+
 /// Notes what adaptive subdivision did, round by round.
 pub fn adapt(report: &AdaptReport, reporter: &Reporter) {
     if report.rounds.is_empty() {

@@ -67,6 +67,7 @@ pub fn solve_scene(
     if let Some(stats) = &solution.form_factors {
         report::form_factor_stats(prepared, stats, reporter);
     }
+    report::energy_note(&solution, reporter);
     let stats = solution.form_factors;
     Ok((solution, stats))
 }
