@@ -11,8 +11,9 @@
 //! approach for realistic image synthesis", substructuring by the radiosity gradient) that
 //! Lightscape and AGi32 apply between solves, within a budget of elements.
 //!
-//! Elements touch when a corner of one lies on the boundary of the other, so the steps
-//! across T-junctions left by earlier splits are seen too.
+//! Elements touch when they share a vertex of their display polygons (a corner of one on
+//! the boundary of the other), so the steps across T-junctions left by earlier splits are
+//! seen too.
 
 use glam::DVec3;
 
@@ -128,100 +129,30 @@ pub fn split_marked(mesh: &Mesh, surfaces: usize, marks: &[bool]) -> (Mesh, Vec<
     (refined, origin)
 }
 
-/// Every pair (a, b), a < b, of elements of one surface that touch: a corner of one lies on
-/// the boundary of the other (within a billionth of the surface's largest element size).
-/// Found through a uniform grid of cells as large as the surface's largest element, so
-/// each element is tested against those in the cells its box overlaps.
+/// Every pair (a, b), a < b, of elements of one surface that touch: share a vertex of
+/// their display polygons ([`Mesh::display`]), which hold each element's corners and the
+/// T-vertices on its edges, so a corner of one lying on the boundary of the other counts
+/// (vertices are shared by index within a surface, and surfaces share none).
 pub(crate) fn touching_pairs(mesh: &Mesh) -> Vec<(u32, u32)> {
-    let mut pairs = Vec::new();
-    for range in &mesh.surface_elements {
-        let elements: Vec<usize> = range.clone().map(|e| e as usize).collect();
-        if elements.len() < 2 {
-            continue;
+    let display = mesh.display();
+    let mut at_vertex: Vec<Vec<u32>> = vec![Vec::new(); mesh.vertices.len()];
+    for e in 0..mesh.len() {
+        for &v in display.polygon(e) {
+            at_vertex[v as usize].push(e as u32);
         }
-        let corners: Vec<Vec<DVec3>> = elements
-            .iter()
-            .map(|&e| mesh.corner_positions(e).collect())
-            .collect();
-        let boxes: Vec<(DVec3, DVec3)> = corners
-            .iter()
-            .map(|c| {
-                c.iter().fold(
-                    (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-                    |(lo, hi), &p| (lo.min(p), hi.max(p)),
-                )
-            })
-            .collect();
-        let size = boxes
-            .iter()
-            .map(|(lo, hi)| (*hi - *lo).max_element())
-            .fold(0.0f64, f64::max);
-        if !(size > 0.0 && size.is_finite()) {
-            continue;
-        }
-        let eps = 1e-9 * size;
-        let origin = boxes
-            .iter()
-            .fold(DVec3::splat(f64::INFINITY), |lo, b| lo.min(b.0));
-        let cell = |p: DVec3| {
-            let c = ((p - origin) / size).floor();
-            [c.x as i64, c.y as i64, c.z as i64]
-        };
-        let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> =
-            std::collections::HashMap::new();
-        for (k, (lo, hi)) in boxes.iter().enumerate() {
-            let (a, b) = (cell(*lo - DVec3::splat(eps)), cell(*hi + DVec3::splat(eps)));
-            for x in a[0]..=b[0] {
-                for y in a[1]..=b[1] {
-                    for z in a[2]..=b[2] {
-                        grid.entry([x, y, z]).or_default().push(k);
-                    }
-                }
-            }
-        }
-        let mut found: Vec<(u32, u32)> = Vec::new();
-        for members in grid.values() {
-            for (i, &p) in members.iter().enumerate() {
-                for &q in &members[i + 1..] {
-                    let (p, q) = (p.min(q), p.max(q));
-                    let overlap = (boxes[p].0 - DVec3::splat(eps)).cmple(boxes[q].1).all()
-                        && (boxes[q].0 - DVec3::splat(eps)).cmple(boxes[p].1).all();
-                    if overlap && touch(&corners[p], &corners[q], eps) {
-                        found.push((elements[p] as u32, elements[q] as u32));
-                    }
-                }
-            }
-        }
-        // A pair sharing several cells is found once per cell.
-        found.sort_unstable();
-        found.dedup();
-        pairs.extend(found);
     }
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    for elements in &at_vertex {
+        for (k, &a) in elements.iter().enumerate() {
+            for &b in &elements[k + 1..] {
+                pairs.push((a.min(b), a.max(b)));
+            }
+        }
+    }
+    // A pair sharing an edge is found at both its ends.
+    pairs.sort_unstable();
+    pairs.dedup();
     pairs
-}
-
-/// True when a corner of polygon `a` lies within `eps` of an edge of `b`, or one of `b`'s
-/// within `eps` of an edge of `a`.
-fn touch(a: &[DVec3], b: &[DVec3], eps: f64) -> bool {
-    let on_boundary = |p: DVec3, poly: &[DVec3]| {
-        (0..poly.len()).any(|i| {
-            let (s, t) = (poly[i], poly[(i + 1) % poly.len()]);
-            segment_distance(p, s, t) <= eps
-        })
-    };
-    a.iter().any(|&p| on_boundary(p, b)) || b.iter().any(|&p| on_boundary(p, a))
-}
-
-/// The distance from `p` to the segment from `s` to `t`.
-fn segment_distance(p: DVec3, s: DVec3, t: DVec3) -> f64 {
-    let d = t - s;
-    let len2 = d.length_squared();
-    let u = if len2 > 0.0 {
-        ((p - s).dot(d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (s + u * d - p).length()
 }
 
 #[cfg(test)]
