@@ -270,7 +270,15 @@ impl<'a> AreaIntegrator<'a> {
                     // bookcase's side sees the floor element under it through no point
                     // of the floor element's 4 x 4: judged from those the pair would
                     // count as wholly visible).
-                    let clipped = self.facing_parts(ci.as_slice(), ni, cj.as_slice(), nj);
+                    let facing = self.facing_polygons(ci.as_slice(), ni, cj.as_slice(), nj);
+                    let (poly_i, poly_j) = match &facing {
+                        Some((a, b)) => (a.as_slice(), b.as_slice()),
+                        None => (ci.as_slice(), cj.as_slice()),
+                    };
+                    let clipped = facing.as_ref().map(|_| {
+                        let n = (NEAR_STEPS * NEAR_STEPS) as usize;
+                        (sample_polygon(poly_i, n), sample_polygon(poly_j, n))
+                    });
                     let (points_i, points_j) = match (&clipped, self.kernel) {
                         (Some((a, b)), _) => (a.as_slice(), b.as_slice()),
                         (None, PairKernel::AreaExactNear) => {
@@ -285,28 +293,15 @@ impl<'a> AreaIntegrator<'a> {
                         })
                     };
                     let (mut visible, mut total) = judge(points_i, points_j, &mut cast);
-                    // A near pair seen in part: judged again from about 8 x 8 points on
-                    // each side (the parts facing each other), 16 times the rays. A partly
-                    // hidden pair of large elements (the wall behind a bookcase, seen
-                    // between two shelves) is where 4 x 4 points miss most.
+                    // A near pair seen in part: judged again from FINE_POINTS lattice points
+                    // on each side (of the parts facing each other), about 12 times the
+                    // rays. A partly hidden pair of large elements (the wall behind a
+                    // bookcase, seen between two shelves) is where 4 x 4 points miss most.
                     if self.kernel == PairKernel::AreaExactNear && visible > 0.0 && visible < total
                     {
-                        let (fi, fj) = match &clipped {
-                            Some(_) => self
-                                .facing_polygons(ci.as_slice(), ni, cj.as_slice(), nj)
-                                .map(|(a, b)| {
-                                    (
-                                        sample_polygon(&a, FINE_POINTS),
-                                        sample_polygon(&b, FINE_POINTS),
-                                    )
-                                })
-                                .unwrap_or_default(),
-                            None => (
-                                sample_polygon(ci.as_slice(), FINE_POINTS),
-                                sample_polygon(cj.as_slice(), FINE_POINTS),
-                            ),
-                        };
-                        let (v, t) = judge(&fi, &fj, &mut cast);
+                        let fine_i = sample_polygon(poly_i, FINE_POINTS);
+                        let fine_j = sample_polygon(poly_j, FINE_POINTS);
+                        let (v, t) = judge(&fine_i, &fine_j, &mut cast);
                         if t > 0.0 {
                             (visible, total) = (v, t);
                         }
@@ -361,20 +356,6 @@ impl<'a> AreaIntegrator<'a> {
         };
         let (pa, pb) = (part(a, nb, b[0])?, part(b, na, a[0])?);
         (pa.len() >= 3 && pb.len() >= 3).then_some((pa, pb))
-    }
-
-    /// [`AreaIntegrator::facing_polygons`] as about [`NEAR_STEPS`]^2 weighted points each.
-    fn facing_parts(
-        &self,
-        a: &[DVec3],
-        na: DVec3,
-        b: &[DVec3],
-        nb: DVec3,
-    ) -> Option<(Vec<(DVec3, f64)>, Vec<(DVec3, f64)>)> {
-        let (pa, pb) = self.facing_polygons(a, na, b, nb)?;
-        let n = (NEAR_STEPS * NEAR_STEPS) as usize;
-        let (sa, sb) = (sample_polygon(&pa, n), sample_polygon(&pb, n));
-        (!sa.is_empty() && !sb.is_empty()).then_some((sa, sb))
     }
 
     /// The area kernel summed over all point pairs of elements i and j: A_i F_ij by the
@@ -493,9 +474,7 @@ fn sample_polygon(p: &[DVec3], count: usize) -> Vec<(DVec3, f64)> {
             let start = out.len();
             let mut total = 0.0;
             for (u, v) in lattice(count.max(1)) {
-                let du = (1.0 - v) * (p[1] - p[0]) + v * (p[2] - p[3]);
-                let dv = (1.0 - u) * (p[3] - p[0]) + u * (p[2] - p[1]);
-                let w = du.cross(dv).length();
+                let w = crate::mesh::bilinear_jacobian(p, u, v);
                 total += w;
                 out.push((crate::mesh::bilinear(p, u, v), w));
             }

@@ -440,13 +440,9 @@ mod tests {
         // within 1e-4 of its origin). The rug covers 2 m^2, on dyadic lines of the grid at
         // level 1: the floor keeps exactly 16 - 2 = 14 m^2.
         for lift in [0.0, 1e-4] {
+            // The rectangle [x0, x1] x [z0, z1] at height y, facing +y.
             let quad = |x0: f64, x1: f64, z0: f64, z1: f64, y: f64| {
-                vec![
-                    dvec3(x0, y, z0),
-                    dvec3(x0, y, z1),
-                    dvec3(x1, y, z1),
-                    dvec3(x1, y, z0),
-                ]
+                axis_aligned_base(dvec3(x0, y, z0), dvec3(x1 - x0, 0., z1 - z0)).to_vec()
             };
             let scene = Scene {
                 surfaces: vec![

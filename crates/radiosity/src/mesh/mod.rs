@@ -225,6 +225,14 @@ pub fn bilinear(q: &[DVec3], u: f64, v: f64) -> DVec3 {
     (1.0 - u) * (1.0 - v) * q[0] + u * (1.0 - v) * q[1] + u * v * q[2] + (1.0 - u) * v * q[3]
 }
 
+/// |d/du x d/dv| of the bilinear map of [`bilinear`] at (u, v): the area a unit of
+/// parameter area covers there.
+pub(crate) fn bilinear_jacobian(q: &[DVec3], u: f64, v: f64) -> f64 {
+    let du = (1.0 - v) * (q[1] - q[0]) + v * (q[2] - q[3]);
+    let dv = (1.0 - u) * (q[3] - q[0]) + u * (q[2] - q[1]);
+    du.cross(dv).length()
+}
+
 fn max_quad_cell_area(q: &[DVec3], nu: u32, nv: u32) -> f64 {
     // The Jacobian of a planar bilinear map is linear in u and v, so the largest cell lies
     // in a corner of the grid.
@@ -431,10 +439,8 @@ impl Mesh {
             for j in 0..k {
                 for i in 0..k {
                     let (u, v) = ((i as f64 + 0.5) / kf, (j as f64 + 0.5) / kf);
-                    // |d/du x d/dv| of the bilinear map, times the cell's parameter area.
-                    let du = (1.0 - v) * (p[1] - p[0]) + v * (p[2] - p[3]);
-                    let dv = (1.0 - u) * (p[3] - p[0]) + u * (p[2] - p[1]);
-                    let w = du.cross(dv).length() / (kf * kf);
+                    // The Jacobian times the cell's parameter area.
+                    let w = bilinear_jacobian(&p, u, v) / (kf * kf);
                     total += w;
                     out.push((bilinear(&p, u, v), w));
                 }

@@ -174,6 +174,7 @@ fn clipped_area(a: &[DVec3], b: &[DVec3], normal: DVec3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::shape::axis_aligned_base;
     use crate::scene::{Rgb, Surface};
     use glam::dvec3;
 
@@ -185,13 +186,9 @@ mod tests {
             reflectance: Rgb([0.5; 3]),
             vertices,
         };
+        // The rectangle [x0, x1] x [z0, z1] at height y, facing +y.
         let quad = |x0: f64, x1: f64, z0: f64, z1: f64, y: f64| {
-            vec![
-                dvec3(x0, y, z0),
-                dvec3(x0, y, z1),
-                dvec3(x1, y, z1),
-                dvec3(x1, y, z0),
-            ]
+            axis_aligned_base(dvec3(x0, y, z0), dvec3(x1 - x0, 0., z1 - z0)).to_vec()
         };
         Scene {
             surfaces: vec![
