@@ -126,7 +126,7 @@ pub struct SolveOptions {
     pub adapt_rounds: Option<u32>,
     /// Adaptive subdivision: a step between touching elements is split when it exceeds this
     /// fraction of the brighter one's luminance (and 5 % of white).
-    #[arg(long, default_value_t = 0.3, value_name = "FRACTION")]
+    #[arg(long, default_value_t = radiosity::mesh::DEFAULT_CONTRAST, value_name = "FRACTION")]
     pub adapt_contrast: f64,
     /// Adaptive subdivision: the refined mesh has at most this many elements (default: twice
     /// the mesh's, at most 20,000, and no more new form-factor pairs than n^2, about twice

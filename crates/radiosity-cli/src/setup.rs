@@ -327,31 +327,25 @@ pub fn adapt(
         }
         return Ok(None);
     }
-    let n = prepared.mesh.len();
-    Ok(Some(AdaptSettings {
-        contrast: options.adapt_contrast,
-        // Steps darker than 5 % of white are hard to see and spend the budget inside
-        // bookcases and under tables (building_small: 5.79 % pixel RMS at 1 %, 5.61 % at 5 %).
-        floor: ADAPT_FLOOR,
-        min_area: prepared.settings.max_patch_area / 64.0,
-        max_elements: options
-            .adapt_max_elements
-            .unwrap_or((2 * n).min(DEFAULT_ADAPT_MAX_ELEMENTS).max(n)),
+    let defaults = AdaptSettings::defaults(
+        prepared.mesh.len(),
+        prepared.settings.max_patch_area,
         rounds,
-        // The refinement integrates at most twice the first matrix's pairs, so the form
-        // factors take at most about three times as long as without it, or 4 million pairs
-        // on small meshes (a second or two).
-        max_new_pairs: match options.adapt_max_elements {
-            Some(_) => u64::MAX,
-            None => (n as u64)
-                .saturating_mul(n as u64)
-                .max(ADAPT_MIN_PAIR_BUDGET),
+    );
+    Ok(Some(match options.adapt_max_elements {
+        // Given, only this limit holds.
+        Some(max_elements) => AdaptSettings {
+            contrast: options.adapt_contrast,
+            max_elements,
+            max_new_pairs: u64::MAX,
+            ..defaults
+        },
+        None => AdaptSettings {
+            contrast: options.adapt_contrast,
+            ..defaults
         },
     }))
 }
-
-/// Steps smaller than this fraction of white are not split (see [`AdaptSettings::floor`]).
-pub const ADAPT_FLOOR: f64 = 0.05;
 
 /// Rounds of adaptive subdivision when `--adapt-rounds` is not given: none. Against the
 /// path tracer (BENCHMARKS.md) two rounds take examples/room.scene from 4.24 % to 2.81 %
@@ -360,12 +354,3 @@ pub const ADAPT_FLOOR: f64 = 0.05;
 /// bookcases and chairs inherit the area method's over-counted near pairs (rows up to
 /// 1.13), and the whole picture gets brighter. Until that is fixed it is asked for.
 pub const DEFAULT_ADAPT_ROUNDS: u32 = 0;
-
-/// New form-factor pairs adaptive subdivision may always integrate, however small the
-/// first mesh: examples/room.scene (907 elements, 0.8 million pairs) needs about 3.3 million
-/// for its two rounds (4.24 % -> 2.73 % against the path tracer).
-pub const ADAPT_MIN_PAIR_BUDGET: u64 = 4_000_000;
-
-/// The most elements adaptive subdivision makes when `--adapt-max-elements` is not given:
-/// where `--solver auto` turns to hierarchical radiosity.
-pub const DEFAULT_ADAPT_MAX_ELEMENTS: usize = 20_000;

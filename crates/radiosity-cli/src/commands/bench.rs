@@ -115,7 +115,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         min_area: args.min_area,
         no_final_gather: false,
         adapt_rounds: None,
-        adapt_contrast: 0.3,
+        adapt_contrast: radiosity::mesh::DEFAULT_CONTRAST,
         adapt_max_elements: None,
     };
     let settings = RenderSettings {

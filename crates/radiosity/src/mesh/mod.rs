@@ -18,7 +18,10 @@ mod adapt;
 mod conforming;
 mod contact;
 
-pub use adapt::{mark_steps, split_marked, AdaptSettings, Origin};
+pub use adapt::{
+    mark_steps, split_marked, AdaptSettings, Origin, DEFAULT_CONTRAST, DEFAULT_FLOOR,
+    DEFAULT_MAX_ELEMENTS, MIN_PAIR_BUDGET,
+};
 #[cfg(test)]
 pub(crate) use conforming::split_corner_mesh;
 pub use conforming::{DisplayPolygons, DisplayTriangle};
