@@ -12,8 +12,9 @@
 //! so the two solutions can be compared element by element along the contacts.
 //!
 //! A buried patch carries no light: it holds and is the source of no link, its radiosity is
-//! zero (its parent's area average counts it as dark, which is what its parent sends), it
-//! absorbs nothing in the energy account and it is not among the leaves returned.
+//! zero, it absorbs nothing in the energy account and it is not among the leaves returned.
+//! Its ancestors keep their *open area* (area less the buried pieces', `set_open_areas`):
+//! the light their links bring is spread over it, and their radiosity is the mean over it.
 
 use rayon::prelude::*;
 
