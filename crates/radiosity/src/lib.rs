@@ -78,6 +78,7 @@ pub mod render;
 pub mod scene;
 pub mod shade;
 pub mod solve;
+mod splitmix;
 pub mod visibility;
 
 /// The solution writer's module at the path the command line uses; it lives in

@@ -7,14 +7,7 @@ use glam::DVec3;
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
-/// SplitMix64's finaliser (Steele, Lea and Flood, "Fast splittable pseudorandom number
-/// generators", OOPSLA 2014): a bijection of u64 that scatters nearby inputs.
-fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
+use crate::splitmix::splitmix64;
 
 /// The generator of pixel `pixel` (its index, row by row from the top-left corner) under
 /// `seed`: a 128-bit PCG state whose high half is a bijection of the pixel index (so the

@@ -48,6 +48,7 @@ use crate::geometry;
 use crate::light::Rgb;
 use crate::mesh::Mesh;
 use crate::scene::Scene;
+use crate::splitmix::jitter;
 use crate::visibility::PolygonBvh;
 
 /// Shadow rays per emitter in the first pass at a point (about: the strata are whole
@@ -235,22 +236,6 @@ impl DirectLight {
 
 /// Salts the fine pass apart from the coarse one.
 const FINE_SALT: u64 = 0x6a09_e667_f3bc_c909;
-
-/// A point in [0, 1)^2 that depends on `salt` and `stratum` only: the jitter of one stratum.
-fn jitter(salt: u64, stratum: usize) -> (f64, f64) {
-    let a = splitmix(salt ^ splitmix(stratum as u64));
-    let b = splitmix(a);
-    let unit = |h: u64| (h >> 11) as f64 / (1u64 << 53) as f64;
-    (unit(a), unit(b))
-}
-
-/// SplitMix64's output function (Steele, Lea and Flood 2014): a hash, not a generator here.
-fn splitmix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
 
 /// The correction of smooth shading by the direct light at each point (see the module
 /// documentation): `rho(x) (D(x) - D_smooth(x))`, for one mesh of one scene, whatever the
