@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 use super::link::Link;
-use super::tree::{Cluster, Node, CLUSTER_SAMPLES};
+use super::tree::{Cluster, ClusterSample, Node, CLUSTER_SAMPLES};
 use super::HierarchicalSettings;
 use crate::visibility::PolygonBvh;
 
@@ -47,7 +47,9 @@ impl Solver<'_> {
     /// Bytes held by nodes, clusters and links (links with the slack of their vectors).
     pub(super) fn memory_bytes(&self) -> u64 {
         (self.nodes.len() * (std::mem::size_of::<Node>() + 28)
-            + self.clusters.len() * (std::mem::size_of::<Cluster>() + CLUSTER_SAMPLES * 48)
+            + self.clusters.len()
+                * (std::mem::size_of::<Cluster>()
+                    + CLUSTER_SAMPLES * std::mem::size_of::<ClusterSample>())
             + self.link_count * std::mem::size_of::<Link>() * 3 / 2) as u64
     }
 }

@@ -80,8 +80,57 @@ pub(super) struct Cluster {
     pub(super) b_max: f64,
     /// Gathered irradiance bins per band.
     pub(super) incident: [[f64; 6]; 3],
-    /// Points on surfaces inside, with their normals, for visibility.
-    pub(super) samples: Vec<(DVec3, DVec3)>,
+    /// Points on surfaces inside, with their normals and the area each stands for, for
+    /// visibility ([`ClusterSample`]).
+    pub(super) samples: Vec<ClusterSample>,
+}
+
+/// A point on a surface inside a cluster, its surface's unit normal, and the area of the
+/// cluster it stands for (the cluster's samples' areas sum to the cluster's area).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ClusterSample {
+    pub(super) point: DVec3,
+    pub(super) normal: DVec3,
+    pub(super) area: f64,
+}
+
+/// Up to [`CLUSTER_SAMPLES`] samples standing for `candidates` (the two children's
+/// samples), drawn in proportion to area by systematic sampling over the candidates'
+/// cumulative area: a sample drawn k times stands for k / CLUSTER_SAMPLES of the total. The
+/// visible fraction of a cluster link is a mean over its samples weighted by their area
+/// (see [`super::Solver::visibility`]); before, each child gave half the samples whatever
+/// its area, so a table's legs, hidden under its top, counted as much as the top, and a
+/// cluster's links came out dark: a 3 x 3 generated building lost 10.7 % of its emitted
+/// power at the default epsilon (a dense solve of it, 0.0 %).
+fn draw_samples(candidates: &[ClusterSample]) -> Vec<ClusterSample> {
+    if candidates.len() <= CLUSTER_SAMPLES {
+        return candidates.to_vec();
+    }
+    let total: f64 = candidates.iter().map(|s| s.area).sum();
+    if !(total > 0.0) {
+        return candidates[..CLUSTER_SAMPLES].to_vec();
+    }
+    let share = total / CLUSTER_SAMPLES as f64;
+    let mut out: Vec<ClusterSample> = Vec::with_capacity(CLUSTER_SAMPLES);
+    let (mut i, mut reached) = (0, candidates[0].area);
+    let mut last = usize::MAX;
+    for k in 0..CLUSTER_SAMPLES {
+        let target = (k as f64 + 0.5) * share;
+        while reached < target && i + 1 < candidates.len() {
+            i += 1;
+            reached += candidates[i].area;
+        }
+        if i == last {
+            out.last_mut().expect("drawn before").area += share;
+        } else {
+            out.push(ClusterSample {
+                area: share,
+                ..candidates[i]
+            });
+            last = i;
+        }
+    }
+    out
 }
 
 /// The midpoint of `a` and `b`.
@@ -151,8 +200,8 @@ impl Solver<'_> {
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         let mut rho: f64 = 0.0;
         let mut area = 0.0;
-        let mut samples = Vec::new();
-        let mut per_child = Vec::new();
+        // The two children's samples, interleaved so that the draw below spreads over both.
+        let mut per_child: Vec<Vec<ClusterSample>> = Vec::new();
         let mut area_bins = [0.0; 6];
         for c in [a, b] {
             let n = &self.nodes[c as usize];
@@ -180,14 +229,23 @@ impl Solver<'_> {
                 // under something standing on it (the Cornell box's floor centre is under
                 // the tall block), which would hide the whole cluster.
                 let m = self.normal[n.surface as usize];
-                per_child.push(quarter_points(n.polygon()).map(|x| (x, m)).to_vec());
+                let area = 0.25 * n.area;
+                per_child.push(
+                    quarter_points(n.polygon())
+                        .map(|point| ClusterSample {
+                            point,
+                            normal: m,
+                            area,
+                        })
+                        .to_vec(),
+                );
             }
         }
-        for k in 0..CLUSTER_SAMPLES {
-            if let Some(&s) = per_child[k % 2].get(k / 2) {
-                samples.push(s);
-            }
-        }
+        let longest = per_child[0].len().max(per_child[1].len());
+        let candidates: Vec<ClusterSample> = (0..2 * longest)
+            .filter_map(|k| per_child[k % 2].get(k / 2).copied())
+            .collect();
+        let samples = draw_samples(&candidates);
         let centre = 0.5 * (lo + hi);
         self.clusters.push(Cluster {
             lo,
@@ -328,6 +386,50 @@ impl Solver<'_> {
             for &k in node.children() {
                 self.leaves_of(k, out);
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(x: f64, area: f64) -> ClusterSample {
+        ClusterSample {
+            point: DVec3::new(x, 0.0, 0.0),
+            normal: DVec3::Y,
+            area,
+        }
+    }
+
+    #[test]
+    fn cluster_samples_are_drawn_in_proportion_to_area() {
+        // A table top of area 8 among eight legs of area 1 each: of the total 16 the top
+        // stands for half, so half of the CLUSTER_SAMPLES = 8 draws (targets 1, 3, 5, 7 of
+        // the cumulative area 0..16, shares of 2) fall on it and merge into one sample of
+        // area 8; the other four land on legs 1, 3, 5 and 7 (targets 9, 11, 13, 15), area
+        // 2 each. Drawn by count, as before, the top would have stood for 1/9.
+        let mut candidates = vec![sample(0.0, 8.0)];
+        candidates.extend((1..=8).map(|k| sample(k as f64, 1.0)));
+        let drawn = draw_samples(&candidates);
+        let got: Vec<(f64, f64)> = drawn.iter().map(|s| (s.point.x, s.area)).collect();
+        assert_eq!(
+            got,
+            vec![(0.0, 8.0), (1.0, 2.0), (3.0, 2.0), (5.0, 2.0), (7.0, 2.0)]
+        );
+        // The areas still sum to the cluster's (exactly: shares of 2 added).
+        assert_eq!(drawn.iter().map(|s| s.area).sum::<f64>(), 16.0);
+    }
+
+    #[test]
+    fn few_cluster_samples_are_kept_as_they_are() {
+        let candidates: Vec<ClusterSample> = (0..CLUSTER_SAMPLES)
+            .map(|k| sample(k as f64, 1.0 + k as f64))
+            .collect();
+        let drawn = draw_samples(&candidates);
+        assert_eq!(drawn.len(), CLUSTER_SAMPLES);
+        for (a, b) in drawn.iter().zip(&candidates) {
+            assert_eq!((a.point, a.area), (b.point, b.area));
         }
     }
 }

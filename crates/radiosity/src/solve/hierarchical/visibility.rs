@@ -5,16 +5,28 @@
 use glam::DVec3;
 
 use super::solver::Solver;
-use super::tree::{Node, CLUSTER_SAMPLES};
+use super::tree::{ClusterSample, Node, CLUSTER_SAMPLES};
 use crate::form_factor::kernel::quarter_points;
 
-/// 16 stratified points of a triangle or a planar convex quadrilateral.
-fn sample_points(poly: &[DVec3]) -> [DVec3; 16] {
+/// 16 stratified points of a triangle or a planar convex quadrilateral: one in each cell
+/// of a 4 x 4 grid of the quadrilateral's (u, v) square, or in each of the 16 sub-triangles
+/// of the triangle split four times along each edge, at a uniformly random spot of its
+/// cell drawn from `seed` (jittered sampling, Cook 1986). Cell centres never come nearer
+/// the edge than half a cell, and the edge is where a perpendicular occluder hides most (a
+/// window at the end of its reveals sees least of the room from its rim): judged from
+/// centres, such links were too visible. Jittered points are unbiased.
+fn sample_points(poly: &[DVec3], seed: u64) -> [DVec3; 16] {
+    let mut stratum = 0;
+    let mut next = || {
+        stratum += 1;
+        crate::splitmix::jitter(seed, stratum)
+    };
     let mut out = [DVec3::ZERO; 16];
     if poly.len() == 4 {
         for j in 0..4 {
             for i in 0..4 {
-                let (u, v) = ((i as f64 + 0.5) / 4.0, (j as f64 + 0.5) / 4.0);
+                let (s, t) = next();
+                let (u, v) = ((i as f64 + s) / 4.0, (j as f64 + t) / 4.0);
                 out[j * 4 + i] = crate::mesh::bilinear(poly, u, v);
             }
         }
@@ -24,10 +36,24 @@ fn sample_points(poly: &[DVec3]) -> [DVec3; 16] {
         for b in 0..4 {
             for s in 0..4 - b {
                 let (x, y) = (s as f64, b as f64);
-                out[k] = a + e1 * ((x + 1.0 / 3.0) / 4.0) + e2 * ((y + 1.0 / 3.0) / 4.0);
+                // The sub-triangle (x, y), (x + 1, y), (x, y + 1) of the lattice ...
+                let (u, v) = next();
+                let (u, v) = if u + v > 1.0 {
+                    (1.0 - u, 1.0 - v)
+                } else {
+                    (u, v)
+                };
+                out[k] = a + e1 * ((x + u) / 4.0) + e2 * ((y + v) / 4.0);
                 k += 1;
                 if s + b + 1 < 4 {
-                    out[k] = a + e1 * ((x + 2.0 / 3.0) / 4.0) + e2 * ((y + 2.0 / 3.0) / 4.0);
+                    // ... and the one across its diagonal, (x + 1, y + 1) less the same.
+                    let (u, v) = next();
+                    let (u, v) = if u + v > 1.0 {
+                        (1.0 - u, 1.0 - v)
+                    } else {
+                        (u, v)
+                    };
+                    out[k] = a + e1 * ((x + 1.0 - u) / 4.0) + e2 * ((y + 1.0 - v) / 4.0);
                     k += 1;
                 }
             }
@@ -43,14 +69,20 @@ impl Solver<'_> {
     /// use 16 pairs (4 x 4 stratified points on each, paired by a fixed permutation) and
     /// only the occluders whose boxes overlap the pair's box (none: visible, no ray);
     /// cluster links use up to eight facing pairs of sample points (a cluster keeps up to
-    /// eight quarter points of its roots, taken alternately from its two children) and the
-    /// whole BVH.
+    /// eight points drawn from its children's in proportion to area, see
+    /// [`super::tree::ClusterSample`]) and the whole BVH, and weigh each facing pair by what
+    /// it stands for of the exchange, A_x cos_x A_y cos_y / d^2 (the point-to-point kernel
+    /// of Cohen & Wallace 1993, eq. 4.16, times the areas), so that the legs hidden under a
+    /// table top do not count as much as the top.
     pub(super) fn visibility(&self, p: u32, q: u32, scratch: &mut Vec<u32>) -> (f64, u64, u32) {
         let (np, nq) = (&self.nodes[p as usize], &self.nodes[q as usize]);
         let occ = self.occluders;
         let mut pairs = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); 16];
         let count;
         let mut use_candidates = false;
+        // Cluster links weigh their facing pairs by what each stands for.
+        let mut weights = [1.0f64; 16];
+        let mut weighted = false;
         if !np.is_cluster() && !nq.is_cluster() {
             let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
             for &v in np.polygon().iter().chain(nq.polygon()) {
@@ -65,50 +97,83 @@ impl Solver<'_> {
                 return (1.0, 0, 16);
             }
             use_candidates = scratch.len() <= 32;
-            let (a, b) = (sample_points(np.polygon()), sample_points(nq.polygon()));
+            // The same points for the link p <- q as for q <- p.
+            let seed = crate::splitmix::splitmix64((p.min(q) as u64) << 32 | p.max(q) as u64);
+            let (seed_p, seed_q) = if p < q { (seed, !seed) } else { (!seed, seed) };
+            let (a, b) = (
+                sample_points(np.polygon(), seed_p),
+                sample_points(nq.polygon(), seed_q),
+            );
             let (mp, mq) = (self.normal[sp as usize], self.normal[sq as usize]);
+            // What a point pair stands for of the exchange: the kernel cos cos / (pi d^2),
+            // bounded as the form factor to a disc of a sixteenth of the larger node
+            // (Wallace et al. 1989, eq. 7) so that two points that nearly meet do not
+            // outweigh the rest.
+            let w = np.area.max(nq.area) / 16.0;
             // The first four pairs spread over both nodes (a diagonal of the 4 x 4 grid).
             for (k, i) in [0, 5, 10, 15, 1, 2, 3, 4, 6, 7, 8, 9, 11, 12, 13, 14]
                 .into_iter()
                 .enumerate()
             {
-                pairs[k] = (a[i], mp, b[(i * 5 + 3) % 16], mq);
+                let (x, y) = (a[i], b[(i * 5 + 3) % 16]);
+                pairs[k] = (x, mp, y, mq);
+                let d = y - x;
+                let d2 = d.length_squared();
+                let (cx, cy) = (mp.dot(d), -mq.dot(d));
+                weights[k] = if cx > 0.0 && cy > 0.0 {
+                    cx * cy / (d2 * (std::f64::consts::PI * d2 + w))
+                } else {
+                    0.0
+                };
             }
+            weighted = weights.iter().all(|w| w.is_finite()) && weights.iter().sum::<f64>() > 0.0;
             count = 16;
         } else {
             // Sample points on the stack: this runs for every cluster link estimated.
-            let samples_of = |n: &Node| -> ([(DVec3, DVec3); CLUSTER_SAMPLES], usize) {
-                let mut out = [(DVec3::ZERO, DVec3::ZERO); CLUSTER_SAMPLES];
+            let samples_of = |n: &Node| -> ([ClusterSample; CLUSTER_SAMPLES], usize) {
+                let mut out = [ClusterSample {
+                    point: DVec3::ZERO,
+                    normal: DVec3::ZERO,
+                    area: 0.0,
+                }; CLUSTER_SAMPLES];
                 if n.is_cluster() {
                     let samples = &self.clusters[n.cluster as usize].samples;
                     out[..samples.len()].copy_from_slice(samples);
                     (out, samples.len())
                 } else {
-                    let m = self.normal[n.surface as usize];
-                    for (o, x) in out.iter_mut().zip(quarter_points(n.polygon())) {
-                        *o = (x, m);
+                    let normal = self.normal[n.surface as usize];
+                    for (o, point) in out.iter_mut().zip(quarter_points(n.polygon())) {
+                        *o = ClusterSample {
+                            point,
+                            normal,
+                            area: 0.25 * n.area,
+                        };
                     }
                     (out, 4)
                 }
             };
             // Up to eight pairs that face each other (from all pairs of sample points, in
-            // a fixed spread-out order), kept in pairs[..8]; up to eight non-facing ones in
-            // pairs[8..], used when none faces.
+            // a fixed spread-out order), kept in pairs[..8] with their weights; up to eight
+            // non-facing ones in pairs[8..], used when none faces.
             let ((a, na), (b, nb)) = (samples_of(np), samples_of(nq));
             let (a, b) = (&a[..na], &b[..nb]);
             let (mut m, mut spare) = (0, 8);
             'outer: for shift in 0..b.len() {
                 for i in 0..a.len() {
                     let (x, y) = (a[i], b[(i + shift) % b.len()]);
-                    let faces = x.1.dot(y.0 - x.0) > 0.0 && y.1.dot(x.0 - y.0) > 0.0;
-                    if faces {
-                        pairs[m] = (x.0, x.1, y.0, y.1);
+                    let d = y.point - x.point;
+                    let (cx, cy) = (x.normal.dot(d), -y.normal.dot(d));
+                    if cx > 0.0 && cy > 0.0 {
+                        pairs[m] = (x.point, x.normal, y.point, y.normal);
+                        // What the pair stands for of the light exchanged: both ends'
+                        // projected areas (A cos), the distance common to all pairs.
+                        weights[m] = x.area * y.area * cx * cy / d.length_squared();
                         m += 1;
                         if m == 8 {
                             break 'outer;
                         }
                     } else if spare < 16 {
-                        pairs[spare] = (x.0, x.1, y.0, y.1);
+                        pairs[spare] = (x.point, x.normal, y.point, y.normal);
                         spare += 1;
                     }
                 }
@@ -116,6 +181,9 @@ impl Solver<'_> {
             if m == 0 {
                 pairs.copy_within(8..spare, 0);
                 m = spare - 8;
+            } else {
+                weighted = weights[..m].iter().all(|w| w.is_finite())
+                    && weights[..m].iter().sum::<f64>() > 0.0;
             }
             count = m;
         }
@@ -127,6 +195,7 @@ impl Solver<'_> {
             }
         };
         let (mut facing, mut visible, mut all_visible) = (0u32, 0u32, 0u32);
+        let (mut facing_weight, mut visible_weight) = (0.0, 0.0);
         let mut rays = 0;
         for (i, &(x, mx, y, my)) in pairs[..count].iter().enumerate() {
             // Four facing pairs all open settle it; anything else (some blocked: partial
@@ -141,10 +210,16 @@ impl Solver<'_> {
             if faces {
                 facing += 1;
                 visible += u32::from(open);
+                facing_weight += weights[i];
+                if open {
+                    visible_weight += weights[i];
+                }
             }
             all_visible += u32::from(open);
         }
-        let fraction = if facing > 0 {
+        let fraction = if weighted && facing_weight > 0.0 {
+            visible_weight / facing_weight
+        } else if facing > 0 {
             visible as f64 / facing as f64
         } else {
             all_visible as f64 / rays as f64
