@@ -63,6 +63,20 @@ pub enum PipelineError {
         /// [`MAX_INTEGRATION_POINTS`].
         limit: f64,
     },
+    /// A computed form factor is NaN, infinite or negative (checked when the matrix is
+    /// computed, before it is solved or written).
+    #[error(transparent)]
+    FormFactorNotFinite(#[from] form_factor::NonFiniteFormFactor),
+    /// A form-factor file holds a matrix of another size than the mesh.
+    #[error("form-factor file {path} holds {found} rows, but the mesh has {expected} elements")]
+    FormFactorSizeMismatch {
+        /// The file.
+        path: String,
+        /// Rows in the file.
+        found: usize,
+        /// Elements of the mesh.
+        expected: usize,
+    },
     /// Adaptive subdivision was asked for with form factors that are not computed: it
     /// needs the form factors of meshes that do not exist yet.
     #[error("adaptive subdivision computes its form factors: it cannot use a form-factor matrix or file")]
@@ -361,6 +375,7 @@ impl Prepared {
         let rays = RayCounter::default();
         let start = Instant::now();
         let matrix = form_factor::compute_matrix(&ctx, self.method(), &rays, progress)?;
+        matrix.check_entries()?;
         let seconds = start.elapsed().as_secs_f64();
         let stats = FormFactorStats {
             rays: rays.get(),
@@ -385,9 +400,18 @@ impl Prepared {
         path: &Path,
         progress: &dyn Progress,
     ) -> Result<FormFactorMatrix, PipelineError> {
-        Ok(run_stage(progress, Stage::FormFactors, 0, || {
+        let matrix = run_stage(progress, Stage::FormFactors, 0, || {
             read_form_factors(path, self.fingerprint(), Some(self.method()))
-        })?)
+        })?;
+        // The fingerprint covers n, but a forged file could carry this mesh's fingerprint.
+        if matrix.n() != self.mesh.len() {
+            return Err(PipelineError::FormFactorSizeMismatch {
+                path: path.display().to_string(),
+                found: matrix.n(),
+                expected: self.mesh.len(),
+            });
+        }
+        Ok(matrix)
     }
 
     /// Writes form factors to `path` (atomically) with this mesh's fingerprint and method.
@@ -415,6 +439,34 @@ impl Prepared {
 /// `observer` sees every Gauss-Seidel sweep and progressive shot and may stop the solve
 /// (the report then says so); `progress` gets the stages for progress bars.
 pub fn solve(
+    prepared: &Prepared,
+    request: &SolveRequest,
+    observer: &mut Observer,
+    progress: &dyn Progress,
+) -> Result<Solution, PipelineError> {
+    let solution = solve_any(prepared, request, observer, progress)?;
+    // The stage boundary: whatever the solver, no NaN or infinity leaves it (each solver
+    // checks its own iterates too; this catches what a stopped run or an export made).
+    if let Some((element, value)) = solution
+        .radiosity
+        .as_slice()
+        .iter()
+        .enumerate()
+        .find_map(|(i, b)| b.0.iter().find(|x| !x.is_finite()).map(|&x| (i, x)))
+    {
+        return Err(SolveError::NotFinite {
+            solver: request.solver.kind().name(),
+            element,
+            value,
+            after: "the solve".into(),
+        }
+        .into());
+    }
+    Ok(solution)
+}
+
+/// [`solve`] before its final check.
+fn solve_any(
     prepared: &Prepared,
     request: &SolveRequest,
     observer: &mut Observer,
@@ -564,6 +616,7 @@ fn solve_adaptive(
             &counter,
             progress,
         )?;
+        next_f.check_entries()?;
         seconds += clock.elapsed().as_secs_f64();
         rays += counter.get();
         let n = next.len() as u64;
