@@ -59,6 +59,19 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{stem}-pathtrace.png")));
+    let inputs = [
+        ("scene file", args.scene.scene.as_deref()),
+        ("reference", args.reference.as_deref()),
+        ("form-factor file", args.solve.form_factors.as_deref()),
+    ];
+    let mut outputs = vec![output.clone()];
+    if args.compare {
+        outputs.extend([sibling(&output, "radiosity"), sibling(&output, "error")]);
+    }
+    outputs.extend(args.save_reference.clone());
+    for out in &outputs {
+        setup::refuse_overwriting_inputs(out, &inputs)?;
+    }
 
     // The path-traced view: traced, or read back.
     let (view, settings) = match &args.reference {

@@ -11,15 +11,26 @@ use radiosity::solve::Step;
 use super::{exposure_note, shade_and_render, solve_scene};
 use crate::args::RenderArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{camera, prepare_solve, render_settings};
+use crate::setup::{camera, prepare_solve, refuse_overwriting_inputs, render_settings, stem_of};
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.png", stem_of(args.scene.scene.as_deref()))));
+    refuse_overwriting_inputs(
+        &output,
+        &[
+            ("scene file", args.scene.scene.as_deref()),
+            ("form-factor file", args.solve.form_factors.as_deref()),
+        ],
+    )?;
     let settings = render_settings(&args)?;
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
-    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     if args.snapshots.is_some() && solver.needs_matrix() {
         bail!("--snapshots needs --solver progressive");
     }
@@ -89,9 +100,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
         scale,
         &reporter,
     );
-    let output = args
-        .output
-        .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
     run_stage(&reporter, Stage::Write, 0, || {
         render::write_png(&image, &output)
     })

@@ -59,9 +59,53 @@ pub fn write_atomically(
     tmp.persist(path).map_err(|e| e.error)
 }
 
+/// True when `a` and `b` name the same existing file (after symbolic links, through hard
+/// links and `..`): same device and inode on Unix, same canonical path elsewhere. A path
+/// that does not exist is no file's, so writing it cannot overwrite an input.
+pub fn is_same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        (ma.dev(), ma.ino()) == (mb.dev(), mb.ino())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!(
+            (std::fs::canonicalize(a), std::fs::canonicalize(b)),
+            (Ok(x), Ok(y)) if x == y
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn same_file_is_seen_through_other_spellings_and_links() {
+        let dir = std::env::temp_dir().join(format!("radiosity-aw-same-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        let file = dir.join("x.scene");
+        std::fs::write(&file, "x").unwrap();
+        assert!(is_same_file(&file, &dir.join("sub/../x.scene")));
+        let hard = dir.join("hard.scene");
+        std::fs::hard_link(&file, &hard).unwrap();
+        assert!(is_same_file(&file, &hard));
+        #[cfg(unix)]
+        {
+            let soft = dir.join("soft.scene");
+            std::os::unix::fs::symlink(&file, &soft).unwrap();
+            assert!(is_same_file(&soft, &file));
+        }
+        std::fs::write(dir.join("other.scene"), "x").unwrap();
+        assert!(!is_same_file(&file, &dir.join("other.scene")));
+        assert!(!is_same_file(&file, &dir.join("missing.scene")));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn failed_write_leaves_no_file() {
