@@ -361,8 +361,8 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     for (flag, point) in [("--eye", camera.eye), ("--look-at", camera.look_at)] {
         if far(point) {
             bail!(
-                "{flag} {},{},{} is out of range: farther than {reach:e} (1e9 times the scene's \
-                 size, {size:e}) from the scene's centre, where rays lose their precision; \
+                "{flag} {:e},{:e},{:e} is out of range: farther than {reach:.3e} (1e9 times the \
+                 scene's size, {size:.3e}) from the scene's centre, where rays lose their precision; \
                  bring it closer (a smaller --fov frames the scene from nearer)",
                 point.x,
                 point.y,

@@ -95,7 +95,9 @@ pub fn remove_stale_temporaries(dir: &Path, name: &str, age: std::time::Duration
             continue;
         };
         // PID.RANDOM, the PID all digits.
-        let Some(pid) = middle.split_once('.').and_then(|(pid, _)| pid.parse::<u32>().ok())
+        let Some(pid) = middle
+            .split_once('.')
+            .and_then(|(pid, _)| pid.parse::<u32>().ok())
         else {
             continue;
         };
@@ -163,7 +165,10 @@ mod tests {
         let not_ours = make(".out.png.notapid.tmp", 3600);
         write_atomically(&dir.join("out.png"), |w| w.write_all(b"png")).unwrap();
         if Path::new("/proc/self").exists() {
-            assert!(!dead_old.exists(), "a dead run's old temporary file is left");
+            assert!(
+                !dead_old.exists(),
+                "a dead run's old temporary file is left"
+            );
         }
         for kept in [&dead_new, &alive, &other_output, &not_ours] {
             assert!(kept.exists(), "{} removed", kept.display());
