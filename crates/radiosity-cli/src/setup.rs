@@ -26,6 +26,9 @@ use crate::progress_bar::Reporter;
 pub fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
     let (prepared, stem) = prepare_scene(args, reporter)?;
     prepared.check_memory(None)?;
+    if !args.no_work_limit {
+        prepared.check_work()?;
+    }
     note_scene(&prepared, &stem, reporter);
     Ok((prepared, stem))
 }
@@ -45,6 +48,16 @@ pub fn prepare_solve(
         reporter,
     )?;
     prepared.check_memory(Some(&solver))?;
+    // The form factors are computed by the dense solvers (unless read from a file) and,
+    // row by row, by progressive refinement; hierarchical radiosity computes its own.
+    let computes = match solver {
+        Solver::Dense(_) => options.form_factors.is_none(),
+        Solver::Progressive(_) => true,
+        Solver::Hierarchical(_) => false,
+    };
+    if computes && !args.no_work_limit {
+        prepared.check_work()?;
+    }
     if let (Solver::Hierarchical(_), Some(method)) = (&solver, method_flag_given(&args.method)) {
         // Printed even with --quiet: the run does not do what the flags say.
         errln!(
@@ -253,11 +266,36 @@ fn solver(
 pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     check_png(args.output.as_deref())?;
     image_size(&args.camera)?;
+    check_render_budget(
+        &args.camera,
+        args.rays.supersample,
+        args.scene.no_work_limit,
+    )?;
     let gamma = gamma(&args.tone)?;
     Ok(RenderSettings {
         gamma,
         ..ray_settings(&args.rays, args.shading)
     })
+}
+
+/// Refuses, before any work, a render whose film would not fit in memory, or (unless
+/// `no_work_limit`) whose camera rays pass the work limit.
+pub fn check_render_budget(
+    camera: &CameraArgs,
+    supersample: u32,
+    no_work_limit: bool,
+) -> Result<()> {
+    let (w, h) = (camera.width, camera.height);
+    radiosity::budget::check_render_memory(
+        w,
+        h,
+        supersample,
+        radiosity::form_factor::available_memory_bytes(),
+    )?;
+    if !no_work_limit {
+        radiosity::budget::check_render_work(w, h, supersample)?;
+    }
+    Ok(())
 }
 
 /// The render settings `--supersample`, `--adaptive-contrast`, `--direct-light` and

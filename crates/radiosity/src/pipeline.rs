@@ -63,10 +63,17 @@ pub enum PipelineError {
         /// [`MAX_INTEGRATION_POINTS`].
         limit: f64,
     },
+    /// A form-factor method's own buffers (the hemicube's, Monte Carlo's strata) would not
+    /// fit in memory.
+    #[error(transparent)]
+    TooMuchMemory(#[from] crate::budget::TooMuchMemory),
     /// A computed form factor is NaN, infinite or negative (checked when the matrix is
     /// computed, before it is solved or written).
     #[error(transparent)]
     FormFactorNotFinite(#[from] form_factor::NonFiniteFormFactor),
+    /// The work would exceed a limit of [`crate::budget`].
+    #[error(transparent)]
+    TooMuchWork(#[from] crate::budget::TooMuchWork),
     /// A form-factor file holds a matrix of another size than the mesh.
     #[error("form-factor file {path} holds {found} rows, but the mesh has {expected} elements")]
     FormFactorSizeMismatch {
@@ -351,6 +358,7 @@ impl Prepared {
                 limit: MAX_INTEGRATION_POINTS,
             });
         }
+        self.check_method_memory(form_factor::available_memory_bytes())?;
         let per_entry = match solver {
             // No matrix: O(n) vectors and one row.
             Some(Solver::Progressive(_) | Solver::Hierarchical(_)) => return Ok(()),
@@ -364,6 +372,60 @@ impl Prepared {
         };
         form_factor::check_dense_fits(what, n, per_entry, form_factor::available_memory_bytes())?;
         Ok(())
+    }
+
+    /// Refuses a method whose own buffers exceed `available` bytes: the hemicube keeps its
+    /// delta form factors (8 bytes a cell, 1.5 resolution^2 cells) once and a depth and
+    /// owner buffer (12 bytes a cell of the largest face, resolution^2) per thread; Monte
+    /// Carlo keeps a shuffled list of its samples (8 bytes each, rounded up to a square) per
+    /// thread.
+    fn check_method_memory(&self, available: u64) -> Result<(), PipelineError> {
+        let threads = rayon::current_num_threads() as f64;
+        let mib = |b: f64| b / (1u64 << 20) as f64;
+        let available_mib = mib(available as f64);
+        let (needed, what, fits) = match self.method {
+            FormFactorMethod::Hemicube { resolution } => {
+                let r = (resolution.max(2) as f64 / 2.0).ceil() * 2.0;
+                let per_cell = 12.0 + 12.0 * threads;
+                (
+                    per_cell * r * r,
+                    format!("the hemicube at --resolution {resolution} on {threads} threads"),
+                    format!(
+                        "at most --resolution {:.0} would fit",
+                        (available as f64 / per_cell).sqrt().floor()
+                    ),
+                )
+            }
+            FormFactorMethod::MonteCarlo { samples, .. } => {
+                let m = (samples.max(1) as f64).sqrt().ceil();
+                (
+                    8.0 * m * m * threads,
+                    format!("Monte Carlo at --samples {samples} on {threads} threads"),
+                    format!(
+                        "at most --samples {:.0} would fit",
+                        (available as f64 / (8.0 * threads)).floor()
+                    ),
+                )
+            }
+            _ => return Ok(()),
+        };
+        if needed <= available as f64 {
+            return Ok(());
+        }
+        Err(crate::budget::TooMuchMemory {
+            what,
+            needed_mib: mib(needed),
+            available_mib,
+            fits,
+        }
+        .into())
+    }
+
+    /// Refuses, before any work, form factors past the work limits of
+    /// [`crate::budget`] (element pairs x k^4 point pairs, Monte Carlo rays, hemicube
+    /// cells); the command line lets a user lift them.
+    pub fn check_work(&self) -> Result<(), crate::budget::TooMuchWork> {
+        crate::budget::check_form_factor_work(self.method, self.mesh.len())
     }
 
     /// Computes the form-factor matrix.

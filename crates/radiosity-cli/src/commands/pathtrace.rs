@@ -32,6 +32,20 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         seed: args.path_seed,
     };
     settings.check()?;
+    if !args.scene.no_work_limit && args.reference.is_none() {
+        radiosity::budget::check_path_trace_work(
+            args.camera.width,
+            args.camera.height,
+            args.paths,
+        )?;
+    }
+    if args.compare {
+        setup::check_render_budget(
+            &args.camera,
+            args.rays.supersample,
+            args.scene.no_work_limit,
+        )?;
+    }
     let shading = setup::shading(args.shading);
     if args.compare && shading == Shading::Wireframe {
         bail!("--compare needs --shading smooth or flat: a wireframe has no radiosity to compare");

@@ -173,3 +173,110 @@ fn an_eye_out_of_range_is_not_called_parallel() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn work_past_the_limit_is_refused_before_it_starts_with_what_fits() {
+    let dir = scratch_dir("work-limit");
+    let scene = example("triangles.scene");
+    // A few elements (one a surface, and the pieces where they touch): 21 pairs x 1000^4
+    // point pairs, weeks of work.
+    let out = radiosity(
+        &[
+            "formfactors",
+            &scene,
+            "--max-area",
+            "100",
+            "--steps",
+            "1000",
+            "-o",
+            "t.ff",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("INTEGRAL_STEPS 1000 on 7 elements"), "{err}");
+    assert!(err.contains("at most INTEGRAL_STEPS"), "{err}");
+    assert!(err.contains("--no-work-limit"), "{err}");
+    assert!(!dir.join("t.ff").exists());
+    for (args, expect) in [
+        (
+            vec![
+                "solve",
+                &scene,
+                "--method",
+                "montecarlo",
+                "--samples",
+                "4294967295",
+            ],
+            "--samples 4294967295",
+        ),
+        (
+            vec![
+                "solve",
+                &scene,
+                "--method",
+                "hemicube",
+                "--resolution",
+                "16384",
+            ],
+            "--resolution 16384",
+        ),
+        (
+            vec![
+                "render",
+                "--supersample",
+                "16",
+                "--width",
+                "10000",
+                "--height",
+                "10000",
+            ],
+            "--supersample 16",
+        ),
+        (
+            vec![
+                "pathtrace",
+                "--paths",
+                "100000",
+                "--width",
+                "4000",
+                "--height",
+                "4000",
+            ],
+            "--paths 100000",
+        ),
+    ] {
+        let mut args = args.clone();
+        args.extend(["-o", "out.png"]);
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{args:?}: {err}");
+        assert!(
+            err.contains(expect) && err.contains("would fit"),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn memory_budget_honours_ulimit_v() {
+    // Under a 1 GiB address-space limit a 3 GiB hemicube is refused with the sizes, not
+    // aborted by a failed allocation (which MemAvailable alone would not foresee).
+    let dir = scratch_dir("ulimit-v");
+    let bin = env!("CARGO_BIN_EXE_radiosity");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 1048576 && exec '{bin}' formfactors --method hemicube --resolution 8192 -o t.ff"
+        ))
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("MiB of memory is available"), "{err}");
+    assert!(err.contains("at most --resolution"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
