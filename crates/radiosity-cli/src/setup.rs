@@ -269,6 +269,7 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     check_render_budget(
         &args.camera,
         args.rays.supersample,
+        false,
         args.scene.no_work_limit,
     )?;
     let gamma = gamma(&args.tone)?;
@@ -278,11 +279,13 @@ pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     })
 }
 
-/// Refuses, before any work, a render whose film would not fit in memory, or (unless
-/// `no_work_limit`) whose camera rays pass the work limit.
+/// Refuses, before any work, a render whose film would not fit in memory (`whole_film`: all
+/// of it at once, as the path tracer's comparison keeps it), or (unless `no_work_limit`)
+/// whose camera rays pass the work limit.
 pub fn check_render_budget(
     camera: &CameraArgs,
     supersample: u32,
+    whole_film: bool,
     no_work_limit: bool,
 ) -> Result<()> {
     let (w, h) = (camera.width, camera.height);
@@ -290,6 +293,7 @@ pub fn check_render_budget(
         w,
         h,
         supersample,
+        whole_film,
         radiosity::form_factor::available_memory_bytes(),
     )?;
     if !no_work_limit {

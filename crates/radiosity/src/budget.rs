@@ -53,18 +53,29 @@ fn mib(bytes: f64) -> f64 {
     bytes / (1u64 << 20) as f64
 }
 
-/// Checks the film of a render against `available` bytes: every camera ray's sample is
-/// kept (3 f64, 24 bytes; `render::Film`) until the image is filtered, and the 8-bit image
-/// takes 3 bytes a pixel.
+/// Samples `render::render` keeps at once: it traces the image in strips of rows of
+/// about this many samples (its STRIP_SAMPLES), at least one row.
+const RENDER_STRIP_SAMPLES: f64 = (1 << 21) as f64;
+
+/// Checks the film of a render against `available` bytes: each camera ray's sample is kept
+/// (3 f64, 24 bytes; `render::Film`) until its pixel is filtered, and the 8-bit image takes
+/// 3 bytes a pixel. With `whole_film` (the path tracer's comparison) every sample of the
+/// image is kept at once; otherwise (`render`) a strip of rows at a time.
 pub fn check_render_memory(
     width: u32,
     height: u32,
     supersample: u32,
+    whole_film: bool,
     available: u64,
 ) -> Result<(), TooMuchMemory> {
     let pixels = width as f64 * height as f64;
     let per_pixel = 24.0 * (supersample as f64).powi(2) + 3.0;
-    let needed = pixels * per_pixel;
+    let needed = if whole_film {
+        pixels * per_pixel
+    } else {
+        let row = width as f64 * (supersample as f64).powi(2);
+        3.0 * pixels + 24.0 * RENDER_STRIP_SAMPLES.max(row)
+    };
     if needed <= available as f64 {
         return Ok(());
     }
@@ -269,13 +280,17 @@ mod tests {
     fn a_render_film_past_the_memory_is_refused_with_the_supersample_that_fits() {
         // 1e8 pixels x (24 x 256 + 3) bytes = 614 GB; with 16 GiB,
         // sqrt((16 GiB / 1e8 - 3) / 24) = 2.6: at most 2.
-        let err = check_render_memory(10_000, 10_000, 16, 16 << 30).unwrap_err();
+        let err = check_render_memory(10_000, 10_000, 16, true, 16 << 30).unwrap_err();
         assert!(
             (err.needed_mib - 1e8 * 6147.0 / 1048576.0).abs() < 1.0,
             "{err:?}"
         );
         assert!(err.to_string().contains("--supersample 2 "), "{err}");
-        assert!(check_render_memory(512, 512, 8, 1 << 30).is_ok());
+        assert!(check_render_memory(512, 512, 8, true, 1 << 30).is_ok());
+        // In strips: 3e8 bytes of image and a strip of 2.56 million samples (one row of
+        // 10,000 x 256), 61 MB.
+        assert!(check_render_memory(10_000, 10_000, 16, false, 400 << 20).is_ok());
+        assert!(check_render_memory(10_000, 10_000, 16, false, 300 << 20).is_err());
     }
 
     #[test]

@@ -151,7 +151,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         settings,
         scale,
         &reporter,
-    );
+    )?;
     let total = start.elapsed().as_secs_f64();
     std::hint::black_box(image);
     let mut stages = [0.0; BENCH_STAGES.len()];

@@ -43,6 +43,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         setup::check_render_budget(
             &args.camera,
             args.rays.supersample,
+            true,
             args.scene.no_work_limit,
         )?;
     }

@@ -54,6 +54,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let display = state.display_radiosity();
         let display = radiosity::light::Rgb::as_arrays(&display);
         let scale = exposure.scale(&prepared.scene, &prepared.mesh, display);
+        let path = dir.join(format!("shot-{:05}.png", state.shot));
         let image = shade_and_render(
             &prepared,
             &prepared.mesh,
@@ -63,15 +64,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
             scale,
             &quiet,
         );
-        let path = dir.join(format!("shot-{:05}.png", state.shot));
-        match render::write_png(&image, &path) {
+        let written_png = image
+            .map_err(anyhow::Error::new)
+            .and_then(|image| Ok(render::write_png(&image, &path)?));
+        match written_png {
             Ok(()) => {
                 written += 1;
                 ControlFlow::Continue(())
             }
             Err(e) => {
-                snapshot_error =
-                    Some(anyhow::Error::new(e).context(format!("cannot write {}", path.display())));
+                snapshot_error = Some(e.context(format!("cannot write {}", path.display())));
                 ControlFlow::Break(())
             }
         }
@@ -99,7 +101,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         settings,
         scale,
         &reporter,
-    );
+    )?;
     run_stage(&reporter, Stage::Write, 0, || {
         render::write_png(&image, &output)
     })
