@@ -75,6 +75,11 @@ pub struct SceneArgs {
     /// No progress bars, timings or notes (errors are still printed).
     #[arg(short, long)]
     pub quiet: bool,
+    /// Run even work estimated at hours or more (INTEGRAL_STEPS x element pairs, Monte
+    /// Carlo samples, hemicube resolution, image size x --supersample, --paths), which is
+    /// refused otherwise. Memory limits still hold.
+    #[arg(long)]
+    pub no_work_limit: bool,
 }
 
 /// How form factors are computed.

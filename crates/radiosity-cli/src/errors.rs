@@ -45,12 +45,19 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
                 Some("; use fewer steps (--steps) or larger elements (--max-area)".into())
             }
             PipelineError::FormFactorFile(e) => hint(e),
+            PipelineError::TooMuchWork(e) => hint(e),
             PipelineError::FormFactorsUnused { .. } => {
                 Some(" (--form-factors applies to --solver gauss-seidel and lu only)".into())
             }
             PipelineError::Solve(e) => hint(e),
             _ => None,
         };
+    }
+    if err
+        .downcast_ref::<radiosity::budget::TooMuchWork>()
+        .is_some()
+    {
+        return Some(" (or pass --no-work-limit to run it anyway)".into());
     }
     if let Some(e) = err.downcast_ref::<FormFactorFileError>() {
         return match e {

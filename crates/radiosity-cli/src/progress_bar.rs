@@ -1,9 +1,48 @@
 //! The command line's listener on the library's [`Progress`] interface: a progress bar per
-//! stage on a terminal (indicatif), silence otherwise, and a record of each stage's time.
+//! stage on a terminal (indicatif); elsewhere (a log file, a pipe, CI) a line on stderr
+//! every [`LINE_EVERY`] while a stage runs, so that a long run is never silent for
+//! minutes; and a record of each stage's time.
 
 use std::io::IsTerminal;
-use std::sync::Mutex;
-use std::time::Duration;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+/// How often a stage reports when stderr is not a terminal.
+pub const LINE_EVERY: Duration = Duration::from_secs(10);
+
+/// The thread that prints a stage's progress lines, and how to stop it.
+struct Ticker {
+    done: Arc<AtomicU64>,
+    stop: Arc<(Mutex<bool>, Condvar)>,
+    thread: std::thread::JoinHandle<()>,
+}
+
+/// "form factors: 12.5 % (1250 of 10000) after 30 s, about 3.5 min left", or without a
+/// total "solve: 1250 steps after 30 s".
+pub fn progress_line(stage: &str, done: u64, total: u64, elapsed: Duration) -> String {
+    let secs = elapsed.as_secs_f64();
+    if total < 2 {
+        return format!("{stage}: {done} steps after {secs:.0} s");
+    }
+    let fraction = done as f64 / total as f64;
+    let left = if done > 0 {
+        let s = secs * (1.0 - fraction) / fraction;
+        if s < 120.0 {
+            format!(", about {s:.0} s left")
+        } else if s < 7200.0 {
+            format!(", about {:.1} min left", s / 60.0)
+        } else {
+            format!(", about {:.1} h left", s / 3600.0)
+        }
+    } else {
+        String::new()
+    };
+    format!(
+        "{stage}: {:.1} % ({done} of {total}) after {secs:.0} s{left}",
+        100.0 * fraction
+    )
+}
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use radiosity::progress::{Progress, Stage};
@@ -11,6 +50,9 @@ use radiosity::progress::{Progress, Stage};
 /// Draws progress bars (when enabled) and records stage timings.
 pub struct Reporter {
     bars_enabled: bool,
+    /// Progress lines instead of bars (stderr is not a terminal, not quiet).
+    lines_enabled: bool,
+    ticker: Mutex<Option<Ticker>>,
     bar: Mutex<Option<ProgressBar>>,
     timings: Mutex<Vec<(Stage, Duration)>>,
     quiet: bool,
@@ -19,8 +61,11 @@ pub struct Reporter {
 impl Reporter {
     /// Bars are drawn only when stderr is a terminal and `quiet` is false.
     pub fn new(quiet: bool) -> Reporter {
+        let terminal = std::io::stderr().is_terminal();
         Reporter {
-            bars_enabled: !quiet && std::io::stderr().is_terminal(),
+            bars_enabled: !quiet && terminal,
+            lines_enabled: !quiet && !terminal,
+            ticker: Mutex::new(None),
             bar: Mutex::new(None),
             timings: Mutex::new(Vec::new()),
             quiet,
@@ -61,6 +106,54 @@ impl Reporter {
     }
 }
 
+impl Reporter {
+    /// Starts the thread that prints a line every [`LINE_EVERY`] until the stage finishes
+    /// (stages that finish sooner print nothing).
+    fn start_ticker(&self, stage: Stage, total: u64) {
+        self.stop_ticker();
+        let done = Arc::new(AtomicU64::new(0));
+        let stop = Arc::new((Mutex::new(false), Condvar::new()));
+        let (d, st) = (done.clone(), stop.clone());
+        let started = Instant::now();
+        let spawned = std::thread::Builder::new()
+            .name("progress".into())
+            .spawn(move || {
+                let (lock, wake) = &*st;
+                let mut stopped = lock.lock().unwrap();
+                // The flag is read under the lock before each wait, so a stop that came
+                // before the first wait is not slept through.
+                while !*stopped {
+                    let (guard, timeout) = wake.wait_timeout(stopped, LINE_EVERY).unwrap();
+                    stopped = guard;
+                    if *stopped {
+                        return;
+                    }
+                    if timeout.timed_out() {
+                        let line = progress_line(
+                            stage.name(),
+                            d.load(Ordering::Relaxed),
+                            total,
+                            started.elapsed(),
+                        );
+                        errln!("{line}");
+                    }
+                }
+            });
+        if let Ok(thread) = spawned {
+            *self.ticker.lock().unwrap() = Some(Ticker { done, stop, thread });
+        }
+    }
+
+    fn stop_ticker(&self) {
+        if let Some(ticker) = self.ticker.lock().unwrap().take() {
+            let (lock, wake) = &*ticker.stop;
+            *lock.lock().unwrap() = true;
+            wake.notify_all();
+            let _ = ticker.thread.join();
+        }
+    }
+}
+
 /// Milliseconds below 1 s, seconds above.
 pub fn format_duration(d: Duration) -> String {
     let s = d.as_secs_f64();
@@ -73,6 +166,9 @@ pub fn format_duration(d: Duration) -> String {
 
 impl Progress for Reporter {
     fn start(&self, stage: Stage, total: u64) {
+        if self.lines_enabled {
+            self.start_ticker(stage, total);
+        }
         if !self.bars_enabled || total < 2 {
             return;
         }
@@ -89,12 +185,16 @@ impl Progress for Reporter {
     }
 
     fn advance(&self, done: u64) {
+        if let Some(ticker) = self.ticker.lock().unwrap().as_ref() {
+            ticker.done.fetch_add(done, Ordering::Relaxed);
+        }
         if let Some(bar) = self.bar.lock().unwrap().as_ref() {
             bar.inc(done);
         }
     }
 
     fn finish(&self, stage: Stage, elapsed: Duration) {
+        self.stop_ticker();
         if let Some(bar) = self.bar.lock().unwrap().take() {
             bar.finish_and_clear();
         }
@@ -103,5 +203,28 @@ impl Progress for Reporter {
 
     fn message(&self, text: &str) {
         self.note(text);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn progress_lines_say_how_far_and_how_long_is_left() {
+        // A quarter done after 30 s: 90 s left at the same rate.
+        assert_eq!(
+            progress_line("form factors", 250, 1000, Duration::from_secs(30)),
+            "form factors: 25.0 % (250 of 1000) after 30 s, about 90 s left"
+        );
+        // 1 % after 60 s: 99 minutes left.
+        assert_eq!(
+            progress_line("render", 1, 100, Duration::from_secs(60)),
+            "render: 1.0 % (1 of 100) after 60 s, about 99.0 min left"
+        );
+        assert_eq!(
+            progress_line("solve", 17, 0, Duration::from_secs(10)),
+            "solve: 17 steps after 10 s"
+        );
     }
 }

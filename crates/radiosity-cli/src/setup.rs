@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
+use glam::DVec3;
 use radiosity::form_factor::FormFactorMethod;
 use radiosity::mesh::AdaptSettings;
 use radiosity::pipeline::{Overrides, Prepared};
@@ -25,6 +26,9 @@ use crate::progress_bar::Reporter;
 pub fn prepare(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
     let (prepared, stem) = prepare_scene(args, reporter)?;
     prepared.check_memory(None)?;
+    if !args.no_work_limit {
+        prepared.check_work()?;
+    }
     note_scene(&prepared, &stem, reporter);
     Ok((prepared, stem))
 }
@@ -44,8 +48,38 @@ pub fn prepare_solve(
         reporter,
     )?;
     prepared.check_memory(Some(&solver))?;
+    // The form factors are computed by the dense solvers (unless read from a file) and,
+    // row by row, by progressive refinement; hierarchical radiosity computes its own.
+    let computes = match solver {
+        Solver::Dense(_) => options.form_factors.is_none(),
+        Solver::Progressive(_) => true,
+        Solver::Hierarchical(_) => false,
+    };
+    if computes && !args.no_work_limit {
+        prepared.check_work()?;
+    }
+    if let (Solver::Hierarchical(_), Some(method)) = (&solver, method_flag_given(&args.method)) {
+        // Printed even with --quiet: the run does not do what the flags say.
+        errln!(
+            "warning: --method {method} is ignored: hierarchical radiosity computes each \
+             link's form factor by its own estimate (point-to-polygon with visibility rays), \
+             not by a form-factor method; use --solver gauss-seidel or lu for --method {method}"
+        );
+    }
     note_scene(&prepared, &stem, reporter);
     Ok((prepared, stem, solver))
+}
+
+/// The method `--method` names when it is not the default (area), which every solver but
+/// hierarchical radiosity uses.
+fn method_flag_given(args: &crate::args::MethodArgs) -> Option<&'static str> {
+    match args.method {
+        MethodArg::Area => None,
+        MethodArg::Contour => Some("contour"),
+        MethodArg::Analytic => Some("analytic"),
+        MethodArg::Hemicube => Some("hemicube"),
+        MethodArg::Montecarlo => Some("montecarlo"),
+    }
 }
 
 /// The scene loaded, meshed with its file's settings overridden by the flags, and its
@@ -104,6 +138,35 @@ fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
     ));
 }
 
+/// The short name of default outputs: "cornell" for the built-in box, else the scene
+/// file's stem.
+pub fn stem_of(scene: Option<&Path>) -> String {
+    match scene {
+        None => "cornell".into(),
+        Some(path) => path
+            .file_stem()
+            .map_or("scene".into(), |s| s.to_string_lossy().into_owned()),
+    }
+}
+
+/// Refuses, before any work, to write `output` over one of the `inputs` (what it is, its
+/// path): the same file by device and inode, whatever the spelling (`./x.scene`, a link).
+pub fn refuse_overwriting_inputs(output: &Path, inputs: &[(&str, Option<&Path>)]) -> Result<()> {
+    for &(what, input) in inputs {
+        if let Some(input) = input {
+            if radiosity::io::is_same_file(output, input) {
+                bail!(
+                    "the output {} is the {what} {}: writing it would destroy the input; \
+                     name another output with -o FILE",
+                    output.display(),
+                    input.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The scene file at `path`, or the built-in Cornell box, with a short name for default
 /// outputs ("cornell", or the file's stem).
 pub fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(SceneFile, String)> {
@@ -114,10 +177,7 @@ pub fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(SceneFile
         )),
         Some(path) => {
             let file = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
-            let stem = path
-                .file_stem()
-                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-            Ok((file, stem))
+            Ok((file, stem_of(Some(path))))
         }
     }
 }
@@ -206,11 +266,40 @@ fn solver(
 pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     check_png(args.output.as_deref())?;
     image_size(&args.camera)?;
+    check_render_budget(
+        &args.camera,
+        args.rays.supersample,
+        false,
+        args.scene.no_work_limit,
+    )?;
     let gamma = gamma(&args.tone)?;
     Ok(RenderSettings {
         gamma,
         ..ray_settings(&args.rays, args.shading)
     })
+}
+
+/// Refuses, before any work, a render whose film would not fit in memory (`whole_film`: all
+/// of it at once, as the path tracer's comparison keeps it), or (unless `no_work_limit`)
+/// whose camera rays pass the work limit.
+pub fn check_render_budget(
+    camera: &CameraArgs,
+    supersample: u32,
+    whole_film: bool,
+    no_work_limit: bool,
+) -> Result<()> {
+    let (w, h) = (camera.width, camera.height);
+    radiosity::budget::check_render_memory(
+        w,
+        h,
+        supersample,
+        whole_film,
+        radiosity::form_factor::available_memory_bytes(),
+    )?;
+    if !no_work_limit {
+        radiosity::budget::check_render_work(w, h, supersample)?;
+    }
+    Ok(())
 }
 
 /// The render settings `--supersample`, `--adaptive-contrast`, `--direct-light` and
@@ -297,7 +386,44 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     if forward.length() == 0.0 {
         bail!("--eye and --look-at must differ");
     }
-    if forward.cross(camera.up).length() <= 1e-12 * forward.length() * camera.up.length() {
+    // Beyond 1e9 scene sizes a ray's hit point carries less than 1e-7 of the scene in
+    // f64 (16 digits), and past 1e154 the distance itself overflows: neither is "parallel".
+    let (lo, hi) = scene.bounds();
+    let size = (hi - lo).length();
+    let size = if size.is_finite() && size > 0.0 {
+        size
+    } else {
+        1.0
+    };
+    let reach = 1e9 * size;
+    let far = |p: DVec3| -> bool {
+        let d = (p - (lo + hi) * 0.5).length();
+        !d.is_finite() || d > reach
+    };
+    for (flag, point) in [("--eye", camera.eye), ("--look-at", camera.look_at)] {
+        if far(point) {
+            bail!(
+                "{flag} {:e},{:e},{:e} is out of range: farther than {reach:.3e} (1e9 times the \
+                 scene's size, {size:.3e}) from the scene's centre, where rays lose their precision; \
+                 bring it closer (a smaller --fov frames the scene from nearer)",
+                point.x,
+                point.y,
+                point.z
+            );
+        }
+    }
+    if !(camera.up.length().is_finite()) {
+        bail!(
+            "--up must be a direction of finite length, got {}",
+            camera.up
+        );
+    }
+    if forward
+        .normalize()
+        .cross(camera.up.normalize_or_zero())
+        .length()
+        <= 1e-12
+    {
         bail!("--up must not be parallel to the viewing direction (or zero)");
     }
     Ok(camera)

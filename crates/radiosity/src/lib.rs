@@ -65,6 +65,7 @@
 //! (for example W/m^2), per red, green and blue band; reflectance rho is in [0, 1).
 #![deny(missing_docs)]
 
+pub mod budget;
 pub mod compare;
 pub mod form_factor;
 pub mod geometry;

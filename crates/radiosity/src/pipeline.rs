@@ -63,6 +63,27 @@ pub enum PipelineError {
         /// [`MAX_INTEGRATION_POINTS`].
         limit: f64,
     },
+    /// A form-factor method's own buffers (the hemicube's, Monte Carlo's strata) would not
+    /// fit in memory.
+    #[error(transparent)]
+    TooMuchMemory(#[from] crate::budget::TooMuchMemory),
+    /// A computed form factor is NaN, infinite or negative (checked when the matrix is
+    /// computed, before it is solved or written).
+    #[error(transparent)]
+    FormFactorNotFinite(#[from] form_factor::NonFiniteFormFactor),
+    /// The work would exceed a limit of [`crate::budget`].
+    #[error(transparent)]
+    TooMuchWork(#[from] crate::budget::TooMuchWork),
+    /// A form-factor file holds a matrix of another size than the mesh.
+    #[error("form-factor file {path} holds {found} rows, but the mesh has {expected} elements")]
+    FormFactorSizeMismatch {
+        /// The file.
+        path: String,
+        /// Rows in the file.
+        found: usize,
+        /// Elements of the mesh.
+        expected: usize,
+    },
     /// Adaptive subdivision was asked for with form factors that are not computed: it
     /// needs the form factors of meshes that do not exist yet.
     #[error("adaptive subdivision computes its form factors: it cannot use a form-factor matrix or file")]
@@ -337,6 +358,7 @@ impl Prepared {
                 limit: MAX_INTEGRATION_POINTS,
             });
         }
+        self.check_method_memory(form_factor::available_memory_bytes())?;
         let per_entry = match solver {
             // No matrix: O(n) vectors and one row.
             Some(Solver::Progressive(_) | Solver::Hierarchical(_)) => return Ok(()),
@@ -352,6 +374,60 @@ impl Prepared {
         Ok(())
     }
 
+    /// Refuses a method whose own buffers exceed `available` bytes: the hemicube keeps its
+    /// delta form factors (8 bytes a cell, 1.5 resolution^2 cells) once and a depth and
+    /// owner buffer (12 bytes a cell of the largest face, resolution^2) per thread; Monte
+    /// Carlo keeps a shuffled list of its samples (8 bytes each, rounded up to a square) per
+    /// thread.
+    fn check_method_memory(&self, available: u64) -> Result<(), PipelineError> {
+        let threads = rayon::current_num_threads() as f64;
+        let mib = |b: f64| b / (1u64 << 20) as f64;
+        let available_mib = mib(available as f64);
+        let (needed, what, fits) = match self.method {
+            FormFactorMethod::Hemicube { resolution } => {
+                let r = (resolution.max(2) as f64 / 2.0).ceil() * 2.0;
+                let per_cell = 12.0 + 12.0 * threads;
+                (
+                    per_cell * r * r,
+                    format!("the hemicube at --resolution {resolution} on {threads} threads"),
+                    format!(
+                        "at most --resolution {:.0} would fit",
+                        (available as f64 / per_cell).sqrt().floor()
+                    ),
+                )
+            }
+            FormFactorMethod::MonteCarlo { samples, .. } => {
+                let m = (samples.max(1) as f64).sqrt().ceil();
+                (
+                    8.0 * m * m * threads,
+                    format!("Monte Carlo at --samples {samples} on {threads} threads"),
+                    format!(
+                        "at most --samples {:.0} would fit",
+                        (available as f64 / (8.0 * threads)).floor()
+                    ),
+                )
+            }
+            _ => return Ok(()),
+        };
+        if needed <= available as f64 {
+            return Ok(());
+        }
+        Err(crate::budget::TooMuchMemory {
+            what,
+            needed_mib: mib(needed),
+            available_mib,
+            fits,
+        }
+        .into())
+    }
+
+    /// Refuses, before any work, form factors past the work limits of
+    /// [`crate::budget`] (element pairs x k^4 point pairs, Monte Carlo rays, hemicube
+    /// cells); the command line lets a user lift them.
+    pub fn check_work(&self) -> Result<(), crate::budget::TooMuchWork> {
+        crate::budget::check_form_factor_work(self.method, self.mesh.len())
+    }
+
     /// Computes the form-factor matrix.
     pub fn form_factors(
         &self,
@@ -361,6 +437,7 @@ impl Prepared {
         let rays = RayCounter::default();
         let start = Instant::now();
         let matrix = form_factor::compute_matrix(&ctx, self.method(), &rays, progress)?;
+        matrix.check_entries()?;
         let seconds = start.elapsed().as_secs_f64();
         let stats = FormFactorStats {
             rays: rays.get(),
@@ -385,9 +462,18 @@ impl Prepared {
         path: &Path,
         progress: &dyn Progress,
     ) -> Result<FormFactorMatrix, PipelineError> {
-        Ok(run_stage(progress, Stage::FormFactors, 0, || {
+        let matrix = run_stage(progress, Stage::FormFactors, 0, || {
             read_form_factors(path, self.fingerprint(), Some(self.method()))
-        })?)
+        })?;
+        // The fingerprint covers n, but a forged file could carry this mesh's fingerprint.
+        if matrix.n() != self.mesh.len() {
+            return Err(PipelineError::FormFactorSizeMismatch {
+                path: path.display().to_string(),
+                found: matrix.n(),
+                expected: self.mesh.len(),
+            });
+        }
+        Ok(matrix)
     }
 
     /// Writes form factors to `path` (atomically) with this mesh's fingerprint and method.
@@ -415,6 +501,34 @@ impl Prepared {
 /// `observer` sees every Gauss-Seidel sweep and progressive shot and may stop the solve
 /// (the report then says so); `progress` gets the stages for progress bars.
 pub fn solve(
+    prepared: &Prepared,
+    request: &SolveRequest,
+    observer: &mut Observer,
+    progress: &dyn Progress,
+) -> Result<Solution, PipelineError> {
+    let solution = solve_any(prepared, request, observer, progress)?;
+    // The stage boundary: whatever the solver, no NaN or infinity leaves it (each solver
+    // checks its own iterates too; this catches what a stopped run or an export made).
+    if let Some((element, value)) = solution
+        .radiosity
+        .as_slice()
+        .iter()
+        .enumerate()
+        .find_map(|(i, b)| b.0.iter().find(|x| !x.is_finite()).map(|&x| (i, x)))
+    {
+        return Err(SolveError::NotFinite {
+            solver: request.solver.kind().name(),
+            element,
+            value,
+            after: "the solve".into(),
+        }
+        .into());
+    }
+    Ok(solution)
+}
+
+/// [`solve`] before its final check.
+fn solve_any(
     prepared: &Prepared,
     request: &SolveRequest,
     observer: &mut Observer,
@@ -564,6 +678,7 @@ fn solve_adaptive(
             &counter,
             progress,
         )?;
+        next_f.check_entries()?;
         seconds += clock.elapsed().as_secs_f64();
         rays += counter.get();
         let n = next.len() as u64;

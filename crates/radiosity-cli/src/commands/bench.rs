@@ -105,6 +105,8 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         steps: args.steps,
         method: args.method.clone(),
         quiet: true,
+        // A benchmark measures what it is asked to, however long.
+        no_work_limit: true,
     };
     let options = SolveOptions {
         solver: args.solver,
@@ -149,7 +151,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         settings,
         scale,
         &reporter,
-    );
+    )?;
     let total = start.elapsed().as_secs_f64();
     std::hint::black_box(image);
     let mut stages = [0.0; BENCH_STAGES.len()];

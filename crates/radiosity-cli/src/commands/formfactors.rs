@@ -7,11 +7,16 @@ use anyhow::Result;
 use crate::args::FormFactorArgs;
 use crate::progress_bar::Reporter;
 use crate::report;
-use crate::setup::prepare;
+use crate::setup::{prepare, refuse_overwriting_inputs, stem_of};
 
 pub fn run(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem) = prepare(&args.scene, &reporter)?;
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.ff", stem_of(args.scene.scene.as_deref()))));
+    refuse_overwriting_inputs(&output, &[("scene file", args.scene.scene.as_deref())])?;
+    let (prepared, _) = prepare(&args.scene, &reporter)?;
     reporter.note(&format!(
         "form factors by {}; occlusion: {}",
         prepared.method(),
@@ -19,9 +24,6 @@ pub fn run(args: FormFactorArgs) -> Result<()> {
     ));
     let (f, stats) = prepared.form_factors(&reporter)?;
     report::form_factor_stats(&prepared, &stats, &reporter);
-    let output = args
-        .output
-        .unwrap_or_else(|| PathBuf::from(format!("{stem}.ff")));
     prepared.save_form_factors(&output, &f, &reporter)?;
     reporter.note(&format!(
         "wrote {} ({} x {} form factors, method {})",

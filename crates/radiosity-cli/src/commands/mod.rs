@@ -82,7 +82,7 @@ pub fn shade_and_render(
     settings: RenderSettings,
     exposure_scale: f64,
     reporter: &Reporter,
-) -> RgbImage {
+) -> Result<RgbImage, radiosity::render::NonFiniteImage> {
     let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
         shade::vertex_radiosity(mesh, element_b)
     });
@@ -91,7 +91,7 @@ pub fn shade_and_render(
         ..settings
     };
     let renderer = Renderer::for_settings(mesh, &prepared.scene, &settings);
-    radiosity::render::render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
+    radiosity::render::try_render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
 }
 
 /// What `render` says about the exposure `scale` it used: for `auto`, the radiosity it

@@ -32,6 +32,21 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         seed: args.path_seed,
     };
     settings.check()?;
+    if !args.scene.no_work_limit && args.reference.is_none() {
+        radiosity::budget::check_path_trace_work(
+            args.camera.width,
+            args.camera.height,
+            args.paths,
+        )?;
+    }
+    if args.compare {
+        setup::check_render_budget(
+            &args.camera,
+            args.rays.supersample,
+            true,
+            args.scene.no_work_limit,
+        )?;
+    }
     let shading = setup::shading(args.shading);
     if args.compare && shading == Shading::Wireframe {
         bail!("--compare needs --shading smooth or flat: a wireframe has no radiosity to compare");
@@ -59,6 +74,19 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{stem}-pathtrace.png")));
+    let inputs = [
+        ("scene file", args.scene.scene.as_deref()),
+        ("reference", args.reference.as_deref()),
+        ("form-factor file", args.solve.form_factors.as_deref()),
+    ];
+    let mut outputs = vec![output.clone()];
+    if args.compare {
+        outputs.extend([sibling(&output, "radiosity"), sibling(&output, "error")]);
+    }
+    outputs.extend(args.save_reference.clone());
+    for out in &outputs {
+        setup::refuse_overwriting_inputs(out, &inputs)?;
+    }
 
     // The path-traced view: traced, or read back.
     let (view, settings) = match &args.reference {

@@ -11,15 +11,26 @@ use radiosity::solve::Step;
 use super::{exposure_note, shade_and_render, solve_scene};
 use crate::args::RenderArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{camera, prepare_solve, render_settings};
+use crate::setup::{camera, prepare_solve, refuse_overwriting_inputs, render_settings, stem_of};
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.png", stem_of(args.scene.scene.as_deref()))));
+    refuse_overwriting_inputs(
+        &output,
+        &[
+            ("scene file", args.scene.scene.as_deref()),
+            ("form-factor file", args.solve.form_factors.as_deref()),
+        ],
+    )?;
     let settings = render_settings(&args)?;
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
-    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     if args.snapshots.is_some() && solver.needs_matrix() {
         bail!("--snapshots needs --solver progressive");
     }
@@ -43,6 +54,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let display = state.display_radiosity();
         let display = radiosity::light::Rgb::as_arrays(&display);
         let scale = exposure.scale(&prepared.scene, &prepared.mesh, display);
+        let path = dir.join(format!("shot-{:05}.png", state.shot));
         let image = shade_and_render(
             &prepared,
             &prepared.mesh,
@@ -52,15 +64,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
             scale,
             &quiet,
         );
-        let path = dir.join(format!("shot-{:05}.png", state.shot));
-        match render::write_png(&image, &path) {
+        let written_png = image
+            .map_err(anyhow::Error::new)
+            .and_then(|image| Ok(render::write_png(&image, &path)?));
+        match written_png {
             Ok(()) => {
                 written += 1;
                 ControlFlow::Continue(())
             }
             Err(e) => {
-                snapshot_error =
-                    Some(anyhow::Error::new(e).context(format!("cannot write {}", path.display())));
+                snapshot_error = Some(e.context(format!("cannot write {}", path.display())));
                 ControlFlow::Break(())
             }
         }
@@ -88,10 +101,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         settings,
         scale,
         &reporter,
-    );
-    let output = args
-        .output
-        .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+    )?;
     run_stage(&reporter, Stage::Write, 0, || {
         render::write_png(&image, &output)
     })

@@ -9,11 +9,22 @@ use radiosity::progress::{run_stage, Stage};
 use super::solve_scene;
 use crate::args::SolveArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::prepare_solve;
+use crate::setup::{prepare_solve, refuse_overwriting_inputs, stem_of};
 
 pub fn run(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{}.csv", stem_of(args.scene.scene.as_deref()))));
+    refuse_overwriting_inputs(
+        &output,
+        &[
+            ("scene file", args.scene.scene.as_deref()),
+            ("form-factor file", args.solve.form_factors.as_deref()),
+        ],
+    )?;
+    let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let (solution, _) = solve_scene(
         &prepared,
         solver,
@@ -22,9 +33,6 @@ pub fn run(args: SolveArgs) -> Result<()> {
         &mut |_| ControlFlow::Continue(()),
         &reporter,
     )?;
-    let output = args
-        .output
-        .unwrap_or_else(|| PathBuf::from(format!("{stem}.csv")));
     run_stage(&reporter, Stage::Write, 0, || {
         radiosity::solution::write_solution(
             &output,

@@ -4,5 +4,6 @@
 mod fixtures;
 
 mod commands;
+mod hostile;
 mod pathtrace;
 mod view;

@@ -61,15 +61,50 @@ pub struct OutOfMemory {
     pub fits: usize,
 }
 
-/// Memory this process may use, in bytes: the memory the system reports available
-/// ([`sysinfo`]'s `available_memory`; on Linux `MemAvailable` from /proc/meminfo), capped by
-/// the memory limit of the cgroup when one is set (cgroup v2 `/sys/fs/cgroup/memory.max`, or
-/// v1 `memory.limit_in_bytes`); 8 GiB where the system reports nothing. A `ulimit -v`
-/// address-space limit is not seen.
+/// A form factor that is not a finite number, or is negative: F_ij is a fraction of
+/// energy, in [0, 1]. Found at a stage boundary (after the matrix is computed, before a
+/// solve, in each row progressive refinement computes).
+#[derive(Clone, Copy, Debug, thiserror::Error, PartialEq)]
+#[error(
+    "form factor F[{row}][{col}] (from element {row} to element {col}) is {value}, not a \
+     number in [0, 1]: the elements' geometry is out of reach of f64 (an area or distance \
+     that underflows or overflows, as in a surface 1e-200 thick)"
+)]
+pub struct NonFiniteFormFactor {
+    /// Row i (the element the energy leaves).
+    pub row: usize,
+    /// Column j (the element it arrives at).
+    pub col: usize,
+    /// The value found.
+    pub value: f64,
+}
+
+/// Checks that every entry of `row` (row i of F) is finite and not negative.
+pub fn check_row(i: usize, row: impl IntoIterator<Item = f64>) -> Result<(), NonFiniteFormFactor> {
+    match row
+        .into_iter()
+        .enumerate()
+        .find(|(_, f)| !(f.is_finite() && *f >= 0.0))
+    {
+        Some((col, value)) => Err(NonFiniteFormFactor { row: i, col, value }),
+        None => Ok(()),
+    }
+}
+
+/// Memory this process may use, in bytes: the one memory budget every estimate in this
+/// library is checked against. The smallest of
 ///
-/// This is the number the hand-written reader of /proc/meminfo and memory.max gave (MemAvailable
-/// in KiB times 1024, the smaller of it and memory.max), except that a cgroup v1 limit now
-/// counts too, and other systems report their own figure instead of the 8 GiB guess.
+/// - the memory the system reports available ([`sysinfo`]'s `available_memory`; on Linux
+///   `MemAvailable` from /proc/meminfo; 8 GiB where the system reports nothing),
+/// - the memory limit of the cgroup when one is set (cgroup v2 `memory.max`, or v1
+///   `memory.limit_in_bytes`),
+/// - on Linux, what is left of the address-space limit (`ulimit -v`, RLIMIT_AS) and of the
+///   data-segment limit (`ulimit -d`, RLIMIT_DATA) after what the process already maps
+///   (`VmSize`, `VmData` of /proc/self/status): an allocation past either fails, however
+///   much memory is free.
+///
+/// The limits are read from /proc/self/limits, the same numbers getrlimit gives, so no
+/// unsafe code is needed. Elsewhere the resource limits are not seen.
 pub fn available_memory_bytes() -> u64 {
     use sysinfo::{MemoryRefreshKind, RefreshKind, System};
     let system = System::new_with_specifics(
@@ -77,14 +112,54 @@ pub fn available_memory_bytes() -> u64 {
     );
     let available = system.available_memory();
     // cgroup_limits asserts that the memory was read (a non-zero total).
-    if available == 0 || system.total_memory() == 0 {
-        return 8 << 30;
-    }
-    // The limit's total is min(limit, total memory), so this is min(available, limit).
-    match system.cgroup_limits() {
-        Some(limits) => available.min(limits.total_memory),
-        None => available,
-    }
+    let memory = if available == 0 || system.total_memory() == 0 {
+        8 << 30
+    } else {
+        // The limit's total is min(limit, total memory), so this is min(available, limit).
+        match system.cgroup_limits() {
+            Some(limits) => available.min(limits.total_memory),
+            None => available,
+        }
+    };
+    memory.min(resource_limit_headroom().unwrap_or(u64::MAX))
+}
+
+/// What the address-space and data-segment limits leave: min over the two of (soft limit
+/// - what is mapped now), `None` when neither is set (or on systems without /proc).
+fn resource_limit_headroom() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    headroom_from_proc(&limits, &status)
+}
+
+/// [`resource_limit_headroom`] from the texts of /proc/self/limits and /proc/self/status.
+fn headroom_from_proc(limits: &str, status: &str) -> Option<u64> {
+    // "Max address space   unlimited   unlimited   bytes": the soft limit is the one enforced.
+    let soft = |name: &str| -> Option<u64> {
+        let line = limits.lines().find(|l| l.starts_with(name))?;
+        line[name.len()..].split_whitespace().next()?.parse().ok()
+    };
+    // "VmSize:	    3896 kB"
+    let used = |key: &str| -> u64 {
+        status
+            .lines()
+            .find(|l| l.starts_with(key))
+            .and_then(|l| {
+                l[key.len()..]
+                    .split_whitespace()
+                    .next()?
+                    .parse::<u64>()
+                    .ok()
+            })
+            .map_or(0, |kib| kib * 1024)
+    };
+    [
+        ("Max address space", "VmSize:"),
+        ("Max data size", "VmData:"),
+    ]
+    .into_iter()
+    .filter_map(|(limit, key)| Some(soft(limit)?.saturating_sub(used(key))))
+    .min()
 }
 
 /// Checks that `bytes_per_entry` x n^2 bytes (plus 10 % headroom) fit in `available` bytes.
@@ -176,6 +251,24 @@ impl FormFactorMatrix {
             mean: sums.iter().sum::<f64>() / self.n.max(1) as f64,
             max: sums.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         }
+    }
+
+    /// Checks that every entry is finite and not negative ([`check_row`] on every row), in
+    /// parallel over rows; the error names the first bad entry of the first bad row.
+    pub fn check_entries(&self) -> Result<(), NonFiniteFormFactor> {
+        (0..self.n)
+            .into_par_iter()
+            .map(|i| check_row(i, self.row(i).iter().map(|&f| f as f64)))
+            .find_first(Result::is_err)
+            .unwrap_or(Ok(()))
+    }
+
+    /// The largest sum of |F_ij| over a row (0 for an empty matrix).
+    pub fn max_abs_row_sum(&self) -> f64 {
+        (0..self.n)
+            .into_par_iter()
+            .map(|i| self.row(i).iter().map(|&f| (f as f64).abs()).sum::<f64>())
+            .reduce(|| 0.0, f64::max)
     }
 
     /// How far the matrix is from reciprocity A_i F_ij = A_j F_ji.
@@ -552,7 +645,26 @@ pub fn compute_rows(
 
 #[cfg(test)]
 mod tests {
-    /// `MemAvailable` read by hand, capped by a cgroup limit read by hand, matches
+    /// `ulimit -v` and `ulimit -d` count: what they leave after the mapped memory is the
+    /// budget, the smaller of the two; "unlimited" sets nothing.
+    #[test]
+    fn memory_budget_honours_ulimit_v_and_ulimit_d() {
+        let limits = "Limit                     Soft Limit           Hard Limit           Units\n\
+                      Max data size             3221225472           unlimited            bytes\n\
+                      Max address space         2147483648           4294967296           bytes\n";
+        let status = "Name:\tradiosity\nVmSize:\t  1048576 kB\nVmData:\t   524288 kB\n";
+        // 2 GiB - 1 GiB mapped = 1 GiB; 3 GiB - 0.5 GiB = 2.5 GiB.
+        assert_eq!(super::headroom_from_proc(limits, status), Some(1 << 30));
+        let unlimited = "Max data size             unlimited            unlimited            bytes\n\
+                         Max address space         unlimited            unlimited            bytes\n";
+        assert_eq!(super::headroom_from_proc(unlimited, status), None);
+        // A limit below what is already mapped leaves nothing.
+        let tight = "Max address space         1024                 unlimited            bytes\n";
+        assert_eq!(super::headroom_from_proc(tight, status), Some(0));
+    }
+
+    /// `MemAvailable` read by hand, capped by a cgroup limit read by hand (and by the
+    /// resource limits), matches
     /// [`super::available_memory_bytes`] up to what other processes change in between.
     #[cfg(target_os = "linux")]
     #[test]
@@ -578,7 +690,8 @@ mod tests {
         .iter()
         .find_map(|p| read(p)?.trim().parse::<u64>().ok())
         .unwrap_or(u64::MAX);
-        let by_hand = available.min(limit) as f64;
+        let rlimit = super::resource_limit_headroom().unwrap_or(u64::MAX);
+        let by_hand = available.min(limit).min(rlimit) as f64;
         let got = super::available_memory_bytes();
         assert!(got <= total.min(limit), "{got} > {total} or {limit}");
         let slack = (0.1 * by_hand).max((256 << 20) as f64);

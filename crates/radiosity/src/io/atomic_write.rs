@@ -11,6 +11,13 @@ use std::path::Path;
 /// `path` is left as it was. The new file gets the permissions [`std::fs::File::create`]
 /// would give it (0666 less the umask), not the owner-only ones of a temporary file.
 ///
+/// The temporary file is named `.NAME.PID.RANDOM.tmp` (PID this process's id). `tempfile`
+/// removes it on every exit path that unwinds, but a run killed by a signal (or an abort)
+/// leaves it behind; so before writing, the temporary files of `path` whose PID is no
+/// longer a running process (on Linux: no /proc/PID) and that were last written a minute or
+/// more ago are removed ([`remove_stale_temporaries`]). The age spares a file another
+/// machine is writing through a shared file system, where its PID means nothing here.
+///
 /// A symbolic link is followed (its target is replaced, the link kept), and an existing
 /// path that is not a regular file (a device such as /dev/stdout, a named pipe) is written
 /// to directly, since it cannot be replaced by renaming.
@@ -40,8 +47,9 @@ pub fn write_atomically(
     let name = path.file_name().ok_or_else(|| {
         io::Error::new(io::ErrorKind::InvalidInput, "output path has no file name")
     })?;
+    remove_stale_temporaries(dir, &name.to_string_lossy(), STALE_AFTER);
     let mut builder = tempfile::Builder::new();
-    let prefix = format!(".{}.", name.to_string_lossy());
+    let prefix = format!(".{}.{}.", name.to_string_lossy(), std::process::id());
     builder.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]
     {
@@ -59,9 +67,142 @@ pub fn write_atomically(
     tmp.persist(path).map_err(|e| e.error)
 }
 
+/// How long a dead run's temporary file is left alone: longer than any write of ours takes
+/// between two writes to the file.
+const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// Removes from `dir` the temporary files `.NAME.PID.RANDOM.tmp` of output `name` left by
+/// runs that are no longer running (see [`write_atomically`]) and untouched for `age`.
+/// Returns how many were removed. Errors are ignored: cleaning up is a courtesy, and a
+/// file another run removes first is fine. Does nothing where it cannot tell whether a
+/// process runs (no /proc).
+pub fn remove_stale_temporaries(dir: &Path, name: &str, age: std::time::Duration) -> usize {
+    if !Path::new("/proc/self").exists() {
+        return 0;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let prefix = format!(".{name}.");
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let file_name = file_name.to_string_lossy();
+        let Some(middle) = file_name
+            .strip_prefix(&prefix)
+            .and_then(|rest| rest.strip_suffix(".tmp"))
+        else {
+            continue;
+        };
+        // PID.RANDOM, the PID all digits.
+        let Some(pid) = middle
+            .split_once('.')
+            .and_then(|(pid, _)| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists() {
+            continue;
+        }
+        let old_enough = entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|elapsed| elapsed >= age);
+        if old_enough && std::fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// True when `a` and `b` name the same existing file (after symbolic links, through hard
+/// links and `..`): same device and inode on Unix, same canonical path elsewhere. A path
+/// that does not exist is no file's, so writing it cannot overwrite an input.
+pub fn is_same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        (ma.dev(), ma.ino()) == (mb.dev(), mb.ino())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!(
+            (std::fs::canonicalize(a), std::fs::canonicalize(b)),
+            (Ok(x), Ok(y)) if x == y
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The largest PID Linux hands out is 2^22 (pid_max); 4,000,000,000 is never running.
+    const DEAD_PID: u32 = 4_000_000_000;
+
+    #[test]
+    fn a_killed_runs_temporary_file_is_removed_by_the_next_write() {
+        let dir = std::env::temp_dir().join(format!("radiosity-aw-stale-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let make = |name: &str, age_s: u64| {
+            let path = dir.join(name);
+            let file = std::fs::File::create(&path).unwrap();
+            let then = std::time::SystemTime::now() - std::time::Duration::from_secs(age_s);
+            file.set_modified(then).unwrap();
+            path
+        };
+        let dead_old = make(&format!(".out.png.{DEAD_PID}.aB3xYz.tmp"), 3600);
+        let dead_new = make(&format!(".out.png.{DEAD_PID}.q1w2e3.tmp"), 0);
+        let alive = make(&format!(".out.png.{}.zzzzzz.tmp", std::process::id()), 3600);
+        let other_output = make(&format!(".other.png.{DEAD_PID}.aB3xYz.tmp"), 3600);
+        let not_ours = make(".out.png.notapid.tmp", 3600);
+        write_atomically(&dir.join("out.png"), |w| w.write_all(b"png")).unwrap();
+        if Path::new("/proc/self").exists() {
+            assert!(
+                !dead_old.exists(),
+                "a dead run's old temporary file is left"
+            );
+        }
+        for kept in [&dead_new, &alive, &other_output, &not_ours] {
+            assert!(kept.exists(), "{} removed", kept.display());
+        }
+        // The write's own temporary file is gone too.
+        let left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(left.len(), 5, "{left:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn same_file_is_seen_through_other_spellings_and_links() {
+        let dir = std::env::temp_dir().join(format!("radiosity-aw-same-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        let file = dir.join("x.scene");
+        std::fs::write(&file, "x").unwrap();
+        assert!(is_same_file(&file, &dir.join("sub/../x.scene")));
+        let hard = dir.join("hard.scene");
+        std::fs::hard_link(&file, &hard).unwrap();
+        assert!(is_same_file(&file, &hard));
+        #[cfg(unix)]
+        {
+            let soft = dir.join("soft.scene");
+            std::os::unix::fs::symlink(&file, &soft).unwrap();
+            assert!(is_same_file(&soft, &file));
+        }
+        std::fs::write(dir.join("other.scene"), "x").unwrap();
+        assert!(!is_same_file(&file, &dir.join("other.scene")));
+        assert!(!is_same_file(&file, &dir.join("missing.scene")));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn failed_write_leaves_no_file() {

@@ -51,6 +51,16 @@ pub const MAX_METHOD_LEN: u32 = 4096;
 /// Bytes of a form-factor file besides the method string and the matrix.
 const FIXED_BYTES: u64 = 8 + 4 + 8 + 4 + 8 + 4 + 4;
 
+/// The largest row sum a form-factor file may hold. Each row of F sums to at most 1 (the
+/// fractions of the energy leaving an element that arrive anywhere), and this program's
+/// methods stay below 1.18 where their discretisation overshoots (contour and analytic at
+/// k = 2 in the furnished room at a coarse mesh; area at most 1.06; hemicube and Monte Carlo
+/// 1 + f32 rounding: tests/suite/methods_on_examples.rs), 1.4 with the area method's older
+/// near-pair rule (form_factor/area.rs). 1.5 refuses nothing this program writes and keeps
+/// rho s < 1.5 rho: a row far above it (the forged file of issue 12 had 5,230) makes the
+/// solve diverge.
+pub const MAX_ROW_SUM: f64 = 1.5;
+
 /// Entries converted per read or write call.
 const CHUNK_ENTRIES: usize = 1 << 16;
 
@@ -166,6 +176,36 @@ pub enum FormFactorFileError {
         found: FormFactorMethod,
         /// The method asked for.
         expected: FormFactorMethod,
+    },
+    /// An entry is NaN, infinite or negative: a form factor is a fraction of energy.
+    #[error(
+        "form-factor file {path}: row {row} has F[{row}][{col}] = {value}, but every form \
+         factor is a number in [0, 1]"
+    )]
+    BadEntry {
+        /// The file.
+        path: PathBuf,
+        /// The row (element the energy leaves).
+        row: usize,
+        /// The column.
+        col: usize,
+        /// The value found.
+        value: f32,
+    },
+    /// A row sums to more than [`MAX_ROW_SUM`]: more energy would arrive than leaves.
+    #[error(
+        "form-factor file {path}: row {row} sums to {sum}, more than {limit} (each row of \
+         form factors sums to at most 1, plus the methods' discretisation error)"
+    )]
+    RowSumTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// The row.
+        row: usize,
+        /// Its sum.
+        sum: f64,
+        /// [`MAX_ROW_SUM`].
+        limit: f64,
     },
     /// The matrix would not fit in memory (nothing was allocated).
     #[error("cannot load form-factor file {path}: {source}")]
@@ -446,6 +486,31 @@ fn read_with_memory(
             stored,
             computed,
         });
+    }
+    // The checksums say the bytes are those written, not that they are form factors: a
+    // forged file can carry valid checksums around NaN or rows summing to thousands.
+    for (row, entries) in data.chunks_exact(n.max(1)).enumerate() {
+        if let Some((col, &value)) = entries
+            .iter()
+            .enumerate()
+            .find(|(_, f)| !(f.is_finite() && **f >= 0.0))
+        {
+            return Err(FormFactorFileError::BadEntry {
+                path: p(),
+                row,
+                col,
+                value,
+            });
+        }
+        let sum: f64 = entries.iter().map(|&f| f as f64).sum();
+        if sum > MAX_ROW_SUM {
+            return Err(FormFactorFileError::RowSumTooLarge {
+                path: p(),
+                row,
+                sum,
+                limit: MAX_ROW_SUM,
+            });
+        }
     }
     Ok(FormFactorMatrix::from_rows(n, data))
 }

@@ -21,4 +21,4 @@ pub mod png;
 pub mod scene_file;
 pub mod solution;
 
-pub use atomic_write::write_atomically;
+pub use atomic_write::{is_same_file, write_atomically};

@@ -20,6 +20,7 @@
 //! [`Progress`] sink as one unit of [`Stage::Render`].
 
 use image::RgbImage;
+use rayon::prelude::*;
 
 use crate::progress::{run_stage, Progress, Stage};
 use tonemap::ToneMap;
@@ -103,11 +104,56 @@ pub fn render(
     settings: &RenderSettings,
     progress: &dyn Progress,
 ) -> RgbImage {
+    render_counting(renderer, camera, element_b, vertex_b, settings, progress).0
+}
+
+/// Camera samples that were not finite numbers: the tone map shows NaN as black, so an
+/// image of them would look like a dark scene.
+#[derive(Clone, Copy, Debug, thiserror::Error, PartialEq)]
+#[error(
+    "the render is not a picture: {bad} of its {total} camera samples are not finite \
+     numbers (NaN or infinity), from radiosities or geometry out of reach of f64"
+)]
+pub struct NonFiniteImage {
+    /// Samples that were NaN or infinite.
+    pub bad: u64,
+    /// Samples in all.
+    pub total: u64,
+}
+
+/// [`render`], refusing an image any of whose samples is not finite (the stage boundary
+/// check of the rendered image).
+pub fn try_render(
+    renderer: &Renderer,
+    camera: &Camera,
+    element_b: &[[f64; 3]],
+    vertex_b: &[[f64; 3]],
+    settings: &RenderSettings,
+    progress: &dyn Progress,
+) -> Result<RgbImage, NonFiniteImage> {
+    let (image, bad, total) =
+        render_counting(renderer, camera, element_b, vertex_b, settings, progress);
+    if bad > 0 {
+        return Err(NonFiniteImage { bad, total });
+    }
+    Ok(image)
+}
+
+/// [`render`], with the count of samples that were not finite and of all samples.
+fn render_counting(
+    renderer: &Renderer,
+    camera: &Camera,
+    element_b: &[[f64; 3]],
+    vertex_b: &[[f64; 3]],
+    settings: &RenderSettings,
+    progress: &dyn Progress,
+) -> (RgbImage, u64, u64) {
     renderer.check_inputs(element_b, vertex_b, settings.shading);
     let (w, h) = (camera.width as usize, camera.height as usize);
     if w == 0 || h == 0 {
-        return RgbImage::new(camera.width, camera.height);
+        return (RgbImage::new(camera.width, camera.height), 0, 0);
     }
+    let (mut bad, mut total) = (0u64, 0u64);
     let n = settings.supersample.max(1) as usize;
     let tone = ToneMap::new(settings.exposure_scale, settings.gamma);
     let strip = (STRIP_SAMPLES / (w * n * n)).max(1);
@@ -124,10 +170,18 @@ pub fn render(
                 n,
                 progress,
             );
+            total += film.samples().len() as u64;
+            bad += film
+                .samples()
+                .par_iter()
+                .filter(|s| !s.iter().all(|x| x.is_finite()))
+                .count() as u64;
             tone.encode_film(&film, out);
         }
     });
-    RgbImage::from_raw(camera.width, camera.height, buf).expect("buffer has the image's size")
+    let image =
+        RgbImage::from_raw(camera.width, camera.height, buf).expect("buffer has the image's size");
+    (image, bad, total)
 }
 
 #[cfg(test)]
@@ -149,6 +203,36 @@ mod tests {
             self.1.fetch_add(done, Ordering::SeqCst);
         }
         fn finish(&self, _: Stage, _: std::time::Duration) {}
+    }
+
+    #[test]
+    fn an_image_of_nan_radiosity_is_refused_not_written_black() {
+        // One flat-shaded square filling the view: every sample reads its element's B.
+        let s = scene(vec![surface(
+            "a",
+            0.0,
+            facing_minus_z(-1., 1., -1., 1., 0.),
+        )]);
+        let mesh = mesh_scene(&s, 4.0).unwrap();
+        let r = Renderer::new(&mesh);
+        let cam = Camera {
+            eye: dvec3(0., 0., -1.),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 50.0,
+            width: 4,
+            height: 4,
+        };
+        let settings = RenderSettings {
+            shading: Shading::Flat,
+            supersample: 1,
+            ..RenderSettings::default()
+        };
+        let nan = vec![[f64::NAN, 0.5, 0.5]; mesh.len()];
+        let err = try_render(&r, &cam, &nan, &[], &settings, &NoProgress).unwrap_err();
+        assert_eq!(err, NonFiniteImage { bad: 16, total: 16 });
+        let fine = vec![[0.5; 3]; mesh.len()];
+        assert!(try_render(&r, &cam, &fine, &[], &settings, &NoProgress).is_ok());
     }
 
     #[test]

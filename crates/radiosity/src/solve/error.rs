@@ -1,6 +1,6 @@
 //! Why a solve failed.
 
-use crate::form_factor::OutOfMemory;
+use crate::form_factor::{NonFiniteFormFactor, OutOfMemory};
 use crate::light::LightError;
 
 /// The radiosity system cannot be solved.
@@ -59,6 +59,45 @@ pub enum SolveError {
         /// Sweeps made.
         sweeps: usize,
     },
+    /// A solver produced a radiosity that is not a finite number (NaN or infinity). It is
+    /// never treated as converged: NaN compares false with every tolerance.
+    #[error(
+        "{solver} produced a radiosity that is not a finite number: element {element} has \
+         B = {value} after {after}; the input is not a valid radiosity system (a form factor, \
+         area or emission that is not finite, or surfaces too small for f64)"
+    )]
+    NotFinite {
+        /// Which solver ("Gauss-Seidel").
+        solver: &'static str,
+        /// The first element (or hierarchical node) whose radiosity is not finite.
+        element: usize,
+        /// Its value (NaN or +-infinity).
+        value: f64,
+        /// When ("sweep 3", "the LU solve", "shot 12").
+        after: String,
+    },
+    /// A solver's iterates grew past what any solution of a valid system can reach.
+    #[error(
+        "{solver} diverged: {what} is {value:e} after {after}, beyond the bound {bound:e} \
+         ({reason}); the form factors are not a valid matrix (rows summing far above 1?)"
+    )]
+    Diverged {
+        /// Which solver.
+        solver: &'static str,
+        /// What grew ("the largest |B|").
+        what: &'static str,
+        /// Its value.
+        value: f64,
+        /// The bound it passed.
+        bound: f64,
+        /// Why nothing valid passes that bound.
+        reason: String,
+        /// When.
+        after: String,
+    },
+    /// A form factor handed to the solver, or computed by it, is not a finite number.
+    #[error(transparent)]
+    FormFactor(#[from] NonFiniteFormFactor),
     /// There is nothing to solve.
     #[error("the scene has no surfaces")]
     NoSurfaces,

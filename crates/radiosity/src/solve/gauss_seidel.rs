@@ -11,14 +11,26 @@
 //! r_i = rho_i sum_{j >= i} F_ij d_j, so |r_i| <= max |d|; once max |d| / max |E| is below
 //! the tolerance the true residual is computed (one more pass over F) and the solve ends
 //! when that too is below the tolerance.
+//!
+//! Failing loudly: after every sweep B is checked finite ([`SolveError::NotFinite`]), and
+//! against the bound no iterate of a valid system passes: with rho_max s < 1 (s the
+//! largest row sum of |F|) the sweeps contract the error in the max norm, so every iterate
+//! stays within |B*| + |B_0 - B*| <= 2 |B*|max + |B_0|max of the origin, where
+//! |B*| <= max |E| / (1 - rho_max s). Where no such bound follows (rho_max s >= 1), a
+//! sweep change 1e6 times its smallest so far is called divergence: a contraction's changes
+//! never grow. Both give [`SolveError::Diverged`].
 
 use std::ops::ControlFlow;
 
+use super::finite::{check_finite, max_abs, SolutionBound};
 use super::residual::{max_abs_emission, relative, relative_residual, row_dot3};
 use super::{GaussSeidelSettings, Observer, Radiosity, SolveError, Step};
 use crate::form_factor::FormFactorMatrix;
 use crate::light::{ElementLight, Rgb};
 use crate::progress::Progress;
+
+/// The name errors give.
+const SOLVER: &str = "Gauss-Seidel";
 
 /// What a Gauss-Seidel run returns.
 pub(super) struct Run {
@@ -46,6 +58,12 @@ pub(super) fn solve(
     let n = f.n();
     let scale = max_abs_emission(emission);
     let mut b: Vec<Rgb> = start.unwrap_or(emission).to_vec();
+    check_finite(&b, SOLVER, || "the start".into())?;
+    let bound = SolutionBound::new(light, f.max_abs_row_sum());
+    let iterate_limit = bound
+        .as_ref()
+        .map(|s| (2.0 * s.bound + max_abs(&b)) * (1.0 + 1e-9));
+    let mut smallest_change = f64::INFINITY;
     let mut residual = f64::INFINITY;
     for sweep in 1..=max_iterations {
         let mut change = [0.0f64; 3];
@@ -58,15 +76,26 @@ pub(super) fn solve(
             }
         }
         progress.advance(1);
+        // NaN would be dropped by f64::max below and read as converged: look for it first.
+        check_finite(&b, SOLVER, || format!("sweep {sweep}"))?;
+        if let (Some(bound), Some(limit)) = (&bound, iterate_limit) {
+            bound.check(&b, limit, SOLVER, || format!("sweep {sweep}"))?;
+        }
         let estimate = relative(change, scale).into_iter().fold(0.0, f64::max);
-        if estimate.is_nan() {
-            // Cannot happen for valid inputs; do not loop on NaN.
-            return Err(SolveError::NotConverged {
-                iterations: sweep,
-                residual: f64::NAN,
-                tolerance,
+        if estimate > 1e6 * smallest_change {
+            return Err(SolveError::Diverged {
+                solver: SOLVER,
+                what: "the change made by one sweep (relative to max |E|)",
+                value: estimate,
+                bound: 1e6 * smallest_change,
+                reason: format!(
+                    "a million times its smallest so far, {smallest_change:e}: a convergent \
+                     iteration's changes shrink"
+                ),
+                after: format!("sweep {sweep}"),
             });
         }
+        smallest_change = smallest_change.min(estimate);
         residual = estimate;
         if estimate < tolerance {
             let true_residual = relative_residual(f, light, &b)

@@ -22,6 +22,7 @@
 
 mod energy;
 mod error;
+mod finite;
 mod gauss_seidel;
 mod hierarchical;
 mod lu;
@@ -95,6 +96,14 @@ fn solve_with_memory(
         DenseSolver::Lu => {
             lu::check_memory(f.n(), available)?;
             let b = lu::solve(f, light, true, progress);
+            // A singular or wildly invalid system gives NaN or infinity, or a B no solution
+            // of a valid system has (rounding allowed for: 1e-6 relative).
+            finite::check_finite(b.as_slice(), "LU", || "the LU solve".into())?;
+            if let Some(bound) = finite::SolutionBound::new(light, f.max_abs_row_sum()) {
+                let limit = bound.bound * (1.0 + 1e-6);
+                bound.check(b.as_slice(), limit, "LU", || "the LU solve".into())?;
+            }
+            finite::check_at_least_emission(b.as_slice(), light, "LU")?;
             (b, None, false)
         }
         DenseSolver::GaussSeidel(settings) => {
@@ -128,6 +137,9 @@ fn check_inputs(
     start: Option<&[Rgb]>,
 ) -> Result<(), SolveError> {
     let n = f.n();
+    // A NaN or negative form factor would make NaN radiosities that every max-based test
+    // reads as converged.
+    f.check_entries()?;
     for (what, len) in [
         ("the element light", Some(light.len())),
         ("the starting solution", start.map(<[Rgb]>::len)),

@@ -183,6 +183,7 @@ pub fn solve_progressive(
     let mut power = total_unshot(&unshot);
     let mut shots = 0usize;
     let mut stopped = false;
+    let mut smallest_fraction = f64::INFINITY;
     let result = run_stage(progress, Stage::Solve, 0, || -> Result<(), SolveError> {
         loop {
             if fraction(power) < tolerance {
@@ -209,6 +210,9 @@ pub fn solve_progressive(
             let a_i = areas[shooter];
             unshot[shooter] = Rgb::BLACK;
             let row = rows.row(shooter, &rays);
+            // A NaN entry would spread NaN to every element it reaches, and the unshot
+            // fraction, folded with f64::max, would read as converged.
+            crate::form_factor::check_row(shooter, row.iter().copied())?;
             let mut row_sum = 0.0;
             let mut reflected_power = [0.0f64; 3];
             for (j, &fij) in row.iter().enumerate() {
@@ -237,6 +241,34 @@ pub fn solve_progressive(
                 std::array::from_fn(|k| (power[k] - a_i * shot[k] + reflected_power[k]).max(0.0))
             };
             progress.advance(1);
+            let now = fraction(power);
+            if !now.is_finite() || power.iter().any(|p| !p.is_finite()) {
+                super::finite::check_finite(&b, "progressive refinement", || {
+                    format!("shot {shots}")
+                })?;
+                return Err(SolveError::NotFinite {
+                    solver: "progressive refinement",
+                    element: shooter,
+                    value: now,
+                    after: format!("shot {shots} (the unshot power)"),
+                });
+            }
+            // Each shot moves power A_i dB_i and reflects at most rho_max s of it (s the
+            // row's sum): with valid rows the unshot power only shrinks.
+            if now > 1e6 * smallest_fraction {
+                return Err(SolveError::Diverged {
+                    solver: "progressive refinement",
+                    what: "the unshot power (fraction of the emitted)",
+                    value: now,
+                    bound: 1e6 * smallest_fraction,
+                    reason: format!(
+                        "a million times its smallest so far, {smallest_fraction:e}: shots \
+                         with rows summing to at most 1 only shrink it"
+                    ),
+                    after: format!("shot {shots}"),
+                });
+            }
+            smallest_fraction = smallest_fraction.min(now);
             let state = ProgressiveState {
                 shot: shots,
                 shooter,

@@ -478,3 +478,76 @@ fn closed_cube_with_computed_form_factors_stays_within_furnace_bounds() {
         }
     }
 }
+
+/// [`closed_four`] with every entry times `scale`: rows sum to `scale`.
+fn closed_four_scaled(scale: f32) -> FormFactorMatrix {
+    FormFactorMatrix::from_rows(
+        4,
+        closed_four().as_slice().iter().map(|f| f * scale).collect(),
+    )
+}
+
+#[test]
+fn every_dense_solver_refuses_nan_and_infinite_form_factors() {
+    let (rho, e) = ([[0.5; 3]; 4], [[1.0; 3]; 4]);
+    for bad in [f32::NAN, f32::INFINITY, -0.5] {
+        let mut data = closed_four().as_slice().to_vec();
+        data[4 + 2] = bad;
+        let f = FormFactorMatrix::from_rows(4, data);
+        for solver in [DenseSolver::Lu, gs(1e-9)] {
+            let err = run(&f, &rho, &e, solver).unwrap_err();
+            assert!(
+                matches!(err, SolveError::FormFactor(ref x) if (x.row, x.col) == (1, 2)),
+                "{solver} on F[1][2] = {bad}: {err:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn gauss_seidel_fails_loudly_on_divergence_instead_of_converging_to_nan() {
+    // Rows summing to 5,230 (the forged file of issue 12) with rho = 0.5: each sweep
+    // multiplies B by about 2,615, so NaN or infinity would follow within 90 sweeps.
+    let f = closed_four_scaled(5230.0);
+    let err = run(&f, &[[0.5; 3]; 4], &[[1.0; 3]; 4], gs(1e-9)).unwrap_err();
+    assert!(matches!(err, SolveError::Diverged { .. }), "{err:?}");
+    assert!(err.to_string().contains("Gauss-Seidel diverged"), "{err}");
+    // Rows summing to 1.5 with rho 0.6 bound B (rho s = 0.9 < 1): the guard must not fire.
+    let (f, _) = random_reciprocal(40, 1.5, 7);
+    let (rho, e) = (vec![[0.6; 3]; 40], vec![[1.0; 3]; 40]);
+    for solver in [DenseSolver::Lu, gs(1e-9)] {
+        assert!(run(&f, &rho, &e, solver).is_ok(), "{solver}");
+    }
+}
+
+#[test]
+fn lu_refuses_the_finite_but_unphysical_solution_of_a_divergent_system() {
+    // (I - rho F) B = E with rows summing to 5,230 has the finite solution
+    // B = E / (1 - 0.5 x 5230) < 0: below the emission, which no convergent system gives.
+    let f = closed_four_scaled(5230.0);
+    let err = run(&f, &[[0.5; 3]; 4], &[[1.0; 3]; 4], DenseSolver::Lu).unwrap_err();
+    assert!(matches!(err, SolveError::Diverged { .. }), "{err:?}");
+    assert!(err.to_string().contains("below its emission"), "{err}");
+}
+
+#[test]
+fn gauss_seidel_never_reads_nan_radiosity_as_converged() {
+    // A NaN start (a warm start from a broken solution) must fail, not report residual 0.
+    let f = closed_four();
+    let light = light(&[[0.5; 3]; 4], &[[1.0; 3]; 4]);
+    let mut start = vec![Rgb([1.0; 3]); 4];
+    start[3] = Rgb([f64::NAN, 1.0, 1.0]);
+    let err = solve(
+        &f,
+        &light,
+        &gs(1e-9),
+        Some(&start),
+        &mut keep_going,
+        &NoProgress,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, SolveError::NotFinite { element: 3, .. }),
+        "{err:?}"
+    );
+}

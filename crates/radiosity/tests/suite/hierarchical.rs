@@ -562,3 +562,58 @@ fn leaves_nest_with_the_mesh_elements() {
     eprintln!("{within} leaves within an element, {unions} unions of elements");
     assert!(within > 0 && unions > 0);
 }
+
+/// A regular `n`-gon of radius 1 on the floor, lit by a square above it.
+fn polygon_under_a_light(n: usize) -> Scene {
+    use glam::dvec3;
+    use radiosity::scene::Surface;
+    let polygon = (0..n)
+        .map(|i| {
+            let a = -std::f64::consts::TAU * i as f64 / n as f64;
+            dvec3(a.cos(), 0.0, a.sin())
+        })
+        .collect();
+    let light = vec![
+        dvec3(-0.2, 1.0, -0.2),
+        dvec3(0.2, 1.0, -0.2),
+        dvec3(0.2, 1.0, 0.2),
+        dvec3(-0.2, 1.0, 0.2),
+    ];
+    let surface = |name: &str, vertices, e: f64| Surface {
+        name: name.into(),
+        emission: Light([e; 3]),
+        reflectance: Light([0.5; 3]),
+        vertices,
+    };
+    Scene {
+        surfaces: vec![
+            surface("floor", polygon, 0.0),
+            surface("light", light, 10.0),
+        ],
+        camera: None,
+    }
+}
+
+#[test]
+fn memory_estimate_counts_the_refinement_frontier_of_a_many_sided_polygon() {
+    // A 2,000-gon becomes 2,000 coplanar fan triangles: their clusters are all too close
+    // for cluster links, so refinement expands them pair by pair (at 5,000 sides, 8.7
+    // million pairs at once, 573 MB peak where the nodes and links held 10 MiB). The
+    // nodes alone are 2 x 2,000 x about 300 bytes, 1.2 MB: a 16 MiB limit lets them
+    // through, and must stop the frontier (about 0.35 n^2 = 1.4 million pairs of at least
+    // 48 bytes, 67 MB) before it is allocated.
+    let scene = polygon_under_a_light(2_000);
+    let bvh = occluder_bvh(&scene);
+    let settings = HierarchicalSettings {
+        max_memory_bytes: Some(16 << 20),
+        ..settings(0.05, 0.05 / 16.0, false)
+    };
+    let err = solve_hierarchical(&scene, 0.05, &bvh, &settings, &NoProgress).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            radiosity::solve::SolveError::HierarchicalTooBig { limit_mib: 16, .. }
+        ),
+        "{err:?}"
+    );
+}

@@ -41,13 +41,16 @@ fn scene(lift: f64) -> Scene {
     }
 }
 
-/// A matrix with awkward f32 values (subnormal, -0, max, tiny) among ordinary ones.
+/// A matrix with awkward f32 values (subnormal, -0, the largest below 1, tiny) among
+/// ordinary ones; rows sum to about 1/4 (row 0 to about 1.25), as form factors may.
 fn matrix(n: usize) -> FormFactorMatrix {
     let mut rng = Pcg64Mcg::seed_from_u64(0x1234_5678);
-    let mut data: Vec<f32> = (0..n * n).map(|_| rng.random::<f32>() / n as f32).collect();
+    let mut data: Vec<f32> = (0..n * n)
+        .map(|_| rng.random::<f32>() / (2 * n) as f32)
+        .collect();
     data[1] = f32::MIN_POSITIVE / 8.0;
     data[2] = -0.0;
-    data[3] = f32::MAX;
+    data[3] = 1.0 - f32::EPSILON / 2.0;
     data[4] = 1e-30;
     FormFactorMatrix::from_rows(n, data)
 }
@@ -411,5 +414,65 @@ fn matrix_too_big_for_memory_is_refused() {
     };
     assert_eq!(source.n, 20);
     assert_names_file(&err, &path);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A file with valid checksums around a matrix that is not one of form factors (the forged
+/// files of issue 12): refused on reading, naming the file, the row and the value.
+fn forged(dir: &Path, n: usize, set: impl Fn(&mut [f32])) -> (PathBuf, u64) {
+    let mesh = mesh_scene(&scene(0.0), 0.5).unwrap();
+    let fp = mesh_fingerprint(&mesh);
+    let mut data = vec![0.1f32; n * n];
+    set(&mut data);
+    let path = dir.join("forged.bin");
+    write_form_factors(&path, &FormFactorMatrix::from_rows(n, data), fp, METHOD).unwrap();
+    (path, fp)
+}
+
+#[test]
+fn forged_nan_inf_and_negative_entries_are_refused_naming_the_row() {
+    let dir = temp_dir("forged-entries");
+    for (value, shown) in [(f32::NAN, "NaN"), (f32::INFINITY, "inf"), (-0.25, "-0.25")] {
+        // Row 2, column 1 (n = 4), after rows that are fine.
+        let (path, fp) = forged(&dir, 4, |d| d[2 * 4 + 1] = value);
+        let err = read_form_factors(&path, fp, Some(METHOD_VALUE)).unwrap_err();
+        let FormFactorFileError::BadEntry { row, col, .. } = &err else {
+            panic!("{value}: {err:?}");
+        };
+        assert_eq!((*row, *col), (2, 1), "{err}");
+        assert_names_file(&err, &path);
+        let text = err.to_string();
+        assert!(text.contains("row 2") && text.contains(shown), "{text}");
+    }
+    // All NaN: the first row is named.
+    let (path, fp) = forged(&dir, 3, |d| d.fill(f32::NAN));
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    assert!(
+        matches!(err, FormFactorFileError::BadEntry { row: 0, col: 0, .. }),
+        "{err:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn forged_row_sums_above_one_and_a_half_are_refused() {
+    let dir = temp_dir("forged-rowsum");
+    // n = 4: rows of 0.1 sum to 0.4; row 3 with 5,230 spread over it sums to 5,230.
+    let (path, fp) = forged(&dir, 4, |d| d[12..16].fill(5230.0 / 4.0));
+    let err = read_form_factors(&path, fp, None).unwrap_err();
+    let FormFactorFileError::RowSumTooLarge { row, sum, .. } = &err else {
+        panic!("{err:?}");
+    };
+    assert_eq!((*row, *sum), (3, 5230.0));
+    assert_names_file(&err, &path);
+    assert!(err.to_string().contains("row 3 sums to 5230"), "{err}");
+    // 1.49 is accepted (within the methods' overshoot), 1.51 is not.
+    let (path, fp) = forged(&dir, 2, |d| d.copy_from_slice(&[0.0, 1.49, 1.0, 0.0]));
+    assert!(read_form_factors(&path, fp, None).is_ok());
+    let (path, fp) = forged(&dir, 2, |d| d.copy_from_slice(&[0.0, 1.51, 1.0, 0.0]));
+    assert!(matches!(
+        read_form_factors(&path, fp, None),
+        Err(FormFactorFileError::RowSumTooLarge { row: 0, .. })
+    ));
     std::fs::remove_dir_all(&dir).unwrap();
 }

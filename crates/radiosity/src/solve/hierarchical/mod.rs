@@ -209,7 +209,8 @@ pub struct HierarchicalReport {
     pub residual: f64,
     /// Visibility segments tested.
     pub rays: u64,
-    /// Bytes held by nodes and links at the end (an estimate from their sizes).
+    /// Bytes held by nodes and links at the end, or the most held with a refinement
+    /// frontier if more (an estimate from their sizes, checked against the limit).
     pub memory_bytes: u64,
     /// Patches marked buried by contact refinement (whole cells and pieces; not among the
     /// leaves).
@@ -301,11 +302,12 @@ pub fn solve_hierarchical(
         memory_limit: settings
             .max_memory_bytes
             .unwrap_or_else(|| crate::form_factor::available_memory_bytes() / 10 * 8),
+        peak_memory: 0,
     };
     progress.message(&format!(
         "hierarchical radiosity: memory grows with the refinement, about {} bytes per node \
          and {} per link; refinement stops with an error past {} MiB",
-        std::mem::size_of::<Node>() + 28,
+        std::mem::size_of::<Node>() + 44,
         std::mem::size_of::<Link>() * 3 / 2,
         solver.memory_limit >> 20
     ));
@@ -418,7 +420,7 @@ pub fn solve_hierarchical(
     let (mesh, radiosity, leaf_ids) = export::leaves_to_mesh(&solver, scene);
     let balance = export::energy_account(&solver, &leaf_ids, &h_of);
     let links: usize = solver.nodes.iter().map(|n| n.links.len()).sum();
-    let memory_bytes = solver.memory_bytes();
+    let memory_bytes = solver.memory_bytes().max(solver.peak_memory);
     let report = HierarchicalReport {
         leaves: leaf_ids.len(),
         nodes: solver.nodes.len(),

@@ -35,7 +35,17 @@ impl Solver<'_> {
     ) -> Result<bool, SolveError> {
         let mut split = false;
         while !frontier.is_empty() {
-            let used = self.memory_bytes();
+            // What is held, and the frontier about to be expanded and estimated (checked
+            // before it is allocated).
+            let expanded: u64 = frontier
+                .iter()
+                .map(|&(p, q)| match &self.nodes[p as usize] {
+                    node if p == q && node.is_cluster() => (node.children().len() as u64).pow(2),
+                    _ => 1,
+                })
+                .sum();
+            let used = self.memory_bytes() + expanded * super::solver::FRONTIER_PAIR_BYTES;
+            self.peak_memory = self.peak_memory.max(used);
             if used > self.memory_limit {
                 return Err(SolveError::HierarchicalTooBig {
                     used_mib: used >> 20,

@@ -41,12 +41,28 @@ pub(super) struct Solver<'a> {
     pub(super) link_count: usize,
     /// Refinement stops with an error when [`Solver::memory_bytes`] passes this.
     pub(super) memory_limit: u64,
+    /// The most [`Solver::memory_bytes`] plus a refinement frontier reached.
+    pub(super) peak_memory: u64,
 }
+
+/// Bytes each pair of a refinement frontier takes while it is estimated: the pair in the
+/// frontier and in the expanded list, up to four in the next frontier (a patch splits in
+/// four), and its estimate. A frontier
+/// is transient but can dwarf what is held: the 5,000 coplanar fan triangles of a convex
+/// 5,000-gon expand into millions of too-close cluster pairs (612 MB measured where the
+/// held nodes and links took 10 MiB).
+pub(super) const FRONTIER_PAIR_BYTES: u64 =
+    (6 * std::mem::size_of::<(u32, u32)>() + std::mem::size_of::<super::link::Estimate>()) as u64;
+
+/// Bytes per node held beside the node itself: its B ([f64; 3]), its span of leaf B
+/// ((f64, f64)) and its cluster index (u32).
+const PER_NODE_BYTES: usize = 24 + 16 + 4;
 
 impl Solver<'_> {
     /// Bytes held by nodes, clusters and links (links with the slack of their vectors).
+    /// The refinement adds its frontier's [`FRONTIER_PAIR_BYTES`] per pair while it runs.
     pub(super) fn memory_bytes(&self) -> u64 {
-        (self.nodes.len() * (std::mem::size_of::<Node>() + 28)
+        (self.nodes.len() * (std::mem::size_of::<Node>() + PER_NODE_BYTES)
             + self.clusters.len()
                 * (std::mem::size_of::<Cluster>()
                     + CLUSTER_SAMPLES * std::mem::size_of::<ClusterSample>())

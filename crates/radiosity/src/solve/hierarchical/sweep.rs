@@ -216,6 +216,43 @@ impl Solver<'_> {
                 .filter(|&k| emitted[k] > 0.0)
                 .map(|k| change[k] / emitted[k])
                 .fold(0.0, f64::max);
+            // NaN is dropped by f64::max above and would read as converged: look for it.
+            if let Some((node, value)) = self
+                .b
+                .iter()
+                .enumerate()
+                .find_map(|(i, b)| b.iter().find(|x| !x.is_finite()).map(|&x| (i, x)))
+                .or_else(|| {
+                    change
+                        .iter()
+                        .find(|x| !x.is_finite())
+                        .map(|&x| (self.top as usize, x))
+                })
+            {
+                return Err(SolveError::NotFinite {
+                    solver: "hierarchical radiosity",
+                    element: node,
+                    value,
+                    after: format!("sweep {sweep}"),
+                });
+            }
+            // The power a sweep changes is at most the power in the scene, which valid
+            // links keep below emitted / (1 - rho_max); twice that leaves room for the
+            // links' own error.
+            let rho_max = self.rho.iter().flatten().fold(0.0, |m: f64, &r| m.max(r));
+            let limit = 2.0 / (1.0 - rho_max).max(1e-12);
+            if residual > limit {
+                return Err(SolveError::Diverged {
+                    solver: "hierarchical radiosity",
+                    what: "the power changed by one sweep (fraction of the emitted)",
+                    value: residual,
+                    bound: limit,
+                    reason: format!(
+                        "twice the most a scene with rho <= {rho_max} holds, 1 / (1 - rho_max)"
+                    ),
+                    after: format!("sweep {sweep}"),
+                });
+            }
             if residual <= tolerance {
                 return Ok((sweep, residual));
             }

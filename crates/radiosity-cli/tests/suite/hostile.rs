@@ -1,0 +1,282 @@
+//! Hostile input (issue 12): files and flags that once were solved to NaN, overwrote their
+//! own input or were misread, each refused with a message that says what is wrong.
+
+use std::path::Path;
+
+use radiosity::form_factor::FormFactorMatrix;
+use radiosity::io::form_factor_file::write_form_factors;
+
+use crate::fixtures::{example, radiosity, scratch_dir, stderr};
+
+/// Copies the example `name` into `dir` as `as_name`.
+fn copy_example(name: &str, dir: &Path, as_name: &str) {
+    std::fs::copy(example(name), dir.join(as_name)).unwrap();
+}
+
+#[test]
+fn an_output_that_is_an_input_is_refused_before_any_work() {
+    let dir = scratch_dir("output-is-input");
+    copy_example("triangles.scene", &dir, "x.scene");
+    let before = std::fs::read(dir.join("x.scene")).unwrap();
+    for args in [
+        vec!["solve", "x.scene", "-o", "x.scene"],
+        vec!["formfactors", "x.scene", "-o", "./x.scene"],
+        vec!["render", "x.scene", "-o", "../{dir}/x.scene"],
+    ] {
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let args: Vec<String> = args.iter().map(|a| a.replace("{dir}", &name)).collect();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = stderr(&out);
+        assert!(err.contains("is the scene file x.scene"), "{args:?}: {err}");
+        assert!(err.contains("-o FILE"), "{err}");
+        assert_eq!(
+            std::fs::read(dir.join("x.scene")).unwrap(),
+            before,
+            "{args:?}"
+        );
+    }
+    // A scene named *.png rendered without -o: the default output is its own name.
+    copy_example("triangles.scene", &dir, "y.png");
+    let out = radiosity(&["render", "y.png", "--width", "8", "--height", "8"], &dir);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("is the scene file y.png"),
+        "{}",
+        stderr(&out)
+    );
+    // Through a hard link as well.
+    std::fs::hard_link(dir.join("x.scene"), dir.join("link.csv")).unwrap();
+    let out = radiosity(&["solve", "x.scene", "-o", "link.csv"], &dir);
+    assert!(
+        stderr(&out).contains("is the scene file"),
+        "{}",
+        stderr(&out)
+    );
+    // The form-factor file read is an input too.
+    let out = radiosity(&["formfactors", "x.scene", "-o", "t.ff", "-q"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = radiosity(
+        &["solve", "x.scene", "--form-factors", "t.ff", "-o", "t.ff"],
+        &dir,
+    );
+    assert!(
+        stderr(&out).contains("is the form-factor file t.ff"),
+        "{}",
+        stderr(&out)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Rewrites the form-factor file at `path` with `data` (valid checksums, the same
+/// fingerprint and method): a forged file.
+fn forge(path: &Path, data: Vec<f32>) {
+    let bytes = std::fs::read(path).unwrap();
+    let method_len = u32::from_le_bytes(bytes[20..24].try_into().unwrap()) as usize;
+    let method = std::str::from_utf8(&bytes[24..24 + method_len])
+        .unwrap()
+        .to_string();
+    let at = 24 + method_len;
+    let fingerprint = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap());
+    let n = (data.len() as f64).sqrt() as usize;
+    let matrix = FormFactorMatrix::from_rows(n, data);
+    write_form_factors(path, &matrix, fingerprint, &method).unwrap();
+}
+
+#[test]
+fn forged_form_factor_files_are_refused_naming_file_and_row() {
+    let dir = scratch_dir("forged-ff");
+    let scene = example("triangles.scene");
+    let out = radiosity(&["formfactors", &scene, "-o", "t.ff", "-q"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bytes = std::fs::read(dir.join("t.ff")).unwrap();
+    let n = u64::from_le_bytes(bytes[12..20].try_into().unwrap()) as usize;
+    for (fill, expect) in [
+        (f32::NAN, "row 0 has F[0][0] = NaN"),
+        (f32::INFINITY, "row 0 has F[0][0] = inf"),
+        (-0.5, "row 0 has F[0][0] = -0.5"),
+        (5230.0 / n as f32, "row 0 sums to 52"),
+    ] {
+        forge(&dir.join("t.ff"), vec![fill; n * n]);
+        let out = radiosity(
+            &["solve", &scene, "--form-factors", "t.ff", "-o", "b.csv"],
+            &dir,
+        );
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{fill}: solved: {err}");
+        assert!(
+            err.contains("t.ff") && err.contains(expect),
+            "{fill}: {err}"
+        );
+        assert!(!dir.join("b.csv").exists());
+    }
+    // n = 0 with this mesh's fingerprint: named, with both sizes.
+    forge(&dir.join("t.ff"), vec![]);
+    let out = radiosity(
+        &["solve", &scene, "--form-factors", "t.ff", "-o", "b.csv"],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("form-factor file t.ff holds 0 rows")
+            && err.contains(&format!("{n} elements")),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn hierarchical_solver_warns_that_it_ignores_method() {
+    let dir = scratch_dir("hier-method");
+    let args = [
+        "check",
+        "--solver",
+        "hierarchical",
+        "--epsilon",
+        "0.5",
+        "--method",
+        "hemicube",
+        "-q",
+    ];
+    let out = radiosity(&args, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("warning: --method hemicube is ignored"),
+        "{}",
+        stderr(&out)
+    );
+    // The default method, or a dense solver, says nothing.
+    let out = radiosity(&args[..5], &dir);
+    assert!(!stderr(&out).contains("is ignored"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_eye_out_of_range_is_not_called_parallel() {
+    let dir = scratch_dir("far-eye");
+    for eye in ["1e300,0,0", "1e300,1e300,1e300", "3e12,1,1"] {
+        let out = radiosity(
+            &[
+                "render", "--eye", eye, "--width", "8", "--height", "8", "-o", "a.png",
+            ],
+            &dir,
+        );
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{eye}");
+        assert!(
+            err.contains("--eye") && err.contains("out of range"),
+            "{eye}: {err}"
+        );
+        assert!(!err.contains("parallel"), "{eye}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn work_past_the_limit_is_refused_before_it_starts_with_what_fits() {
+    let dir = scratch_dir("work-limit");
+    let scene = example("triangles.scene");
+    // A few elements (one a surface, and the pieces where they touch): 21 pairs x 1000^4
+    // point pairs, weeks of work.
+    let out = radiosity(
+        &[
+            "formfactors",
+            &scene,
+            "--max-area",
+            "100",
+            "--steps",
+            "1000",
+            "-o",
+            "t.ff",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("INTEGRAL_STEPS 1000 on 7 elements"), "{err}");
+    assert!(err.contains("at most INTEGRAL_STEPS"), "{err}");
+    assert!(err.contains("--no-work-limit"), "{err}");
+    assert!(!dir.join("t.ff").exists());
+    for (args, expect) in [
+        (
+            vec![
+                "solve",
+                &scene,
+                "--method",
+                "montecarlo",
+                "--samples",
+                "4294967295",
+            ],
+            "--samples 4294967295",
+        ),
+        (
+            vec![
+                "solve",
+                &scene,
+                "--method",
+                "hemicube",
+                "--resolution",
+                "16384",
+            ],
+            "--resolution 16384",
+        ),
+        (
+            vec![
+                "render",
+                "--supersample",
+                "16",
+                "--width",
+                "10000",
+                "--height",
+                "10000",
+            ],
+            "--supersample 16",
+        ),
+        (
+            vec![
+                "pathtrace",
+                "--paths",
+                "100000",
+                "--width",
+                "4000",
+                "--height",
+                "4000",
+            ],
+            "--paths 100000",
+        ),
+    ] {
+        let mut args = args.clone();
+        args.extend(["-o", "out.png"]);
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{args:?}: {err}");
+        assert!(
+            err.contains(expect) && err.contains("would fit"),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn memory_budget_honours_ulimit_v() {
+    // Under a 1 GiB address-space limit a 3 GiB hemicube is refused with the sizes, not
+    // aborted by a failed allocation (which MemAvailable alone would not foresee).
+    let dir = scratch_dir("ulimit-v");
+    let bin = env!("CARGO_BIN_EXE_radiosity");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 1048576 && exec '{bin}' formfactors --method hemicube --resolution 8192 -o t.ff"
+        ))
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("MiB of memory is available"), "{err}");
+    assert!(err.contains("at most --resolution"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
