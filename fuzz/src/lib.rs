@@ -1,0 +1,224 @@
+//! The fuzz targets' bodies, one function per reader, and the bounds they put on the work
+//! after a successful read (see `fuzz/README.md`, "Harness bounds").
+//!
+//! A target fails only by panicking or aborting: a clean error from a reader, the mesher or
+//! a solver is a correct answer to hostile input.
+
+use std::path::PathBuf;
+use std::sync::{Once, OnceLock};
+
+use radiosity::form_factor::FormFactorMethod;
+use radiosity::geometry;
+use radiosity::io::form_factor_file::read_form_factors;
+use radiosity::io::scene_file::{parse_scene, read_scene, write_scene};
+use radiosity::progress::NoProgress;
+use radiosity::scene::Scene;
+use radiosity::solve::keep_going;
+use radiosity::{pipeline, shade, MeshSettings, Prepared, SolveRequest, Solver};
+
+/// Harness bound: after a successful parse, `MAX_PATCH_AREA` is raised so that the mesh has
+/// about this many elements by area (the program's own limit is `mesh::MAX_ELEMENTS`, 8
+/// million, seconds of work per input).
+pub const MESH_ELEMENTS: f64 = 200.0;
+
+/// Harness bound: form factors and a Gauss-Seidel solve run on meshes of at most this many
+/// elements ...
+pub const SOLVE_ELEMENTS: usize = 24;
+
+/// ... with `INTEGRAL_STEPS` lowered to at most this.
+pub const SOLVE_STEPS: u32 = 3;
+
+/// Harness bound for a known issue (#12: obvhs panics building the occluder BVH of scenes
+/// with coordinates of 1e20 and more): scenes with a coordinate larger than this in
+/// magnitude are parsed, written and parsed again, but not meshed.
+pub const MAX_COORDINATE: f64 = 1e12;
+
+/// Harness bound for a known issue (#12: box faces skip the polygon checks, so a box of
+/// thickness 1e-200 plans a grid of 4.3e9 vertices or makes NaN elements): scenes with an
+/// edge shorter than this fraction of the scene's extent, or a surface whose area is less
+/// than its square times the extent squared, are not meshed.
+pub const MIN_RELATIVE_EDGE: f64 = 1e-6;
+
+/// Sets up what every target shares: one rayon thread (fuzzing takes one core; a second
+/// thread would only add noise to coverage).
+fn init() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(1).build_global();
+    });
+}
+
+/// A file of this process's own for the readers that take a path: in /dev/shm where there
+/// is one (no disk traffic), else the temporary directory.
+fn scratch_file(name: &str) -> PathBuf {
+    let dir = if std::path::Path::new("/dev/shm").is_dir() {
+        PathBuf::from("/dev/shm")
+    } else {
+        std::env::temp_dir()
+    };
+    dir.join(format!("radiosity-fuzz-{}-{name}", std::process::id()))
+}
+
+/// The scene reader on arbitrary bytes, then what a user runs next on a small scene.
+///
+/// Bytes that are not UTF-8 go through [`read_scene`] (via a file), which must refuse them
+/// with the line of the first bad byte; text goes to [`parse_scene`]. Every error must format.
+/// A scene that parses is written back and must parse again (the writer's output is the
+/// reader's input), then, within the bounds above, is meshed, and small meshes get form
+/// factors, a Gauss-Seidel solve and vertex shading.
+pub fn scene_file(data: &[u8]) {
+    init();
+    let text = match std::str::from_utf8(data) {
+        Ok(text) => text,
+        Err(_) => {
+            let path = scratch_file("scene");
+            std::fs::write(&path, data).expect("writing the scratch file");
+            let result = read_scene(&path);
+            let _ = std::fs::remove_file(&path);
+            let error = result.expect_err("bytes that are not UTF-8 must be refused");
+            assert!(!error.to_string().is_empty());
+            return;
+        }
+    };
+    let file = match parse_scene(text, "fuzz.scene") {
+        Ok(file) => file,
+        Err(error) => {
+            assert!(!error.errors.is_empty(), "an error without a message");
+            let _ = error.to_string();
+            return;
+        }
+    };
+
+    // The writer's output must read back.
+    let mut written = Vec::new();
+    write_scene(&file.scene, file.settings, &mut written).expect("writing to memory");
+    let written = String::from_utf8(written).expect("the writer writes UTF-8");
+    if let Err(e) = parse_scene(&written, "written.scene") {
+        panic!("a parsed scene, written back, does not parse again: {e}\n--- written:\n{written}");
+    }
+
+    if !within_known_issue_bounds(&file.scene) {
+        return;
+    }
+    let total_area: f64 = file
+        .scene
+        .surfaces
+        .iter()
+        .map(|s| geometry::polygon_area(&s.vertices))
+        .sum();
+    let settings = MeshSettings {
+        max_patch_area: file.settings.max_patch_area.max(total_area / MESH_ELEMENTS),
+        integral_steps: file.settings.integral_steps,
+    };
+    let Ok(mut prepared) = Prepared::new(file.scene, settings, &NoProgress) else {
+        return;
+    };
+    if prepared.mesh.len() > SOLVE_ELEMENTS {
+        return;
+    }
+    prepared.method = FormFactorMethod::AreaIntegral {
+        steps: settings.integral_steps.min(SOLVE_STEPS),
+    };
+    if prepared.check_memory(Some(&Solver::DEFAULT_GAUSS_SEIDEL)).is_err() {
+        return;
+    }
+    let request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
+    if let Ok(solution) = pipeline::solve(&prepared, &request, &mut keep_going, &NoProgress) {
+        let b = solution.element_rgb();
+        let _ = shade::vertex_radiosity(&solution.mesh, b);
+    }
+}
+
+/// False for the scenes in the two known issues that [`MAX_COORDINATE`] and
+/// [`MIN_RELATIVE_EDGE`] describe.
+fn within_known_issue_bounds(scene: &Scene) -> bool {
+    let points = || scene.surfaces.iter().flat_map(|s| s.vertices.iter());
+    if points().any(|p| !(p.abs().max_element() <= MAX_COORDINATE)) {
+        return false;
+    }
+    let (lo, hi) = scene.bounds();
+    let extent = (hi - lo).max_element();
+    if !(extent > 0.0) {
+        return false;
+    }
+    let min_edge = MIN_RELATIVE_EDGE * extent;
+    scene.surfaces.iter().all(|s| {
+        let n = s.vertices.len();
+        let edges_ok = (0..n).all(|i| (s.vertices[(i + 1) % n] - s.vertices[i]).length() >= min_edge);
+        edges_ok && geometry::polygon_area(&s.vertices) >= min_edge * min_edge
+    })
+}
+
+/// The scene every form-factor input is read against: two facing unit squares, one
+/// element each, and a floor of two (four elements in all), with its fingerprint and method.
+pub const FORM_FACTOR_SCENE: &str = "MAX_PATCH_AREA 0.5
+INTEGRAL_STEPS 2
+SCENEBEGIN
+PATCHBEGIN
+#Floor
+VERTICES 4
+Er 0
+Eg 0
+Eb 0
+Rr 0.5
+Rg 0.5
+Rb 0.5
+VERTEX0 0 0 0
+VERTEX1 1 0 0
+VERTEX2 1 0 -1
+VERTEX3 0 0 -1
+PATCHEND
+PATCHBEGIN
+#Light
+VERTICES 4
+Er 1
+Eg 1
+Eb 1
+Rr 0
+Rg 0
+Rb 0
+VERTEX0 0 1 0
+VERTEX1 0 1 -1
+VERTEX2 1 1 -1
+VERTEX3 1 1 0
+PATCHEND
+SCENEEND
+";
+
+/// The prepared [`FORM_FACTOR_SCENE`] (meshed once per process).
+pub fn form_factor_scene() -> &'static Prepared {
+    static PREPARED: OnceLock<Prepared> = OnceLock::new();
+    PREPARED.get_or_init(|| {
+        init();
+        let file = parse_scene(FORM_FACTOR_SCENE, "form_factor_scene").expect("the scene parses");
+        Prepared::new(file.scene, file.settings, &NoProgress).expect("the scene meshes")
+    })
+}
+
+/// The form-factor reader on arbitrary bytes (written to a file: the reader takes a path),
+/// read against [`form_factor_scene`]'s fingerprint and method as `solve --form-factors`
+/// does. A matrix that is accepted is solved as the command would, with Gauss-Seidel.
+pub fn form_factor_file(data: &[u8]) {
+    let prepared = form_factor_scene();
+    let path = scratch_file("ff");
+    std::fs::write(&path, data).expect("writing the scratch file");
+    let result = read_form_factors(&path, prepared.fingerprint(), Some(prepared.method()));
+    let _ = std::fs::remove_file(&path);
+    let matrix = match result {
+        Ok(matrix) => matrix,
+        Err(error) => {
+            let message = error.to_string();
+            assert!(
+                message.contains(path.to_str().unwrap()),
+                "the message does not name the file: {message}"
+            );
+            return;
+        }
+    };
+    assert_eq!(matrix.n(), prepared.mesh.len(), "a matrix for another mesh was accepted");
+    let _ = matrix.row_sums();
+    let _ = matrix.reciprocity(&prepared.areas());
+    let mut request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
+    request.form_factors = pipeline::FormFactors::Matrix(&matrix);
+    let _ = pipeline::solve(prepared, &request, &mut keep_going, &NoProgress);
+}
