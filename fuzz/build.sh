@@ -14,4 +14,4 @@ export RUSTFLAGS="${RUSTFLAGS:-} -Cpasses=sancov-module \
  -Cllvm-args=-sanitizer-coverage-trace-compares \
  --cfg fuzzing -Cdebug-assertions -Coverflow-checks"
 host=$(rustc -vV | sed -n "s/^host: //p")
-exec cargo build --release --target "$host" "$@"
+exec cargo build --release --locked --target "$host" "$@"
