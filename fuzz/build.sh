@@ -4,7 +4,9 @@
 # cargo build (for instance --bin scene_file). The binaries land in
 # $CARGO_TARGET_DIR (default fuzz/target)/HOST/release/, HOST being the host triple: naming the
 # target keeps RUSTFLAGS off the build scripts and proc macros, which would not link with
-# the coverage hooks (libFuzzer provides them only to the fuzz binaries).
+# the coverage hooks (libFuzzer provides them only to the fuzz binaries). Not --locked: the
+# committed Cargo.lock pins every version, and a dependency the library gains later is added
+# to it rather than failing CI's fuzz build (pass --locked to refuse that).
 set -euo pipefail
 cd "$(dirname "$0")"
 export RUSTFLAGS="${RUSTFLAGS:-} -Cpasses=sancov-module \
@@ -14,4 +16,4 @@ export RUSTFLAGS="${RUSTFLAGS:-} -Cpasses=sancov-module \
  -Cllvm-args=-sanitizer-coverage-trace-compares \
  --cfg fuzzing -Cdebug-assertions -Coverflow-checks"
 host=$(rustc -vV | sed -n "s/^host: //p")
-exec cargo build --release --locked --target "$host" "$@"
+exec cargo build --release --target "$host" "$@"
