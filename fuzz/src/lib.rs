@@ -234,7 +234,39 @@ pub fn form_factor_scene() -> &'static Prepared {
 /// read against [`form_factor_scene`]'s fingerprint and method as `solve --form-factors`
 /// does. Every refusal must name the file. A matrix that is accepted is solved as the command
 /// would, with Gauss-Seidel.
+///
+/// The bytes are read twice: as they are, and, where they are long enough to hold both
+/// checksums, with the header and file CRC-32s recomputed ([`with_checksums_fixed`]), so that
+/// mutations of n, the method, the fingerprint and the matrix reach the checks behind the
+/// checksums (a forged file, as #12 describes, has valid CRCs).
 pub fn form_factor_file(data: &[u8]) {
+    read_and_solve(data);
+    if let Some(fixed) = with_checksums_fixed(data) {
+        if fixed != data {
+            read_and_solve(&fixed);
+        }
+    }
+}
+
+/// `data` with the header checksum (at 32 + L, over the bytes before it) and the final
+/// checksum (the last 4 bytes, over all before them) recomputed, as the writer computes them;
+/// `None` when `data` is too short to hold the header (L from bytes 20..24) and a final CRC.
+pub fn with_checksums_fixed(data: &[u8]) -> Option<Vec<u8>> {
+    let method_len = u32::from_le_bytes(data.get(20..24)?.try_into().ok()?) as usize;
+    let header_crc_at = 32usize.checked_add(method_len)?;
+    let final_crc_at = data.len().checked_sub(4)?;
+    if header_crc_at + 4 > final_crc_at {
+        return None;
+    }
+    let mut fixed = data.to_vec();
+    let header_crc = crc32fast::hash(&fixed[..header_crc_at]);
+    fixed[header_crc_at..header_crc_at + 4].copy_from_slice(&header_crc.to_le_bytes());
+    let final_crc = crc32fast::hash(&fixed[..final_crc_at]);
+    fixed[final_crc_at..].copy_from_slice(&final_crc.to_le_bytes());
+    Some(fixed)
+}
+
+fn read_and_solve(data: &[u8]) {
     let prepared = form_factor_scene();
     let path = scratch_file("ff");
     std::fs::write(&path, data).expect("writing the scratch file");
