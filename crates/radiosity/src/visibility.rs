@@ -10,6 +10,13 @@
 //! between them, and form-factor sample points lie on such diagonals by symmetry), so the
 //! leaf test here is written by hand: the ray meets the polygon's plane in f64, and the
 //! point is inside when it is on the inner side of every edge (edges included).
+//!
+//! The hierarchy is in f32 and obvhs has absolute constants (a ray skips the boxes it leaves
+//! within 1e-4 of its origin), so it is built in its own units: scene coordinates times a
+//! power of two that makes the scene's diagonal 1024 to 2048 units long. Scaling by a power
+//! of two is exact, so the hierarchy and every answer are the same at any scale (a scene in
+//! metres or in light years, within [`crate::geometry::MAX_COORDINATE`]), and no f32 box
+//! area overflows or underflows. The leaf tests stay in scene units, in f64.
 
 use std::time::Duration;
 
@@ -62,6 +69,8 @@ pub struct PolygonBvh {
     edge_planes: Vec<(DVec3, f64)>,
     /// Length of the bounding-box diagonal of all polygons, for relative tolerances.
     scale: f64,
+    /// The power of two that takes scene units to the hierarchy's (module documentation).
+    to_local: f64,
 }
 
 /// The first thing a ray hits.
@@ -92,15 +101,23 @@ impl PolygonBvh {
         } else {
             (hi - lo).length().max(f64::MIN_POSITIVE)
         };
+        let to_local = local_unit(scale);
         // Pad boxes so that flat, axis-aligned polygons get boxes of non-zero thickness and
         // the f32, quantised node boxes of the CWBVH cannot make a ray miss a polygon it
         // meets. With 1e-6 of the scene size, one Monte Carlo ray in 10^5 leaked out of a
-        // closed cube near a corner; 1e-5 closes the leak.
-        let pad = (1e-5 * scale) as f32;
+        // closed cube near a corner; 1e-5 closes the leak. A scene far from the origin
+        // (a room at x = 1e6) needs more: f32 rounds a coordinate by up to 2^-24 of its
+        // size, so the pad is also 2^-20 (16 such roundings) of the largest coordinate.
+        let largest = if polygons.is_empty() {
+            0.0
+        } else {
+            lo.abs().max(hi.abs()).max_element()
+        };
+        let pad = ((1e-5 * scale).max(largest * 2f64.powi(-20)) * to_local) as f32;
         let bounds: Vec<Bounds> = polygons
             .iter()
             .map(|p| {
-                let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| to_f32(*v)).collect();
+                let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| to_f32(*v * to_local)).collect();
                 let b = Aabb::from_points(&pts);
                 Bounds(Aabb::new(
                     b.min - Vec3A::splat(pad),
@@ -142,6 +159,7 @@ impl PolygonBvh {
                 corners,
                 edge_planes,
                 scale,
+                to_local,
             };
         }
         let bvh = build_cwbvh(
@@ -160,6 +178,7 @@ impl PolygonBvh {
             corners,
             edge_planes,
             scale,
+            to_local,
         }
     }
 
@@ -241,8 +260,8 @@ impl PolygonBvh {
         }
         let pad = 1e-6 * self.scale;
         let query = Aabb::new(
-            to_f32(lo - DVec3::splat(pad)),
-            to_f32(hi + DVec3::splat(pad)),
+            to_f32((lo - DVec3::splat(pad)) * self.to_local),
+            to_f32((hi + DVec3::splat(pad)) * self.to_local),
         );
         let bvh = &self.bvh;
         let mut state = bvh.new_traversal(Vec3A::ZERO);
@@ -307,10 +326,16 @@ impl PolygonBvh {
             return false;
         }
         let dir = d / len;
-        let ray = Ray::new(to_f32(p), to_f32(dir), 0.0, len as f32 * 1.001 + eps as f32);
+        let to_local = self.to_local;
+        let ray = Ray::new(
+            to_f32(p * to_local),
+            to_f32(dir),
+            0.0,
+            ((len * 1.001 + eps) * to_local) as f32,
+        );
         !self.bvh.ray_traverse_miss(ray, |_, k| {
             match self.intersect(k, p, dir, eps, len - eps) {
-                Some(t) => t as f32,
+                Some(t) => (t * to_local) as f32,
                 None => f32::INFINITY,
             }
         })
@@ -345,7 +370,13 @@ impl PolygonBvh {
         if self.polygons.is_empty() {
             return None;
         }
-        let ray = Ray::new(to_f32(origin), to_f32(dir), 0.0, t_max as f32 * 1.001);
+        let to_local = self.to_local;
+        let ray = Ray::new(
+            to_f32(origin * to_local),
+            to_f32(dir),
+            0.0,
+            (t_max * 1.001 * to_local) as f32,
+        );
         let mut hit = RayHit::none();
         let mut best: Option<(f64, u32)> = None;
         self.bvh.ray_traverse(ray, &mut hit, |_, k| {
@@ -355,12 +386,27 @@ impl PolygonBvh {
                     best = Some((t, self.polygons[k].id));
                     // Report a t just inside the f32 ray's range so the traversal keeps
                     // shrinking its interval; the exact t is kept in f64 in `best`.
-                    t as f32
+                    (t * to_local) as f32
                 }
                 None => f32::INFINITY,
             }
         });
         best.map(|(t, id)| Hit { t, id })
+    }
+}
+
+/// The power of two that makes a scene of diagonal `scale` 1024 to 2048 of the hierarchy's
+/// units long (module documentation).
+fn local_unit(scale: f64) -> f64 {
+    let e = (1024.0 / scale).log2().floor().clamp(-1000.0, 1000.0) as i32;
+    let unit = 2f64.powi(e);
+    // log2 may round either way; one step fixes it.
+    if scale * unit < 1024.0 {
+        2.0 * unit
+    } else if scale * unit >= 2048.0 {
+        0.5 * unit
+    } else {
+        unit
     }
 }
 

@@ -2,6 +2,7 @@
 //! primitive, and robustness against garbled input.
 
 use super::*;
+use glam::dvec3;
 use crate::geometry;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
