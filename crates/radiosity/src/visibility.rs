@@ -347,9 +347,9 @@ impl PolygonBvh {
     /// a shared edge, overlapping polygons), the first in BVH order.
     ///
     /// A box query and the inside test, not a ray: obvhs's ray traversal skips every box
-    /// that a ray leaves within 1e-4 of its origin (an absolute distance, its `EPSILON`,
-    /// which stands in for the ray's own t_min), so a short ray through a point on a
-    /// polygon finds nothing in a scene in metres.
+    /// that a ray leaves within 1e-4 of its origin (an absolute distance in the hierarchy's
+    /// units, its `EPSILON`, which stands in for the ray's own t_min; about 1e-7 of the
+    /// scene's diagonal), so a short enough ray through a point on a polygon finds nothing.
     pub fn polygon_at(&self, p: DVec3, tolerance: f64) -> Option<u32> {
         let mut candidates = Vec::new();
         self.overlapping(
@@ -479,11 +479,18 @@ mod tests {
         assert_eq!(bvh.polygon_at(dvec3(1.5, 0.5, 1.0), 1e-6), None);
         // An edge belongs to the square.
         assert_eq!(bvh.polygon_at(dvec3(1.0, 0.5, 1.0), 1e-6), Some(1));
-        // What polygon_at replaces: a ray this short finds nothing, since obvhs skips the
-        // boxes a ray leaves within 1e-4 of its origin. If this starts to pass, obvhs has
-        // changed and the note at polygon_at can go.
+        // What polygon_at replaces: obvhs skips the boxes a ray leaves within 1e-4 of its
+        // origin, in the hierarchy's units (the diagonal, sqrt(2 + 1e-6), is 2^10 = 1024 of
+        // them: a square far from these units would see the same). A ray of 2e-6 scene
+        // units (2e-3 units of the hierarchy) finds the square; one of 2e-8 (2e-5 units,
+        // below 1e-4) finds nothing. If the second starts to pass, obvhs has changed and the
+        // note at polygon_at can go.
         assert_eq!(
-            bvh.closest_hit(p + 1e-6 * DVec3::Z, -DVec3::Z, 0.0, 2e-6),
+            bvh.closest_hit(p + 1e-6 * DVec3::Z, -DVec3::Z, 0.0, 2e-6).map(|h| h.id),
+            Some(1)
+        );
+        assert_eq!(
+            bvh.closest_hit(p + 1e-8 * DVec3::Z, -DVec3::Z, 0.0, 2e-8),
             None
         );
     }
