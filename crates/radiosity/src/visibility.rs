@@ -12,11 +12,13 @@
 //! point is inside when it is on the inner side of every edge (edges included).
 //!
 //! The hierarchy is in f32 and obvhs has absolute constants (a ray skips the boxes it leaves
-//! within 1e-4 of its origin), so it is built in its own units: scene coordinates times a
-//! power of two that makes the scene's diagonal 1024 to 2048 units long. Scaling by a power
-//! of two is exact, so the hierarchy and every answer are the same at any scale (a scene in
-//! metres or in light years, within [`crate::geometry::MAX_COORDINATE`]), and no f32 box
-//! area overflows or underflows. The leaf tests stay in scene units, in f64.
+//! within 1e-4 of its origin), so it is built in its own units: scene coordinates less the
+//! centre of the scene's bounding box, times a power of two that makes the scene's diagonal
+//! 1024 to 2048 units long. Scaling by a power of two is exact, so the hierarchy and every
+//! answer are the same at any scale (a scene in metres or in light years, within
+//! [`crate::geometry::MAX_COORDINATE`]), no f32 box area overflows or underflows, and a scene
+//! far from the origin (a room at x = 1e9) keeps f32's precision. The leaf tests stay in
+//! scene units, in f64.
 
 use std::time::Duration;
 
@@ -69,7 +71,9 @@ pub struct PolygonBvh {
     edge_planes: Vec<(DVec3, f64)>,
     /// Length of the bounding-box diagonal of all polygons, for relative tolerances.
     scale: f64,
-    /// The power of two that takes scene units to the hierarchy's (module documentation).
+    /// The centre of the scene's bounding box and the power of two that take scene units to
+    /// the hierarchy's (module documentation).
+    centre: DVec3,
     to_local: f64,
 }
 
@@ -102,22 +106,23 @@ impl PolygonBvh {
             (hi - lo).length().max(f64::MIN_POSITIVE)
         };
         let to_local = local_unit(scale);
+        let centre = if polygons.is_empty() {
+            DVec3::ZERO
+        } else {
+            0.5 * lo + 0.5 * hi
+        };
+        let local = |v: DVec3| to_f32((v - centre) * to_local);
         // Pad boxes so that flat, axis-aligned polygons get boxes of non-zero thickness and
         // the f32, quantised node boxes of the CWBVH cannot make a ray miss a polygon it
         // meets. With 1e-6 of the scene size, one Monte Carlo ray in 10^5 leaked out of a
-        // closed cube near a corner; 1e-5 closes the leak. A scene far from the origin
-        // (a room at x = 1e6) needs more: f32 rounds a coordinate by up to 2^-24 of its
-        // size, so the pad is also 2^-20 (16 such roundings) of the largest coordinate.
-        let largest = if polygons.is_empty() {
-            0.0
-        } else {
-            lo.abs().max(hi.abs()).max_element()
-        };
-        let pad = ((1e-5 * scale).max(largest * 2f64.powi(-20)) * to_local) as f32;
+        // closed cube near a corner; 1e-5 closes the leak (f32 rounds the hierarchy's
+        // coordinates, at most 2048 from its centre, by 1.2e-4 units at most: well inside
+        // the pad, at least 1e-2 units).
+        let pad = (1e-5 * scale * to_local) as f32;
         let bounds: Vec<Bounds> = polygons
             .iter()
             .map(|p| {
-                let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| to_f32(*v * to_local)).collect();
+                let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| local(*v)).collect();
                 let b = Aabb::from_points(&pts);
                 Bounds(Aabb::new(
                     b.min - Vec3A::splat(pad),
@@ -159,6 +164,7 @@ impl PolygonBvh {
                 corners,
                 edge_planes,
                 scale,
+                centre,
                 to_local,
             };
         }
@@ -178,6 +184,7 @@ impl PolygonBvh {
             corners,
             edge_planes,
             scale,
+            centre,
             to_local,
         }
     }
@@ -202,6 +209,11 @@ impl PolygonBvh {
             .collect();
         let ids: Vec<u32> = (0..polygons.len() as u32).collect();
         PolygonBvh::new(&polygons, &ids)
+    }
+
+    /// A scene point in the hierarchy's units (module documentation).
+    fn local(&self, v: DVec3) -> Vec3A {
+        to_f32((v - self.centre) * self.to_local)
     }
 
     /// The number of polygons.
@@ -260,8 +272,8 @@ impl PolygonBvh {
         }
         let pad = 1e-6 * self.scale;
         let query = Aabb::new(
-            to_f32((lo - DVec3::splat(pad)) * self.to_local),
-            to_f32((hi + DVec3::splat(pad)) * self.to_local),
+            self.local(lo - DVec3::splat(pad)),
+            self.local(hi + DVec3::splat(pad)),
         );
         let bvh = &self.bvh;
         let mut state = bvh.new_traversal(Vec3A::ZERO);
@@ -328,7 +340,7 @@ impl PolygonBvh {
         let dir = d / len;
         let to_local = self.to_local;
         let ray = Ray::new(
-            to_f32(p * to_local),
+            self.local(p),
             to_f32(dir),
             0.0,
             ((len * 1.001 + eps) * to_local) as f32,
@@ -372,7 +384,7 @@ impl PolygonBvh {
         }
         let to_local = self.to_local;
         let ray = Ray::new(
-            to_f32(origin * to_local),
+            self.local(origin),
             to_f32(dir),
             0.0,
             (t_max * 1.001 * to_local) as f32,

@@ -127,8 +127,10 @@ pub enum MeshError {
     },
     /// The subdivision would make more elements than the limit.
     #[error(
-        "meshing with MAX_PATCH_AREA = {max_area} would make {count} elements, more than the \
-         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.3e}"
+        "meshing with MAX_PATCH_AREA = {} would make {} elements, more than the \
+         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.3e}",
+        compact(*max_area),
+        if *count == u64::MAX { "more than 1.8e19".to_string() } else { count.to_string() }
     )]
     TooManyElements {
         /// The requested maximum element area.
@@ -140,6 +142,16 @@ pub enum MeshError {
         /// A maximum area that would stay within the limit.
         suggested: f64,
     },
+}
+
+/// `x` as Rust writes it where that is short (1e-4 to 1e15 in magnitude, or 0), else with
+/// an exponent: a MAX_PATCH_AREA of 1e-300 is not three hundred zeros.
+fn compact(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// The most elements [`mesh_scene`] will make: about 1.2 GB of mesh (112 bytes per element

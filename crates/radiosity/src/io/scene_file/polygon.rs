@@ -58,7 +58,8 @@ pub(super) fn message(e: &PolygonError) -> String {
 pub(super) fn box_face_message(face: &str, e: &PolygonError) -> String {
     let why = match *e {
         PolygonError::RepeatedVertex { .. } => "two of its corners are the same point: a size \
-             is too small to register beside the box's coordinates"
+             is too small to register beside the box's coordinates or its other sizes (less \
+             than a billionth of them)"
             .to_string(),
         PolygonError::ZeroArea => {
             "its area is zero: one size is less than a billionth of another".to_string()
