@@ -14,6 +14,10 @@ use crate::mesh::MeshSettings;
 use crate::scene::shape::{self, Facing};
 use crate::scene::{Scene, Surface};
 
+/// Two surfaces in one plane are the same surface given twice when one covers all but this
+/// fraction of the larger's area (module [`Parser::duplicates`]).
+const DUPLICATE_TOLERANCE: f64 = 1e-6;
+
 /// After this many errors the reader stops looking for more.
 const MAX_ERRORS: usize = 100;
 
@@ -115,9 +119,14 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneErro
         pos: 0,
         eof,
         errors: Vec::new(),
+        surface_lines: Vec::new(),
+        block_line: (0, 0),
     };
     let settings = parser.header();
     let surfaces = parser.body();
+    if parser.errors.is_empty() {
+        parser.duplicates(&surfaces);
+    }
     match settings {
         Some(settings) if parser.errors.is_empty() => Ok(SceneFile {
             settings,
@@ -145,6 +154,11 @@ struct Parser<'a> {
     pos: usize,
     eof: (usize, usize),
     errors: Vec<ParseError>,
+    /// Where each surface read so far was given (its `VERTEX0` line, or its box's `SIZE` or
+    /// `HEIGHT` line), for problems between surfaces.
+    surface_lines: Vec<(usize, usize)>,
+    /// The line of the block read last.
+    block_line: (usize, usize),
 }
 
 /// A patch or box block's name and colours.
@@ -424,10 +438,12 @@ impl<'a> Parser<'a> {
                 Some(Keyword::PatchBegin) => {
                     blocks += 1;
                     surfaces.extend(self.patch());
+                    self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
                 Some(Keyword::BoxBegin) => {
                     blocks += 1;
                     surfaces.extend(self.box_block().into_iter().flatten());
+                    self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
                 Some(Keyword::SceneEnd) => {
                     self.scene_end(blocks);
@@ -439,6 +455,41 @@ impl<'a> Parser<'a> {
                     self.stray_line();
                 }
             }
+        }
+    }
+
+    /// Reports every surface that lies in the plane of another, facing the same way, and
+    /// covers all of it while being no larger: the same surface given twice (a second floor
+    /// quad on the floor). A surface on part of another (a rug on a floor, in its plane or
+    /// above it) is a model the mesher handles ([`crate::scene::lying_on`]: the covered
+    /// part is left out); a duplicate leaves nothing of the lower one and is a mistake.
+    fn duplicates(&mut self, surfaces: &[Surface]) {
+        if surfaces.len() < 2 {
+            return;
+        }
+        let scene = Scene {
+            surfaces: surfaces.to_vec(),
+            camera: None,
+        };
+        let bvh = crate::visibility::PolygonBvh::over_surfaces(&scene);
+        for o in crate::scene::lying_on(&scene, &bvh) {
+            let (lower, upper) = (o.lower as usize, o.upper as usize);
+            let area = |s: usize| geometry::polygon_area(&surfaces[s].vertices);
+            // Covering the whole of the lower surface and no larger than it, to 1e-6 (six
+            // significant digits, as scene files are often written).
+            let whole = (1.0 - DUPLICATE_TOLERANCE) * area(lower).max(area(upper));
+            if !o.same_plane(bvh.scale()) || o.covered_area < whole {
+                continue;
+            }
+            let (line, column) = self.surface_lines[upper];
+            let (lower_line, _) = self.surface_lines[lower];
+            let msg = format!(
+                "surface \"{}\" lies exactly on surface \"{}\" (line {lower_line}): the same \
+                 polygon facing the same way, given twice; remove one (a surface lying on \
+                 another must cover only part of it, like a rug on a floor)",
+                surfaces[upper].name, surfaces[lower].name
+            );
+            self.error(line, column, msg);
         }
     }
 
@@ -554,6 +605,7 @@ impl<'a> Parser<'a> {
             let head = p.colours(name)?;
             Ok((head, p.vertex_lines(count)?))
         })?;
+        self.block_line = (corners.line, corners.column);
         self.check_polygon(&mut corners)?;
         Some(Surface {
             name: head.name,
@@ -697,6 +749,7 @@ impl<'a> Parser<'a> {
                 (quad, height, line, column)
             }
         };
+        self.block_line = (line, column);
         // Each face passes the polygon checks, as a patch would: a box too thin for its
         // position or its other sizes, too small, or too large is refused here, not met by
         // the mesher as a face of zero area.
