@@ -80,6 +80,9 @@ pub mod shade;
 pub mod solve;
 pub mod visibility;
 
+#[cfg(test)]
+mod scale_tests;
+
 /// The solution writer's module at the path the command line uses; it lives in
 /// [`io::solution`].
 pub use io::solution;
