@@ -7,8 +7,8 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use glam::DVec3;
 use radiosity::form_factor::FormFactorMethod;
-use radiosity::mesh::AdaptSettings;
-use radiosity::pipeline::{Overrides, Prepared};
+use radiosity::mesh::{AdaptSettings, MeshError};
+use radiosity::pipeline::{Overrides, PipelineError, Prepared};
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{Camera, RenderSettings, Shading};
 use radiosity::scene::{self, Scene, SceneFile};
@@ -96,7 +96,14 @@ fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, Str
         }
     }
     let settings = overrides.apply(file.settings);
-    let mut prepared = Prepared::new(file.scene, settings, reporter)?;
+    let mut prepared =
+        Prepared::new(file.scene, settings, reporter).map_err(|e| match e {
+            // Say where the MAX_PATCH_AREA that cannot be met came from.
+            PipelineError::Mesh(
+                MeshError::TooManyElements { .. } | MeshError::BadElementArea { .. },
+            ) => anyhow::Error::new(e).context(max_area_origin(args)),
+            e => e.into(),
+        })?;
     let m = &args.method;
     let steps = prepared.settings.integral_steps;
     prepared.method = match m.method {
@@ -125,6 +132,31 @@ fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, Str
         }
     };
     Ok((prepared, stem))
+}
+
+/// Where the MAX_PATCH_AREA in force came from: `--max-area`, the scene file's line
+/// (`room.scene:1: MAX_PATCH_AREA 0.001`), or the built-in box.
+fn max_area_origin(args: &SceneArgs) -> String {
+    if let Some(a) = args.max_area {
+        return format!("--max-area {a}");
+    }
+    let Some(path) = args.scene.as_deref() else {
+        return "the built-in Cornell box's MAX_PATCH_AREA".to_string();
+    };
+    // The first line that starts with the keyword (the reader has accepted the file, so it
+    // is there, in its place before SCENEBEGIN).
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let line = text.lines().enumerate().find_map(|(i, l)| {
+        let code = l.split("//").next().unwrap_or("").trim_start_matches('\u{feff}');
+        let mut words = code.split_whitespace();
+        let head = words.next()?;
+        head.eq_ignore_ascii_case("MAX_PATCH_AREA")
+            .then(|| (i + 1, words.next().unwrap_or("").to_string()))
+    });
+    match line {
+        Some((n, value)) => format!("{}:{n}: MAX_PATCH_AREA {value}", path.display()),
+        None => format!("{}: MAX_PATCH_AREA", path.display()),
+    }
 }
 
 fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {

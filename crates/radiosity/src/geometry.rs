@@ -10,13 +10,18 @@ use glam::DVec3;
 
 /// Newell's area vector: its direction is the front normal and its length is the area of a
 /// planar polygon.
+///
+/// Summed about the first corner, not the origin, so that the result does not depend on
+/// where the polygon is: about the origin, a 1 x 1 square at x = 1e9 would be the
+/// difference of terms near 1e9, and lose half its digits.
 pub fn area_vector(vertices: &[DVec3]) -> DVec3 {
     let n = vertices.len();
+    let Some(&o) = vertices.first() else {
+        return DVec3::ZERO;
+    };
     let mut sum = DVec3::ZERO;
-    for i in 0..n {
-        let a = vertices[i];
-        let b = vertices[(i + 1) % n];
-        sum += a.cross(b);
+    for i in 1..n.saturating_sub(1) {
+        sum += (vertices[i] - o).cross(vertices[i + 1] - o);
     }
     0.5 * sum
 }
@@ -67,7 +72,62 @@ pub fn max_plane_deviation(vertices: &[DVec3]) -> f64 {
 }
 
 /// The largest distance between two corners (the polygon's diameter).
+///
+/// Exact for planar polygons, in O(n log n) time: the corners are projected onto the
+/// polygon's plane (Newell normal; for a degenerate polygon, the plane across the smallest
+/// extent of its bounding box), their convex hull is found (Andrew's monotone chain), and
+/// the diameter is the largest 3D distance over the hull's antipodal pairs (rotating
+/// calipers, Shamos 1978; Preparata and Shamos, *Computational Geometry*, 4.2.3). For a
+/// polygon out of plane by d, the pair found may miss the true diameter by d^2 / diameter
+/// at most: 2e-6 of the diameter at the planarity tolerance (0.2 %). Polygons of up to 8
+/// corners compare every pair.
 pub fn diameter(vertices: &[DVec3]) -> f64 {
+    if vertices.len() <= 8 {
+        return brute_force_diameter(vertices);
+    }
+    let normal = polygon_normal(vertices).unwrap_or_else(|| {
+        let (lo, hi) = bounds(vertices);
+        let extent = hi - lo;
+        if extent.x <= extent.y && extent.x <= extent.z {
+            DVec3::X
+        } else if extent.y <= extent.z {
+            DVec3::Y
+        } else {
+            DVec3::Z
+        }
+    });
+    let (u, v) = normal.any_orthonormal_pair();
+    let flat: Vec<(f64, f64, usize)> = vertices
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (p.dot(u), p.dot(v), i))
+        .collect();
+    let hull = convex_hull(flat);
+    let d3 = |a: usize, b: usize| vertices[hull[a].2].distance(vertices[hull[b].2]);
+    let m = hull.len();
+    if m < 3 {
+        return if m == 2 { d3(0, 1) } else { 0.0 };
+    }
+    // Twice the area of the triangle (hull[a], hull[b], hull[c]).
+    let area = |a: usize, b: usize, c: usize| {
+        let (p, q, r) = (hull[a], hull[b], hull[c]);
+        (q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0)
+    };
+    let mut best: f64 = 0.0;
+    let mut j = 1;
+    for i in 0..m {
+        let i1 = (i + 1) % m;
+        // The corner furthest from edge i: the area over the edge grows up to it.
+        while area(i, i1, (j + 1) % m) > area(i, i1, j) {
+            j = (j + 1) % m;
+        }
+        best = best.max(d3(i, j)).max(d3(i1, j));
+    }
+    best
+}
+
+/// Every pair compared: O(n^2), for small polygons.
+fn brute_force_diameter(vertices: &[DVec3]) -> f64 {
     let mut d: f64 = 0.0;
     for (i, a) in vertices.iter().enumerate() {
         for b in &vertices[i + 1..] {
@@ -75,6 +135,46 @@ pub fn diameter(vertices: &[DVec3]) -> f64 {
         }
     }
     d
+}
+
+/// The convex hull of 2D points (x, y, tag), counter-clockwise, without collinear points
+/// (Andrew 1979, monotone chain).
+fn convex_hull(mut points: Vec<(f64, f64, usize)>) -> Vec<(f64, f64, usize)> {
+    points.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    points.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    if points.len() < 3 {
+        return points;
+    }
+    let turn = |o: (f64, f64, usize), a: (f64, f64, usize), b: (f64, f64, usize)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(f64, f64, usize)> = Vec::with_capacity(points.len() + 1);
+    for pass in 0..2 {
+        let start = hull.len();
+        let ordered: Box<dyn Iterator<Item = &(f64, f64, usize)>> = if pass == 0 {
+            Box::new(points.iter())
+        } else {
+            Box::new(points.iter().rev())
+        };
+        for &p in ordered {
+            while hull.len() >= start + 2 && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        // The last point of each chain is the first of the other.
+        hull.pop();
+    }
+    hull
+}
+
+/// The smallest axis-aligned box holding the corners, as (min, max).
+fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
+    vertices.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+    )
 }
 
 /// Moves every corner onto the best-fit plane (Newell normal through the corner mean).
@@ -87,30 +187,22 @@ pub fn project_to_plane(vertices: &mut [DVec3]) {
     }
 }
 
-/// True when the polygon is strictly convex with every turn the same way round its normal
-/// (collinear corners, with a turn of zero, are allowed). Assumes a non-degenerate polygon.
-pub fn is_convex(vertices: &[DVec3]) -> bool {
-    let Some(n) = polygon_normal(vertices) else {
-        return false;
-    };
-    let k = vertices.len();
-    let scale = diameter(vertices).powi(2);
-    for i in 0..k {
-        let a = vertices[i];
-        let b = vertices[(i + 1) % k];
-        let c = vertices[(i + 2) % k];
-        let turn = (b - a).cross(c - b).dot(n);
-        // Relative tolerance: a turn this small is a straight (collinear) corner.
-        if turn < -1e-9 * scale {
-            return false;
-        }
-    }
-    true
-}
-
 /// A polygon is accepted as planar when no corner is further than this fraction of its
 /// diameter from the best-fit plane (0.2 %).
 pub const PLANARITY_TOLERANCE: f64 = 2e-3;
+
+/// The largest coordinate magnitude a scene may have (scene units): 1e30.
+///
+/// Together with [`MIN_POLYGON_SIZE`] this is the range of scales the program supports:
+/// sixty orders of magnitude, so any physical unit fits. The limits come from f64 in the
+/// form-factor kernel and the solvers: areas reach size^2, the kernel divides by distance^4
+/// and multiplies two areas (size^4 over distance^4), all of which stay between 1e-240 and
+/// 1e240, far inside f64's 1e-308 .. 1e308. (The ray-query hierarchy, which is in f32,
+/// works in its own units: see [`crate::visibility::PolygonBvh`].)
+pub const MAX_COORDINATE: f64 = 1e30;
+
+/// The smallest diameter a polygon may have (scene units): 1e-30. See [`MAX_COORDINATE`].
+pub const MIN_POLYGON_SIZE: f64 = 1e-30;
 
 /// Corners are projected onto the best-fit plane only when some corner is further than this
 /// fraction of the diameter from it, so that projecting twice changes nothing.
@@ -122,6 +214,10 @@ const SAME_POINT: f64 = 1e-9;
 /// An area below this fraction of the squared diameter is zero.
 const ZERO_AREA: f64 = 1e-9;
 
+/// A turn (the cross product of two consecutive edges along the normal) below minus this
+/// fraction of the squared diameter turns the wrong way; above it, a corner is straight.
+const STRAIGHT_TURN: f64 = 1e-9;
+
 /// Why a list of corners is not a usable planar convex polygon ([`validate_polygon`]).
 /// Corners are numbered from 0 in the order given.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
@@ -132,6 +228,25 @@ pub enum PolygonError {
         /// The number of corners given.
         count: usize,
     },
+    /// A coordinate is infinite or NaN.
+    #[error("vertex {vertex} has a coordinate that is not a finite number ({value})")]
+    NotFinite {
+        /// The corner.
+        vertex: usize,
+        /// The coordinate.
+        value: f64,
+    },
+    /// A coordinate's magnitude is above [`MAX_COORDINATE`].
+    #[error(
+        "vertex {vertex} has the coordinate {value:e}, beyond the largest the program \
+         supports ({MAX_COORDINATE:e} in magnitude)"
+    )]
+    OutOfRange {
+        /// The corner.
+        vertex: usize,
+        /// The coordinate.
+        value: f64,
+    },
     /// Two corners coincide (closer than 1e-9 of the diameter).
     #[error("degenerate polygon: vertices {first} and {second} are the same point")]
     RepeatedVertex {
@@ -139,6 +254,15 @@ pub enum PolygonError {
         first: usize,
         /// The second of the pair (`first < second`).
         second: usize,
+    },
+    /// The diameter is below [`MIN_POLYGON_SIZE`].
+    #[error(
+        "the polygon is {diameter:e} scene units across, less than the smallest the program \
+         supports ({MIN_POLYGON_SIZE:e})"
+    )]
+    TooSmall {
+        /// The polygon's diameter (scene units).
+        diameter: f64,
     },
     /// The area is zero (below 1e-9 of the squared diameter): the corners are collinear, or
     /// the outline crosses itself so that its parts cancel.
@@ -173,34 +297,56 @@ pub enum PolygonError {
 }
 
 /// Checks that `vertices` make a usable planar convex polygon, in this order: at least 3
-/// corners, no repeated corners, a non-zero area, planar within [`PLANARITY_TOLERANCE`] of
+/// corners, finite coordinates within [`MAX_COORDINATE`], no repeated corners, a diameter of
+/// at least [`MIN_POLYGON_SIZE`], a non-zero area, planar within [`PLANARITY_TOLERANCE`] of
 /// the diameter, and convex (every corner turns the same way round the front normal, and
 /// the outline goes round once). Convexity is judged on the corners as [`flatten`] would
 /// project them, so a polygon that passes stays valid once flattened.
+///
+/// Every test is relative to the polygon's own size, and is made on a copy moved to its
+/// first corner and scaled by a power of two to about unit size: a polygon passes or fails
+/// the same at any position and scale within the supported range, and no square or
+/// product of coordinates can overflow or underflow. O(n log n) in the corners.
 pub fn validate_polygon(vertices: &[DVec3]) -> Result<(), PolygonError> {
     if vertices.len() < 3 {
         return Err(PolygonError::TooFewVertices {
             count: vertices.len(),
         });
     }
-    let diameter = diameter(vertices);
-    if let Some((first, second)) = repeated_corner(vertices, diameter) {
+    for (vertex, v) in vertices.iter().enumerate() {
+        for value in v.to_array() {
+            if !value.is_finite() {
+                return Err(PolygonError::NotFinite { vertex, value });
+            }
+            if value.abs() > MAX_COORDINATE {
+                return Err(PolygonError::OutOfRange { vertex, value });
+            }
+        }
+    }
+    let (local, unit) = normalised(vertices);
+    let diameter = self::diameter(&local);
+    if let Some((first, second)) = repeated_corner(&local, diameter) {
         return Err(PolygonError::RepeatedVertex { first, second });
     }
-    if polygon_area(vertices) <= ZERO_AREA * diameter * diameter {
+    if diameter * unit < MIN_POLYGON_SIZE {
+        return Err(PolygonError::TooSmall {
+            diameter: diameter * unit,
+        });
+    }
+    if polygon_area(&local) <= ZERO_AREA * diameter * diameter {
         return Err(PolygonError::ZeroArea);
     }
-    let (vertex, deviation) = furthest_from_plane(vertices);
+    let (vertex, deviation) = furthest_from_plane(&local);
     let limit = PLANARITY_TOLERANCE * diameter;
     if deviation > limit {
         return Err(PolygonError::NotPlanar {
             vertex,
-            deviation,
-            limit,
-            diameter,
+            deviation: deviation * unit,
+            limit: limit * unit,
+            diameter: diameter * unit,
         });
     }
-    let mut flat = vertices.to_vec();
+    let mut flat = local;
     flatten(&mut flat);
     if is_convex(&flat) && winds_once(&flat) {
         return Ok(());
@@ -209,6 +355,41 @@ pub fn validate_polygon(vertices: &[DVec3]) -> Result<(), PolygonError> {
         Some(vertex) => PolygonError::Reflex { vertex },
         None => PolygonError::WindsMoreThanOnce,
     })
+}
+
+/// The corners moved so that the first is at the origin and scaled by powers of two (which
+/// is exact) to within a unit of it, and the scale that undoes it: `vertices[i] =
+/// vertices[0] + unit * local[i]`. The coordinates are first scaled into [-1, 1], so the
+/// differences cannot overflow. Finite coordinates assumed.
+fn normalised(vertices: &[DVec3]) -> (Vec<DVec3>, f64) {
+    let largest = |vs: &mut dyn Iterator<Item = DVec3>| vs.map(|v| v.abs().max_element()).fold(0.0, f64::max);
+    let first = power_of_two_at_least(largest(&mut vertices.iter().copied()));
+    let o = vertices[0] / first;
+    let moved: Vec<DVec3> = vertices.iter().map(|v| *v / first - o).collect();
+    let second = power_of_two_at_least(largest(&mut moved.iter().copied()));
+    let local = moved.into_iter().map(|v| v / second).collect();
+    (local, first * second)
+}
+
+/// The smallest power of two at or above `x` (1 for 0).
+fn power_of_two_at_least(x: f64) -> f64 {
+    if !(x > 0.0) {
+        return 1.0;
+    }
+    let e = x.log2().ceil().clamp(-1000.0, 1000.0) as i32;
+    let p = 2f64.powi(e);
+    // log2 may round either way; one step fixes it.
+    if p < x {
+        2.0 * p
+    } else {
+        p
+    }
+}
+
+/// True when the polygon is strictly convex with every turn the same way round its normal
+/// (collinear corners, with a turn of zero, are allowed). Assumes a non-degenerate polygon.
+pub fn is_convex(vertices: &[DVec3]) -> bool {
+    polygon_normal(vertices).is_some() && reflex_corner(vertices).is_none()
 }
 
 /// Projects the corners onto the best-fit plane ([`project_to_plane`]) when some corner is
@@ -237,14 +418,48 @@ fn furthest_from_plane(vertices: &[DVec3]) -> (usize, f64) {
         )
 }
 
-/// The first pair of corners (i < j) that coincide.
+/// The first pair of corners (i < j, by i then j) that lie within 1e-9 of the diameter of
+/// each other. Expected O(n): corners are put in cubic cells of that size, and only corners
+/// in the 27 cells around each are compared (a cell holds a bounded number of corners that
+/// are pairwise further apart than its size).
 fn repeated_corner(vertices: &[DVec3], diameter: f64) -> Option<(usize, usize)> {
     let limit = SAME_POINT * diameter;
-    (0..vertices.len()).find_map(|i| {
-        (i + 1..vertices.len())
-            .find(|&j| vertices[i].distance(vertices[j]) <= limit)
-            .map(|j| (i, j))
-    })
+    if vertices.len() <= 8 || !(limit > 0.0) {
+        return (0..vertices.len()).find_map(|i| {
+            (i + 1..vertices.len())
+                .find(|&j| vertices[i].distance(vertices[j]) <= limit)
+                .map(|j| (i, j))
+        });
+    }
+    let (lo, _) = bounds(vertices);
+    let cell = |v: DVec3| ((v - lo) / limit).floor().as_i64vec3().to_array();
+    let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> =
+        std::collections::HashMap::with_capacity(vertices.len());
+    for (i, v) in vertices.iter().enumerate() {
+        cells.entry(cell(*v)).or_default().push(i);
+    }
+    let mut first: Option<(usize, usize)> = None;
+    for (i, v) in vertices.iter().enumerate() {
+        let [x, y, z] = cell(*v);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(near) = cells.get(&[x + dx, y + dy, z + dz]) else {
+                        continue;
+                    };
+                    for &j in near {
+                        if j > i && v.distance(vertices[j]) <= limit && first.is_none_or(|f| (i, j) < f) {
+                            first = Some((i, j));
+                        }
+                    }
+                }
+            }
+        }
+        if first.is_some_and(|f| f.0 == i) {
+            return first;
+        }
+    }
+    first
 }
 
 /// The first corner whose turn is against the front normal.
@@ -254,24 +469,32 @@ fn reflex_corner(vertices: &[DVec3]) -> Option<usize> {
     let scale = diameter(vertices).powi(2);
     (0..n).find_map(|i| {
         let (a, b, c) = (vertices[i], vertices[(i + 1) % n], vertices[(i + 2) % n]);
-        ((b - a).cross(c - b).dot(normal) < -1e-9 * scale).then_some((i + 1) % n)
+        ((b - a).cross(c - b).dot(normal) < -STRAIGHT_TURN * scale).then_some((i + 1) % n)
     })
 }
 
-/// True when every corner lies on the inner side of every edge, which rules out outlines that
-/// turn the same way at every corner but go round more than once (a pentagram).
+/// True when the outline goes round the normal once, for an outline that turns the same
+/// way (or straight on) at every corner: the turning angles (each in (-pi, pi], a
+/// reversal counting as pi) add up to 2 pi once round, 4 pi for a pentagram. O(n).
 fn winds_once(vertices: &[DVec3]) -> bool {
     let Some(normal) = polygon_normal(vertices) else {
         return false;
     };
     let n = vertices.len();
-    let scale = diameter(vertices).powi(2);
-    (0..n).all(|i| {
-        let (a, b) = (vertices[i], vertices[(i + 1) % n]);
-        vertices
-            .iter()
-            .all(|v| (b - a).cross(*v - a).dot(normal) >= -1e-9 * scale)
-    })
+    let total: f64 = (0..n)
+        .map(|i| {
+            let (a, b, c) = (vertices[i], vertices[(i + 1) % n], vertices[(i + 2) % n]);
+            let (e, f) = (b - a, c - b);
+            let angle = e.cross(f).dot(normal).atan2(e.dot(f));
+            // A turn of -pi (or a hair less) is a reversal: pi, like +pi.
+            if angle < -0.5 * std::f64::consts::PI {
+                angle + std::f64::consts::TAU
+            } else {
+                angle
+            }
+        })
+        .sum();
+    (total - std::f64::consts::TAU).abs() < 0.5 * std::f64::consts::PI
 }
 
 #[cfg(test)]

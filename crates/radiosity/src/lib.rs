@@ -82,6 +82,9 @@ pub mod solve;
 mod splitmix;
 pub mod visibility;
 
+#[cfg(test)]
+mod scale_tests;
+
 /// The solution writer's module at the path the command line uses; it lives in
 /// [`io::solution`].
 pub use io::solution;

@@ -10,6 +10,15 @@
 //! between them, and form-factor sample points lie on such diagonals by symmetry), so the
 //! leaf test here is written by hand: the ray meets the polygon's plane in f64, and the
 //! point is inside when it is on the inner side of every edge (edges included).
+//!
+//! The hierarchy is in f32 and obvhs has absolute constants (a ray skips the boxes it leaves
+//! within 1e-4 of its origin), so it is built in its own units: scene coordinates less the
+//! centre of the scene's bounding box, times a power of two that makes the scene's diagonal
+//! 1024 to 2048 units long. Scaling by a power of two is exact, so the hierarchy and every
+//! answer are the same at any scale (a scene in metres or in light years, within
+//! [`crate::geometry::MAX_COORDINATE`]), no f32 box area overflows or underflows, and a scene
+//! far from the origin (a room at x = 1e9) keeps f32's precision. The leaf tests stay in
+//! scene units, in f64.
 
 use std::time::Duration;
 
@@ -62,6 +71,10 @@ pub struct PolygonBvh {
     edge_planes: Vec<(DVec3, f64)>,
     /// Length of the bounding-box diagonal of all polygons, for relative tolerances.
     scale: f64,
+    /// The centre of the scene's bounding box and the power of two that take scene units to
+    /// the hierarchy's (module documentation).
+    centre: DVec3,
+    to_local: f64,
 }
 
 /// The first thing a ray hits.
@@ -92,15 +105,24 @@ impl PolygonBvh {
         } else {
             (hi - lo).length().max(f64::MIN_POSITIVE)
         };
+        let to_local = local_unit(scale);
+        let centre = if polygons.is_empty() {
+            DVec3::ZERO
+        } else {
+            0.5 * lo + 0.5 * hi
+        };
+        let local = |v: DVec3| to_f32((v - centre) * to_local);
         // Pad boxes so that flat, axis-aligned polygons get boxes of non-zero thickness and
         // the f32, quantised node boxes of the CWBVH cannot make a ray miss a polygon it
         // meets. With 1e-6 of the scene size, one Monte Carlo ray in 10^5 leaked out of a
-        // closed cube near a corner; 1e-5 closes the leak.
-        let pad = (1e-5 * scale) as f32;
+        // closed cube near a corner; 1e-5 closes the leak (f32 rounds the hierarchy's
+        // coordinates, at most 2048 from its centre, by 1.2e-4 units at most: well inside
+        // the pad, at least 1e-2 units).
+        let pad = (1e-5 * scale * to_local) as f32;
         let bounds: Vec<Bounds> = polygons
             .iter()
             .map(|p| {
-                let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| to_f32(*v)).collect();
+                let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| local(*v)).collect();
                 let b = Aabb::from_points(&pts);
                 Bounds(Aabb::new(
                     b.min - Vec3A::splat(pad),
@@ -142,6 +164,8 @@ impl PolygonBvh {
                 corners,
                 edge_planes,
                 scale,
+                centre,
+                to_local,
             };
         }
         let bvh = build_cwbvh(
@@ -160,6 +184,8 @@ impl PolygonBvh {
             corners,
             edge_planes,
             scale,
+            centre,
+            to_local,
         }
     }
 
@@ -183,6 +209,11 @@ impl PolygonBvh {
             .collect();
         let ids: Vec<u32> = (0..polygons.len() as u32).collect();
         PolygonBvh::new(&polygons, &ids)
+    }
+
+    /// A scene point in the hierarchy's units (module documentation).
+    fn local(&self, v: DVec3) -> Vec3A {
+        to_f32((v - self.centre) * self.to_local)
     }
 
     /// The number of polygons.
@@ -241,8 +272,8 @@ impl PolygonBvh {
         }
         let pad = 1e-6 * self.scale;
         let query = Aabb::new(
-            to_f32(lo - DVec3::splat(pad)),
-            to_f32(hi + DVec3::splat(pad)),
+            self.local(lo - DVec3::splat(pad)),
+            self.local(hi + DVec3::splat(pad)),
         );
         let bvh = &self.bvh;
         let mut state = bvh.new_traversal(Vec3A::ZERO);
@@ -307,10 +338,16 @@ impl PolygonBvh {
             return false;
         }
         let dir = d / len;
-        let ray = Ray::new(to_f32(p), to_f32(dir), 0.0, len as f32 * 1.001 + eps as f32);
+        let to_local = self.to_local;
+        let ray = Ray::new(
+            self.local(p),
+            to_f32(dir),
+            0.0,
+            ((len * 1.001 + eps) * to_local) as f32,
+        );
         !self.bvh.ray_traverse_miss(ray, |_, k| {
             match self.intersect(k, p, dir, eps, len - eps) {
-                Some(t) => t as f32,
+                Some(t) => (t * to_local) as f32,
                 None => f32::INFINITY,
             }
         })
@@ -322,9 +359,9 @@ impl PolygonBvh {
     /// a shared edge, overlapping polygons), the first in BVH order.
     ///
     /// A box query and the inside test, not a ray: obvhs's ray traversal skips every box
-    /// that a ray leaves within 1e-4 of its origin (an absolute distance, its `EPSILON`,
-    /// which stands in for the ray's own t_min), so a short ray through a point on a
-    /// polygon finds nothing in a scene in metres.
+    /// that a ray leaves within 1e-4 of its origin (an absolute distance in the hierarchy's
+    /// units, its `EPSILON`, which stands in for the ray's own t_min; about 1e-7 of the
+    /// scene's diagonal), so a short enough ray through a point on a polygon finds nothing.
     pub fn polygon_at(&self, p: DVec3, tolerance: f64) -> Option<u32> {
         let mut candidates = Vec::new();
         self.overlapping(
@@ -345,7 +382,13 @@ impl PolygonBvh {
         if self.polygons.is_empty() {
             return None;
         }
-        let ray = Ray::new(to_f32(origin), to_f32(dir), 0.0, t_max as f32 * 1.001);
+        let to_local = self.to_local;
+        let ray = Ray::new(
+            self.local(origin),
+            to_f32(dir),
+            0.0,
+            (t_max * 1.001 * to_local) as f32,
+        );
         let mut hit = RayHit::none();
         let mut best: Option<(f64, u32)> = None;
         self.bvh.ray_traverse(ray, &mut hit, |_, k| {
@@ -355,12 +398,27 @@ impl PolygonBvh {
                     best = Some((t, self.polygons[k].id));
                     // Report a t just inside the f32 ray's range so the traversal keeps
                     // shrinking its interval; the exact t is kept in f64 in `best`.
-                    t as f32
+                    (t * to_local) as f32
                 }
                 None => f32::INFINITY,
             }
         });
         best.map(|(t, id)| Hit { t, id })
+    }
+}
+
+/// The power of two that makes a scene of diagonal `scale` 1024 to 2048 of the hierarchy's
+/// units long (module documentation).
+fn local_unit(scale: f64) -> f64 {
+    let e = (1024.0 / scale).log2().floor().clamp(-1000.0, 1000.0) as i32;
+    let unit = 2f64.powi(e);
+    // log2 may round either way; one step fixes it.
+    if scale * unit < 1024.0 {
+        2.0 * unit
+    } else if scale * unit >= 2048.0 {
+        0.5 * unit
+    } else {
+        unit
     }
 }
 
@@ -433,11 +491,18 @@ mod tests {
         assert_eq!(bvh.polygon_at(dvec3(1.5, 0.5, 1.0), 1e-6), None);
         // An edge belongs to the square.
         assert_eq!(bvh.polygon_at(dvec3(1.0, 0.5, 1.0), 1e-6), Some(1));
-        // What polygon_at replaces: a ray this short finds nothing, since obvhs skips the
-        // boxes a ray leaves within 1e-4 of its origin. If this starts to pass, obvhs has
-        // changed and the note at polygon_at can go.
+        // What polygon_at replaces: obvhs skips the boxes a ray leaves within 1e-4 of its
+        // origin, in the hierarchy's units (the diagonal, sqrt(2 + 1e-6), is 2^10 = 1024 of
+        // them: a square far from these units would see the same). A ray of 2e-6 scene
+        // units (2e-3 units of the hierarchy) finds the square; one of 2e-8 (2e-5 units,
+        // below 1e-4) finds nothing. If the second starts to pass, obvhs has changed and the
+        // note at polygon_at can go.
         assert_eq!(
-            bvh.closest_hit(p + 1e-6 * DVec3::Z, -DVec3::Z, 0.0, 2e-6),
+            bvh.closest_hit(p + 1e-6 * DVec3::Z, -DVec3::Z, 0.0, 2e-6).map(|h| h.id),
+            Some(1)
+        );
+        assert_eq!(
+            bvh.closest_hit(p + 1e-8 * DVec3::Z, -DVec3::Z, 0.0, 2e-8),
             None
         );
     }

@@ -102,10 +102,35 @@ pub enum MeshError {
     /// `MAX_PATCH_AREA` is not a positive finite number.
     #[error("MAX_PATCH_AREA must be a positive number, got {0}")]
     BadMaxArea(f64),
+    /// A surface is not a usable polygon ([`geometry::validate_polygon`]): the scene was
+    /// not read by the scene reader, which refuses these with the file and line.
+    #[error("surface {surface} ({name:?}) is not a usable polygon: {error}")]
+    InvalidSurface {
+        /// The surface's index in the scene.
+        surface: usize,
+        /// Its name.
+        name: String,
+        /// What is wrong with it.
+        error: geometry::PolygonError,
+    },
+    /// An element came out with a zero or non-finite area (a surface at the edge of the
+    /// supported range of scales cut very finely).
+    #[error(
+        "an element of surface {surface} has area {area}, not a positive finite number; \
+         use a larger MAX_PATCH_AREA"
+    )]
+    BadElementArea {
+        /// The surface the element belongs to.
+        surface: usize,
+        /// Its area.
+        area: f64,
+    },
     /// The subdivision would make more elements than the limit.
     #[error(
-        "meshing with MAX_PATCH_AREA = {max_area} would make {count} elements, more than the \
-         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.3e}"
+        "meshing with MAX_PATCH_AREA = {} would make {} elements, more than the \
+         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.3e}",
+        compact(*max_area),
+        if *count == u64::MAX { "more than 1.8e19".to_string() } else { count.to_string() }
     )]
     TooManyElements {
         /// The requested maximum element area.
@@ -117,6 +142,16 @@ pub enum MeshError {
         /// A maximum area that would stay within the limit.
         suggested: f64,
     },
+}
+
+/// `x` as Rust writes it where that is short (1e-4 to 1e15 in magnitude, or 0), else with
+/// an exponent: a MAX_PATCH_AREA of 1e-300 is not three hundred zeros.
+fn compact(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// The most elements [`mesh_scene`] will make: about 1.2 GB of mesh (112 bytes per element
@@ -144,7 +179,6 @@ impl Plan {
     }
 }
 
-/// Plans the cut of one polygon so that no element exceeds `max_area`.
 /// Plans the cut of one polygon so that no element exceeds `max_area`, or returns the
 /// (estimated) element count when that would exceed [`MAX_ELEMENTS`] on its own, before any
 /// integer could overflow or any loop run long.
@@ -164,8 +198,19 @@ fn plan(vertices: &[DVec3], max_area: f64) -> Result<Plan, f64> {
             let [a, b, c, d] = [vertices[0], vertices[1], vertices[2], vertices[3]];
             let lu = 0.5 * ((b - a).length() + (c - d).length());
             let lv = 0.5 * ((d - a).length() + (c - b).length());
-            let mut nu = ((target * lu / lv).sqrt().round().clamp(1.0, target)) as u32;
-            let mut nv = ((target / nu as f64).ceil() as u32).max(1);
+            // In f64 and checked before the casts: a degenerate quad (a zero edge length,
+            // a zero or infinite area) would make NaN, which casts to 0, and a grid of
+            // 0 x 4,294,967,295. Surfaces are validated before planning; this keeps the
+            // planner safe on its own.
+            let nu_f = (target * lu / lv).sqrt().round().clamp(1.0, target);
+            if !(nu_f.is_finite() && area.is_finite() && area > 0.0) {
+                return Err(f64::INFINITY);
+            }
+            let nv_f = (target / nu_f).ceil().max(1.0);
+            if nu_f * nv_f > MAX_ELEMENTS as f64 {
+                return Err(nu_f * nv_f);
+            }
+            let (mut nu, mut nv) = (nu_f as u32, nv_f as u32);
             while max_quad_cell_area(vertices, nu, nv) > max_area * (1.0 + 1e-12) {
                 if lu / nu as f64 >= lv / nv as f64 {
                     nu += 1;
@@ -255,6 +300,16 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
     if !(max_area.is_finite() && max_area > 0.0) {
         return Err(MeshError::BadMaxArea(max_area));
     }
+    // Every surface a usable polygon (finite, within the supported range of scales, of
+    // non-zero area), so that the plans below are finite and no element has a zero or
+    // infinite area.
+    for (surface, s) in scene.surfaces.iter().enumerate() {
+        geometry::validate_polygon(&s.vertices).map_err(|error| MeshError::InvalidSurface {
+            surface,
+            name: s.name.clone(),
+            error,
+        })?;
+    }
     let planned: Vec<Result<Plan, f64>> = scene
         .surfaces
         .iter()
@@ -267,7 +322,12 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
         .sum();
     if estimate > MAX_ELEMENTS as f64 {
         let count = estimate.min(u64::MAX as f64) as u64;
-        let suggested = max_area * estimate / MAX_ELEMENTS as f64 * 1.05;
+        let mut suggested = max_area * estimate / MAX_ELEMENTS as f64 * 1.05;
+        if !suggested.is_finite() {
+            // The estimate overflowed (a MAX_PATCH_AREA of 1e-300): the area alone says
+            // what would fit.
+            suggested = scene.total_area() / MAX_ELEMENTS as f64 * 1.05;
+        }
         return Err(MeshError::TooManyElements {
             max_area,
             count,
@@ -304,6 +364,17 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
             .push(first_vertex..mesh.vertices.len() as u32);
         mesh.surface_elements
             .push(first_element..mesh.elements.len() as u32);
+    }
+    // The areas that every later stage divides by or weighs with.
+    if let Some(e) = mesh
+        .elements
+        .iter()
+        .find(|e| !(e.area.is_finite() && e.area > 0.0))
+    {
+        return Err(MeshError::BadElementArea {
+            surface: e.surface as usize,
+            area: e.area,
+        });
     }
     mesh.build_neighbours();
     Ok(mesh)

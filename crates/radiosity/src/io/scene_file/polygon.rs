@@ -1,7 +1,7 @@
 //! How the scene reader words a [`PolygonError`]: corners named by their `VERTEXk` lines,
 //! lengths in scene units with four significant digits.
 
-use crate::geometry::PolygonError;
+use crate::geometry::{self, PolygonError};
 
 /// The message, for the file:line:column error at the polygon's `VERTEX0` line.
 pub(super) fn message(e: &PolygonError) -> String {
@@ -12,6 +12,20 @@ pub(super) fn message(e: &PolygonError) -> String {
         PolygonError::RepeatedVertex { first, second } => {
             format!("degenerate polygon: VERTEX{first} and VERTEX{second} are the same point")
         }
+        PolygonError::NotFinite { vertex, value } => {
+            format!("VERTEX{vertex} has a coordinate that is not a finite number ({value})")
+        }
+        PolygonError::OutOfRange { vertex, value } => format!(
+            "VERTEX{vertex} has the coordinate {value:e}, beyond the largest the program \
+             supports ({:e} in magnitude); rescale the scene (for instance to metres)",
+            geometry::MAX_COORDINATE
+        ),
+        PolygonError::TooSmall { diameter } => format!(
+            "the polygon is {} scene units across, less than the smallest the program \
+             supports ({:e}); rescale the scene (for instance to millimetres)",
+            significant(diameter),
+            geometry::MIN_POLYGON_SIZE
+        ),
         PolygonError::ZeroArea => "degenerate polygon: its area is zero (the vertices are \
                                    collinear, or the outline crosses itself)"
             .to_string(),
@@ -36,6 +50,39 @@ pub(super) fn message(e: &PolygonError) -> String {
             "the polygon is not convex: its outline goes round more than once".to_string()
         }
     }
+}
+
+/// The message for a box whose face `face` (its full name, `Table.side0`) fails the
+/// polygon checks, at the box's `SIZE` or `HEIGHT` line. A face's corners are not written
+/// in the file, so the message speaks of the box's sizes, not of `VERTEXk` lines.
+pub(super) fn box_face_message(face: &str, e: &PolygonError) -> String {
+    let why = match *e {
+        PolygonError::RepeatedVertex { .. } => "two of its corners are the same point: a size \
+             is too small to register beside the box's coordinates or its other sizes (less \
+             than a billionth of them)"
+            .to_string(),
+        PolygonError::ZeroArea => {
+            "its area is zero: one size is less than a billionth of another".to_string()
+        }
+        PolygonError::TooSmall { diameter } => format!(
+            "it is {} scene units across, less than the smallest the program supports ({:e}); \
+             rescale the scene (for instance to millimetres)",
+            significant(diameter),
+            geometry::MIN_POLYGON_SIZE
+        ),
+        PolygonError::OutOfRange { value, .. } => format!(
+            "it reaches the coordinate {value:e}, beyond the largest the program supports \
+             ({:e} in magnitude); rescale the scene (for instance to metres)",
+            geometry::MAX_COORDINATE
+        ),
+        PolygonError::NotFinite { .. } => {
+            "a corner's coordinate is not a finite number (the box reaches past the largest \
+             number)"
+                .to_string()
+        }
+        _ => message(e),
+    };
+    format!("the box's face \"{face}\" is not a usable polygon: {why}")
 }
 
 /// `x` with four significant digits, without an exponent for everyday magnitudes.

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use glam::{dvec3, DVec3};
+use glam::DVec3;
 use thiserror::Error;
 
 use super::lex::{lex, Keyword, Line, Token};
@@ -13,6 +13,10 @@ use crate::light::Rgb;
 use crate::mesh::MeshSettings;
 use crate::scene::shape::{self, Facing};
 use crate::scene::{Scene, Surface};
+
+/// Two surfaces in one plane are the same surface given twice when one covers all but this
+/// fraction of the larger's area (module [`Parser::duplicates`]).
+const DUPLICATE_TOLERANCE: f64 = 1e-6;
 
 /// After this many errors the reader stops looking for more.
 const MAX_ERRORS: usize = 100;
@@ -115,9 +119,14 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneErro
         pos: 0,
         eof,
         errors: Vec::new(),
+        surface_lines: Vec::new(),
+        block_line: (0, 0),
     };
     let settings = parser.header();
     let surfaces = parser.body();
+    if parser.errors.is_empty() {
+        parser.duplicates(&surfaces);
+    }
     match settings {
         Some(settings) if parser.errors.is_empty() => Ok(SceneFile {
             settings,
@@ -145,6 +154,11 @@ struct Parser<'a> {
     pos: usize,
     eof: (usize, usize),
     errors: Vec<ParseError>,
+    /// Where each surface read so far was given (its `VERTEX0` line, or its box's `SIZE` or
+    /// `HEIGHT` line), for problems between surfaces.
+    surface_lines: Vec<(usize, usize)>,
+    /// The line of the block read last.
+    block_line: (usize, usize),
 }
 
 /// A patch or box block's name and colours.
@@ -165,9 +179,21 @@ struct Corners {
 /// A box block's geometry as written.
 enum BoxShape {
     /// `ORIGIN` and `SIZE`.
-    Aligned { origin: DVec3, size: DVec3 },
+    Aligned {
+        origin: DVec3,
+        size: DVec3,
+        /// The `SIZE` line, where problems with the faces are reported.
+        line: usize,
+        column: usize,
+    },
     /// `VERTICES 4`, `VERTEX0`..`VERTEX3` and `HEIGHT`.
-    Prism { base: Corners, height: f64 },
+    Prism {
+        base: Corners,
+        height: f64,
+        /// The `HEIGHT` line, where problems with the other faces are reported.
+        line: usize,
+        column: usize,
+    },
 }
 
 impl<'a> Parser<'a> {
@@ -258,13 +284,29 @@ impl<'a> Parser<'a> {
         };
         let message = match token.text.parse::<f64>() {
             Ok(v) if v.is_finite() => return Ok((v, token)),
+            // "a number (the y size)" becomes "a finite number (the y size)".
             Ok(_) => format!(
-                "expected a finite number after \"{key}\", found \"{}\"",
+                "expected a finite {} after \"{key}\", found \"{}\"",
+                what.strip_prefix("a ").unwrap_or(what),
                 token.text
             ),
             Err(_) => format!("expected {what} after \"{key}\", found \"{}\"", token.text),
         };
         Err(self.error_at(token, line, message))
+    }
+
+    /// Records an error when the coordinate `v` (word `token` of `line`) is beyond
+    /// [`geometry::MAX_COORDINATE`] in magnitude.
+    fn check_range(&mut self, v: f64, token: Token<'a>, line: &Line<'a>) {
+        if v.abs() > geometry::MAX_COORDINATE {
+            let msg = format!(
+                "the coordinate \"{}\" is beyond the largest the program supports ({:e} in \
+                 magnitude); rescale the scene (for instance to metres)",
+                token.text,
+                geometry::MAX_COORDINATE
+            );
+            self.error_at(token, line, msg);
+        }
     }
 
     /// A `KEYWORD value` line.
@@ -285,22 +327,26 @@ impl<'a> Parser<'a> {
         Ok((found.map_or(0.0, |f| f.0), found.map(|f| f.1), line))
     }
 
-    /// A `KEYWORD x y z` line; `what` names the three numbers ("coordinate", "size"). A bad
-    /// number is recorded and read as 0 (see [`Parser::value_or_recorded`]).
-    fn triple(&mut self, keyword: Keyword, what: &str) -> Step<(DVec3, Line<'a>)> {
+    /// A `KEYWORD x y z` line; `what` names the three numbers ("coordinate", "size"). Each
+    /// number comes with its word, `None` from the first one that could not be read (that
+    /// one is recorded, and the block will be dropped at its end; the rest of the line would
+    /// only repeat the complaint).
+    #[allow(clippy::type_complexity)]
+    fn triple_read(
+        &mut self,
+        keyword: Keyword,
+        what: &str,
+    ) -> Step<([Option<(f64, Token<'a>)>; 3], Line<'a>)> {
         let line = self.expect(keyword)?;
-        let mut xyz = [0.0; 3];
+        let mut xyz = [None; 3];
         for (i, axis) in ["x", "y", "z"].iter().enumerate() {
-            if let Ok((v, _)) = self.number(&line, i + 1, &format!("a number (the {axis} {what})"))
-            {
-                xyz[i] = v;
-            } else {
-                // Recorded; the rest of the line would only repeat the complaint.
-                return Ok((dvec3(xyz[0], xyz[1], xyz[2]), line));
+            match self.number(&line, i + 1, &format!("a number (the {axis} {what})")) {
+                Ok(found) => xyz[i] = Some(found),
+                Err(Reported) => return Ok((xyz, line)),
             }
         }
         self.line_end(&line, 4);
-        Ok((dvec3(xyz[0], xyz[1], xyz[2]), line))
+        Ok((xyz, line))
     }
 
     /// A whole number written as an integer or with a zero fraction ("2", "2.0").
@@ -392,10 +438,12 @@ impl<'a> Parser<'a> {
                 Some(Keyword::PatchBegin) => {
                     blocks += 1;
                     surfaces.extend(self.patch());
+                    self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
                 Some(Keyword::BoxBegin) => {
                     blocks += 1;
                     surfaces.extend(self.box_block().into_iter().flatten());
+                    self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
                 Some(Keyword::SceneEnd) => {
                     self.scene_end(blocks);
@@ -407,6 +455,41 @@ impl<'a> Parser<'a> {
                     self.stray_line();
                 }
             }
+        }
+    }
+
+    /// Reports every surface that lies in the plane of another, facing the same way, and
+    /// covers all of it while being no larger: the same surface given twice (a second floor
+    /// quad on the floor). A surface on part of another (a rug on a floor, in its plane or
+    /// above it) is a model the mesher handles ([`crate::scene::lying_on`]: the covered
+    /// part is left out); a duplicate leaves nothing of the lower one and is a mistake.
+    fn duplicates(&mut self, surfaces: &[Surface]) {
+        if surfaces.len() < 2 {
+            return;
+        }
+        let scene = Scene {
+            surfaces: surfaces.to_vec(),
+            camera: None,
+        };
+        let bvh = crate::visibility::PolygonBvh::over_surfaces(&scene);
+        for o in crate::scene::lying_on(&scene, &bvh) {
+            let (lower, upper) = (o.lower as usize, o.upper as usize);
+            let area = |s: usize| geometry::polygon_area(&surfaces[s].vertices);
+            // Covering the whole of the lower surface and no larger than it, to 1e-6 (six
+            // significant digits, as scene files are often written).
+            let whole = (1.0 - DUPLICATE_TOLERANCE) * area(lower).max(area(upper));
+            if !o.same_plane(bvh.scale()) || o.covered_area < whole {
+                continue;
+            }
+            let (line, column) = self.surface_lines[upper];
+            let (lower_line, _) = self.surface_lines[lower];
+            let msg = format!(
+                "surface \"{}\" lies exactly on surface \"{}\" (line {lower_line}): the same \
+                 polygon facing the same way, given twice; remove one (a surface lying on \
+                 another must cover only part of it, like a rug on a floor)",
+                surfaces[upper].name, surfaces[lower].name
+            );
+            self.error(line, column, msg);
         }
     }
 
@@ -522,6 +605,7 @@ impl<'a> Parser<'a> {
             let head = p.colours(name)?;
             Ok((head, p.vertex_lines(count)?))
         })?;
+        self.block_line = (corners.line, corners.column);
         self.check_polygon(&mut corners)?;
         Some(Surface {
             name: head.name,
@@ -620,11 +704,14 @@ impl<'a> Parser<'a> {
                 );
                 return Err(self.unexpected(&wanted));
             }
-            let (v, line) = self.triple(keyword, "coordinate")?;
+            let (read, line) = self.triple_read(keyword, "coordinate")?;
             if k == 0 {
                 (first_line, first_column) = (line.number, line.head().column);
             }
-            vertices.push(v);
+            for (v, token) in read.iter().flatten() {
+                self.check_range(*v, *token, &line);
+            }
+            vertices.push(read.map(|t| t.map_or(0.0, |t| t.0)).into());
         }
         Ok(Corners {
             vertices,
@@ -644,15 +731,36 @@ impl<'a> Parser<'a> {
             let shape = p.box_shape()?;
             Ok((head, facing, shape))
         })?;
-        let (base, height) = match shape {
-            BoxShape::Aligned { origin, size } => (shape::axis_aligned_base(origin, size), size.y),
-            BoxShape::Prism { mut base, height } => {
+        let (base, height, line, column) = match shape {
+            BoxShape::Aligned {
+                origin,
+                size,
+                line,
+                column,
+            } => (shape::axis_aligned_base(origin, size), size.y, line, column),
+            BoxShape::Prism {
+                mut base,
+                height,
+                line,
+                column,
+            } => {
                 self.check_polygon(&mut base)?;
                 let quad = [0, 1, 2, 3].map(|i| base.vertices.get(i).copied().unwrap_or_default());
-                (quad, height)
+                (quad, height, line, column)
             }
         };
+        self.block_line = (line, column);
+        // Each face passes the polygon checks, as a patch would: a box too thin for its
+        // position or its other sizes, too small, or too large is refused here, not met by
+        // the mesher as a face of zero area.
         let faces = shape::box_faces(&base, height, facing);
+        for (suffix, face) in shape::FACE_NAMES.iter().zip(&faces) {
+            if let Err(e) = geometry::validate_polygon(face) {
+                let name = format!("{}.{suffix}", head.name);
+                self.error(line, column, polygon::box_face_message(&name, &e));
+                return None;
+            }
+        }
         let surfaces = shape::FACE_NAMES
             .iter()
             .zip(faces)
@@ -693,19 +801,43 @@ impl<'a> Parser<'a> {
         if self.current_keyword() != Some(Keyword::Origin) {
             return Err(self.unexpected("ORIGIN or VERTICES"));
         }
-        let (origin, _) = self.triple(Keyword::Origin, "coordinate")?;
-        let (size, line) = self.triple(Keyword::Size, "size")?;
+        let (origin_read, origin_line) = self.triple_read(Keyword::Origin, "coordinate")?;
+        let mut origin = [0.0; 3];
+        for (i, found) in origin_read.iter().enumerate() {
+            let Some((v, token)) = *found else { break };
+            origin[i] = v;
+            self.check_range(v, token, &origin_line);
+        }
+        let (read, line) = self.triple_read(Keyword::Size, "size")?;
+        // Only the numbers that were read are checked: a missing or unreadable one has been
+        // reported already, at its own column.
+        let mut size = [0.0; 3];
         for (i, axis) in ["x", "y", "z"].iter().enumerate() {
-            if size[i] <= 0.0 {
-                let token = line.tokens[i + 1];
+            let Some((v, token)) = read[i] else { break };
+            size[i] = v;
+            if v <= 0.0 {
                 let msg = format!(
                     "box sizes must be greater than 0, found \"{}\" for {axis}",
                     token.text
                 );
                 self.error_at(token, &line, msg);
+            } else if (origin[i] + v).abs() > geometry::MAX_COORDINATE {
+                let msg = format!(
+                    "the box reaches {axis} = {:e} (ORIGIN plus SIZE), beyond the largest \
+                     coordinate the program supports ({:e} in magnitude); rescale the scene \
+                     (for instance to metres)",
+                    origin[i] + v,
+                    geometry::MAX_COORDINATE
+                );
+                self.error_at(token, &line, msg);
             }
         }
-        Ok(BoxShape::Aligned { origin, size })
+        Ok(BoxShape::Aligned {
+            origin: origin.into(),
+            size: size.into(),
+            line: line.number,
+            column: line.head().column,
+        })
     }
 
     /// The base quad and `HEIGHT` of a box given as one face plus a height.
@@ -724,7 +856,12 @@ impl<'a> Parser<'a> {
             let msg = format!("HEIGHT must be greater than 0, found \"{}\"", token.text);
             self.error_at(token, &line, msg);
         }
-        Ok(BoxShape::Prism { base, height })
+        Ok(BoxShape::Prism {
+            base,
+            height,
+            line: line.number,
+            column: line.head().column,
+        })
     }
 }
 

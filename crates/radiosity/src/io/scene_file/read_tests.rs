@@ -2,6 +2,7 @@
 //! primitive, and robustness against garbled input.
 
 use super::*;
+use glam::dvec3;
 use crate::geometry;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -752,4 +753,130 @@ fn bad_numbers_do_not_hide_later_errors_in_the_patch() {
     let errs = errors(&text);
     let at: Vec<(usize, usize)> = errs.iter().map(|e| (e.0, e.1)).collect();
     assert_eq!(at, vec![(10, 4), (12, 4), (16, 11)], "{errs:#?}");
+}
+
+// ----- issue 12: hostile geometry -----
+
+// Regression (issue 12): `SIZE` with fewer than three good numbers indexed past the end of
+// the line and panicked; `SIZE 1 abc 1` blamed z for the y that could not be read.
+#[test]
+fn box_size_with_missing_or_bad_numbers_is_an_error_naming_the_axis() {
+    let at = |size: &str| errors(&box_scene("OUT", &format!("ORIGIN 0 0 0\n{size}")));
+    let e = at("SIZE 1 1");
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert_eq!((e[0].0, e[0].1), (14, 9));
+    assert!(e[0].2.contains("(the z size)") && e[0].2.contains("end of line"), "{e:#?}");
+    let e = at("SIZE -1");
+    assert!(e.iter().any(|e| e.2.contains("(the y size)")), "{e:#?}");
+    assert!(e.iter().any(|e| e.2.contains("greater than 0") && e.2.contains("for x")));
+    let e = at("SIZE 1 nan");
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert!(e[0].2.contains("expected a finite number (the y size) after \"SIZE\", found \"nan\""));
+    let e = at("SIZE 1 abc 1");
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert_eq!((e[0].0, e[0].1), (14, 8));
+    assert!(e[0].2.contains("(the y size)") && !e[0].2.contains(" z"), "{e:#?}");
+}
+
+// Regression (issue 12): box faces skipped the polygon checks, and the mesher planned a grid
+// of 0 x 4,294,967,295 for them. Each face now passes the checks a patch does; the error is
+// at the SIZE line and names the face.
+#[test]
+fn box_faces_too_small_or_too_thin_are_refused_at_the_size_line() {
+    let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1e-300 1e-300 1e-300"));
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert_eq!((e[0].0, e[0].1), (14, 1));
+    assert!(e[0].2.contains("\"Table.base\"") && e[0].2.contains("1e-30"), "{e:#?}");
+    // 1e-200 beside 0.2 is lost in rounding: two corners of the base are one point.
+    let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1e-200 1e-200 0.2"));
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert!(e[0].2.contains("same point"), "{e:#?}");
+    // A box of thickness 1e-12 beside 1 (the issue's NaN box was 1e-200 thick): its sides'
+    // corners are 1e-12 of their diameter apart, below the 1e-9 that counts as one point.
+    let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1 1e-12 1"));
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert!(e[0].2.contains("\"Table.side0\"") && e[0].2.contains("same point"), "{e:#?}");
+    // A prism whose height is lost beside its base's coordinates: reported at HEIGHT.
+    let thin = "VERTICES 4\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 1 0 1\nVERTEX3 0 0 1\nHEIGHT 1e-300";
+    let e = errors(&box_scene("OUT", thin));
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert_eq!(e[0].0, 18, "{e:#?}");
+}
+
+// Regression (issue 12): coordinates of 1e20 and more panicked in the BVH builder, and ones
+// near 1e154..1e308 gave "VERTEX0 and VERTEX1 are the same point" (the squared length
+// overflowed). Coordinates beyond 1e30 are refused at their own word, with the range.
+#[test]
+fn coordinates_beyond_the_supported_range_are_refused_at_their_word() {
+    one_error(&with_line(13, "VERTEX0 1e31 0 0"), 13, 9, "(1e30 in magnitude)");
+    let e = errors(&with_lines(&[(13, "VERTEX0 -1e300 0 0"), (15, "VERTEX2 1 1e200 0")]));
+    let at: Vec<(usize, usize)> = e.iter().map(|e| (e.0, e.1)).collect();
+    assert_eq!(at, vec![(13, 9), (15, 11)], "{e:#?}");
+    assert!(!e.iter().any(|e| e.2.contains("same point")), "{e:#?}");
+    let e = errors(&box_scene("OUT", "ORIGIN 1e308 0 0\nSIZE 1e308 1 1"));
+    assert!(e.iter().any(|e| (e.0, e.1) == (13, 8) && e.2.contains("1e30")), "{e:#?}");
+    let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1e308 1 1"));
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert_eq!((e[0].0, e[0].1), (14, 6));
+    assert!(e[0].2.contains("reaches x = 1e308"), "{e:#?}");
+    // Within the range: a quad of +-1e20 is read.
+    let big = with_lines(&[
+        (13, "VERTEX0 -1e20 -1e20 0"),
+        (14, "VERTEX1 1e20 -1e20 0"),
+        (15, "VERTEX2 1e20 1e20 0"),
+        (16, "VERTEX3 -1e20 1e20 0"),
+    ]);
+    assert!(parse_scene(&big, "t").is_ok());
+}
+
+// Regression (issue 12): scaled scenes were refused as "not convex" or "area is zero". The
+// unit square scaled by 1e-30 .. 1e29 and moved off the origin is read everywhere; a
+// square of 1e-31 is refused as too small, not as degenerate.
+#[test]
+fn scaled_and_moved_polygons_are_judged_as_at_unit_scale() {
+    for exp in -30..=29 {
+        let s = 10f64.powi(exp);
+        let lines: Vec<String> = [(0., 0.), (1., 0.), (1., 1.), (0., 1.)]
+            .iter()
+            .enumerate()
+            .map(|(k, (x, y))| format!("VERTEX{k} {} {} {}", x * s + 5.0 * s, y * s, s))
+            .collect();
+        let edits: Vec<(usize, &str)> = (0..4).map(|k| (13 + k, lines[k].as_str())).collect();
+        let text = with_lines(&edits);
+        assert!(parse_scene(&text, "t").is_ok(), "scale 1e{exp}: {:?}", errors(&text));
+    }
+    let tiny = with_lines(&[
+        (13, "VERTEX0 0 0 0"),
+        (14, "VERTEX1 1e-31 0 0"),
+        (15, "VERTEX2 1e-31 1e-31 0"),
+        (16, "VERTEX3 0 1e-31 0"),
+    ]);
+    one_error(&tiny, 13, 1, "less than the smallest the program supports");
+}
+
+// Regression (issue 12): a second floor quad on the floor was accepted silently (row sums of
+// 1.32 in the issue). The same polygon given twice is refused at the second, naming the
+// first's line; a smaller rug in the floor's plane is still a model the mesher handles.
+#[test]
+fn a_surface_given_twice_is_refused_naming_both_lines() {
+    let floor_twice = VALID.replace("SCENEEND\n", "")
+        + &patch("Floor2", "Rg 0.5", "VERTEX2 1 1 0")
+        + "SCENEEND\n";
+    let e = errors(&floor_twice);
+    assert_eq!(e.len(), 1, "{e:#?}");
+    assert_eq!(e[0].0, 27, "{e:#?}");
+    assert!(
+        e[0].2.contains("\"Floor2\" lies exactly on surface \"Floor\" (line 13)"),
+        "{e:#?}"
+    );
+    // Facing the other way (a two-sided wall), or a rug covering part of the floor: read.
+    let back = patch("Back", "Rg 0.5", "VERTEX2 1 1 0")
+        .replace("VERTEX1 1 0 0", "VERTEX1 0 1 0")
+        .replace("VERTEX3 0 1 0\n", "VERTEX3 1 0 0\n");
+    let back_to_back = VALID.replace("SCENEEND\n", "") + &back + "SCENEEND\n";
+    assert_eq!(errors(&back_to_back), vec![]);
+    let rug = VALID.replace("SCENEEND\n", "")
+        + &patch("Rug", "Rg 0.5", "VERTEX2 1 0.5 0").replace("VERTEX3 0 1 0", "VERTEX3 0 0.5 0")
+        + "SCENEEND\n";
+    assert_eq!(errors(&rug), vec![]);
 }
