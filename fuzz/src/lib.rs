@@ -12,7 +12,6 @@ use radiosity::geometry;
 use radiosity::io::form_factor_file::read_form_factors;
 use radiosity::io::scene_file::{parse_scene, read_scene, write_scene};
 use radiosity::progress::NoProgress;
-use radiosity::scene::Scene;
 use radiosity::solve::keep_going;
 use radiosity::{pipeline, shade, MeshSettings, Prepared, SolveRequest, Solver};
 
@@ -32,39 +31,6 @@ pub const SOLVE_ELEMENTS: usize = 16;
 /// ... with `INTEGRAL_STEPS` lowered to at most this.
 pub const SOLVE_STEPS: u32 = 3;
 
-/// Harness bound for a known issue (#12: obvhs panics building the occluder BVH of scenes
-/// with coordinates of 1e20 and more): scenes with a coordinate larger than this in
-/// magnitude are parsed, written and parsed again, but not meshed.
-pub const MAX_COORDINATE: f64 = 1e12;
-
-/// Harness bound for a known issue (#12: box faces skip the polygon checks, so a box of
-/// thickness 1e-200 plans a grid of 4.3e9 vertices or makes NaN elements, and the writer
-/// writes its faces as patches that the reader then refuses): scenes with an edge shorter
-/// than this fraction of the scene's extent, or a surface whose area is less than its square
-/// times the extent squared, are not meshed, nor held to reading back what they write.
-pub const MIN_RELATIVE_EDGE: f64 = 1e-6;
-
-/// Harness bound for a known issue (#12: a box whose `SIZE` line has fewer than three
-/// good numbers, `SIZE 1 1`, `SIZE -1`, `SIZE 1 nan`, panics with an index out of bounds in
-/// the reader): true when every `SIZE` line of `text` has three finite numbers, split into
-/// lines, comments and words exactly as the reader's lexer does. Inputs with such a line are
-/// not given to the reader at all.
-pub fn size_lines_complete(text: &str) -> bool {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    text.lines().all(|raw| {
-        let code = raw.find("//").map_or(raw, |p| &raw[..p]);
-        let words: Vec<&str> = code.split_whitespace().collect();
-        match words.first() {
-            Some(w) if w.eq_ignore_ascii_case("SIZE") => {
-                words.len() >= 4
-                    && words[1..4]
-                        .iter()
-                        .all(|w| w.parse::<f64>().is_ok_and(f64::is_finite))
-            }
-            _ => true,
-        }
-    })
-}
 
 /// Sets up what every target shares: one rayon thread (fuzzing takes one core; a second
 /// thread would only add noise to coverage).
@@ -107,9 +73,6 @@ pub fn scene_file(data: &[u8]) {
             return;
         }
     };
-    if !size_lines_complete(text) {
-        return;
-    }
     let file = match parse_scene(text, "fuzz.scene") {
         Ok(file) => file,
         Err(error) => {
@@ -119,20 +82,17 @@ pub fn scene_file(data: &[u8]) {
         }
     };
 
-    // The writer's output must read back (within the known-issue bounds: degenerate box
-    // faces are accepted by the reader but refused when read back as patches). The writer
-    // may refuse, cleanly, a name the reader accepts: one with a lone carriage return; see
-    // fuzz/RESULTS.md.
-    let bounded = within_known_issue_bounds(&file.scene);
+    // The writer's output must read back. The writer may refuse, cleanly, a name the
+    // reader accepts: one with a lone carriage return; see fuzz/RESULTS.md.
     let mut written = Vec::new();
-    if write_scene(&file.scene, file.settings, &mut written).is_ok() && bounded {
+    if write_scene(&file.scene, file.settings, &mut written).is_ok() {
         let written = String::from_utf8(written).expect("the writer writes UTF-8");
         if let Err(e) = parse_scene(&written, "written.scene") {
             panic!("a parsed scene, written back, does not parse again: {e}\n--- written:\n{written}");
         }
     }
 
-    if file.scene.surfaces.len() > MESH_SURFACES || !bounded {
+    if file.scene.surfaces.len() > MESH_SURFACES {
         return;
     }
     let total_area: f64 = file
@@ -164,25 +124,6 @@ pub fn scene_file(data: &[u8]) {
     }
 }
 
-/// False for the scenes in the two known issues that [`MAX_COORDINATE`] and
-/// [`MIN_RELATIVE_EDGE`] describe.
-fn within_known_issue_bounds(scene: &Scene) -> bool {
-    let points = || scene.surfaces.iter().flat_map(|s| s.vertices.iter());
-    if points().any(|p| !(p.abs().max_element() <= MAX_COORDINATE)) {
-        return false;
-    }
-    let (lo, hi) = scene.bounds();
-    let extent = (hi - lo).max_element();
-    if !(extent > 0.0) {
-        return false;
-    }
-    let min_edge = MIN_RELATIVE_EDGE * extent;
-    scene.surfaces.iter().all(|s| {
-        let n = s.vertices.len();
-        let edges_ok = (0..n).all(|i| (s.vertices[(i + 1) % n] - s.vertices[i]).length() >= min_edge);
-        edges_ok && geometry::polygon_area(&s.vertices) >= min_edge * min_edge
-    })
-}
 
 /// The scene every form-factor input is read against: two facing unit squares, one
 /// element each, and a floor of two (four elements in all), with its fingerprint and method.
@@ -284,8 +225,8 @@ fn read_and_solve(data: &[u8]) {
         }
     };
     // A forged file whose n is not the mesh's but whose fingerprint is (n = 0, say) is read
-    // here and refused by the solve: a known issue of #12 (the refusal does not name the
-    // file), so only a panic in that solve counts.
+    // here and refused by the solve (which names the file since #12), so only a panic in
+    // that solve counts.
     let _ = matrix.row_sums();
     let _ = matrix.reciprocity(&prepared.areas());
     let mut request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);

@@ -14,7 +14,7 @@
 //! The hierarchy is in f32 and obvhs has absolute constants (a ray skips the boxes it leaves
 //! within 1e-4 of its origin), so it is built in its own units: scene coordinates less the
 //! centre of the scene's bounding box, times a power of two that makes the scene's diagonal
-//! 1024 to 2048 units long. Scaling by a power of two is exact, so the hierarchy and every
+//! 16 to 32 units long. Scaling by a power of two is exact, so the hierarchy and every
 //! answer are the same at any scale (a scene in metres or in light years, within
 //! [`crate::geometry::MAX_COORDINATE`]), no f32 box area overflows or underflows, and a scene
 //! far from the origin (a room at x = 1e9) keeps f32's precision. The leaf tests stay in
@@ -116,8 +116,8 @@ impl PolygonBvh {
         // the f32, quantised node boxes of the CWBVH cannot make a ray miss a polygon it
         // meets. With 1e-6 of the scene size, one Monte Carlo ray in 10^5 leaked out of a
         // closed cube near a corner; 1e-5 closes the leak (f32 rounds the hierarchy's
-        // coordinates, at most 2048 from its centre, by 1.2e-4 units at most: well inside
-        // the pad, at least 1e-2 units).
+        // coordinates, at most 32 from its centre, by 3.8e-6 units at most: well inside
+        // the pad, at least 1.6e-4 units).
         let pad = (1e-5 * scale * to_local) as f32;
         let bounds: Vec<Bounds> = polygons
             .iter()
@@ -407,15 +407,23 @@ impl PolygonBvh {
     }
 }
 
-/// The power of two that makes a scene of diagonal `scale` 1024 to 2048 of the hierarchy's
-/// units long (module documentation).
+/// The shortest diagonal of the scene in the hierarchy's units (module documentation): 16,
+/// so that obvhs's absolute constants are small against the scene (its rays skip boxes
+/// they leave within 1e-4 of their origin: 6e-6 of the diagonal at most) and large against
+/// f32's rounding there (the ulp at 32 is 3.8e-6, below the 1e-5 its debug validation of a
+/// built hierarchy allows; at 1024 to 2048 units, the ulp of 1.2e-4 failed that validation
+/// on two ordinary boxes, found by the fuzzer).
+const LOCAL_DIAGONAL: f64 = 16.0;
+
+/// The power of two that makes a scene of diagonal `scale` [`LOCAL_DIAGONAL`] to twice that
+/// of the hierarchy's units long (module documentation).
 fn local_unit(scale: f64) -> f64 {
-    let e = (1024.0 / scale).log2().floor().clamp(-1000.0, 1000.0) as i32;
+    let e = (LOCAL_DIAGONAL / scale).log2().floor().clamp(-1000.0, 1000.0) as i32;
     let unit = 2f64.powi(e);
     // log2 may round either way; one step fixes it.
-    if scale * unit < 1024.0 {
+    if scale * unit < LOCAL_DIAGONAL {
         2.0 * unit
-    } else if scale * unit >= 2048.0 {
+    } else if scale * unit >= 2.0 * LOCAL_DIAGONAL {
         0.5 * unit
     } else {
         unit
@@ -492,13 +500,13 @@ mod tests {
         // An edge belongs to the square.
         assert_eq!(bvh.polygon_at(dvec3(1.0, 0.5, 1.0), 1e-6), Some(1));
         // What polygon_at replaces: obvhs skips the boxes a ray leaves within 1e-4 of its
-        // origin, in the hierarchy's units (the diagonal, sqrt(2 + 1e-6), is 2^10 = 1024 of
-        // them: a square far from these units would see the same). A ray of 2e-6 scene
-        // units (2e-3 units of the hierarchy) finds the square; one of 2e-8 (2e-5 units,
-        // below 1e-4) finds nothing. If the second starts to pass, obvhs has changed and the
-        // note at polygon_at can go.
+        // origin, in the hierarchy's units (the diagonal, sqrt(2 + 1e-6), is 16 of them
+        // times sqrt 2: a square far from these units would see the same). A ray of 2e-4
+        // scene units (3.2e-3 units of the hierarchy) finds the square; one of 2e-8 (3.2e-7
+        // units, below 1e-4) finds nothing. If the second starts to pass, obvhs has changed
+        // and the note at polygon_at can go.
         assert_eq!(
-            bvh.closest_hit(p + 1e-6 * DVec3::Z, -DVec3::Z, 0.0, 2e-6).map(|h| h.id),
+            bvh.closest_hit(p + 1e-4 * DVec3::Z, -DVec3::Z, 0.0, 2e-4).map(|h| h.id),
             Some(1)
         );
         assert_eq!(
