@@ -283,9 +283,13 @@ fn read_and_solve(data: &[u8]) {
             return;
         }
     };
-    // A forged file whose n is not the mesh's but whose fingerprint is (n = 0, say) is read
-    // here and refused by the solve: a known issue of #12 (the refusal does not name the
-    // file), so only a panic in that solve counts.
+    // A forged file whose n is not the mesh's but whose fingerprint is (n = 0 or 5, say) is
+    // read here: a known issue of #12 (`check` then panics in `reciprocity`, index out of
+    // bounds; fixed on harden-budgets, fcd5b3c, where `load_form_factors` refuses it). Bound:
+    // such a matrix goes no further.
+    if matrix.n() != prepared.mesh.len() {
+        return;
+    }
     let _ = matrix.row_sums();
     let _ = matrix.reciprocity(&prepared.areas());
     let mut request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
