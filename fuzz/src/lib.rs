@@ -224,9 +224,18 @@ fn read_and_solve(data: &[u8]) {
             return;
         }
     };
-    // A forged file whose n is not the mesh's but whose fingerprint is (n = 0, say) is read
-    // here and refused by the solve (which names the file since #12), so only a panic in
-    // that solve counts.
+    // A forged file whose n is not the mesh's but whose fingerprint is (n = 0 or 5, say)
+    // is read here: the file reader does not know the mesh's element count. The program
+    // loads through `Prepared::load_form_factors`, which refuses it (naming the file, since
+    // #12); before that, `check` panicked in `reciprocity` (index out of bounds). So such a
+    // matrix goes no further here either.
+    if matrix.n() != prepared.mesh.len() {
+        std::fs::write(&path, data).expect("writing the scratch file");
+        let refused = prepared.load_form_factors(&path, &NoProgress);
+        let _ = std::fs::remove_file(&path);
+        assert!(refused.is_err(), "a matrix of another size was loaded");
+        return;
+    }
     let _ = matrix.row_sums();
     let _ = matrix.reciprocity(&prepared.areas());
     let mut request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
