@@ -14,10 +14,7 @@
 //! The hierarchy is in f32 and obvhs has absolute constants (a ray skips the boxes it leaves
 //! within 1e-4 of its origin), so it is built in its own units: scene coordinates less the
 //! centre of the scene's bounding box, times a power of two that makes the scene's diagonal
-//! 8 to 16 units long. (Small enough that f32 rounds coordinates, at most 8 from the
-//! centre, by under 1e-6 units, well inside the 1e-5 obvhs allows its node boxes when it
-//! checks its tree; large enough that its 1e-4 is about the boxes' own padding, 1e-5 of the
-//! diagonal.) Scaling by a power of two is exact, so the hierarchy and every
+//! 16 to 32 units long. Scaling by a power of two is exact, so the hierarchy and every
 //! answer are the same at any scale (a scene in metres or in light years, within
 //! [`crate::geometry::MAX_COORDINATE`]), no f32 box area overflows or underflows, and a scene
 //! far from the origin (a room at x = 1e9) keeps f32's precision. The leaf tests stay in
@@ -119,8 +116,8 @@ impl PolygonBvh {
         // the f32, quantised node boxes of the CWBVH cannot make a ray miss a polygon it
         // meets. With 1e-6 of the scene size, one Monte Carlo ray in 10^5 leaked out of a
         // closed cube near a corner; 1e-5 closes the leak (f32 rounds the hierarchy's
-        // coordinates, at most 8 from its centre, by under 1e-6 units: well inside the pad,
-        // at least 8e-5 units).
+        // coordinates, at most 32 from its centre, by 3.8e-6 units at most: well inside
+        // the pad, at least 1.6e-4 units).
         let pad = (1e-5 * scale * to_local) as f32;
         let bounds: Vec<Bounds> = polygons
             .iter()
@@ -363,7 +360,7 @@ impl PolygonBvh {
     ///
     /// A box query and the inside test, not a ray: obvhs's ray traversal skips every box
     /// that a ray leaves within 1e-4 of its origin (an absolute distance in the hierarchy's
-    /// units, its `EPSILON`, which stands in for the ray's own t_min; 6e-6 to 1.2e-5 of the
+    /// units, its `EPSILON`, which stands in for the ray's own t_min; about 1e-7 of the
     /// scene's diagonal), so a short enough ray through a point on a polygon finds nothing.
     pub fn polygon_at(&self, p: DVec3, tolerance: f64) -> Option<u32> {
         let mut candidates = Vec::new();
@@ -410,15 +407,23 @@ impl PolygonBvh {
     }
 }
 
-/// The power of two that makes a scene of diagonal `scale` 8 to 16 of the hierarchy's units
-/// long (module documentation).
+/// The shortest diagonal of the scene in the hierarchy's units (module documentation): 16,
+/// so that obvhs's absolute constants are small against the scene (its rays skip boxes
+/// they leave within 1e-4 of their origin: 6e-6 of the diagonal at most) and large against
+/// f32's rounding there (the ulp at 32 is 3.8e-6, below the 1e-5 its debug validation of a
+/// built hierarchy allows; at 1024 to 2048 units, the ulp of 1.2e-4 failed that validation
+/// on two ordinary boxes, found by the fuzzer).
+const LOCAL_DIAGONAL: f64 = 16.0;
+
+/// The power of two that makes a scene of diagonal `scale` [`LOCAL_DIAGONAL`] to twice that
+/// of the hierarchy's units long (module documentation).
 fn local_unit(scale: f64) -> f64 {
-    let e = (8.0 / scale).log2().floor().clamp(-1000.0, 1000.0) as i32;
+    let e = (LOCAL_DIAGONAL / scale).log2().floor().clamp(-1000.0, 1000.0) as i32;
     let unit = 2f64.powi(e);
     // log2 may round either way; one step fixes it.
-    if scale * unit < 8.0 {
+    if scale * unit < LOCAL_DIAGONAL {
         2.0 * unit
-    } else if scale * unit >= 16.0 {
+    } else if scale * unit >= 2.0 * LOCAL_DIAGONAL {
         0.5 * unit
     } else {
         unit
@@ -495,13 +500,18 @@ mod tests {
         // An edge belongs to the square.
         assert_eq!(bvh.polygon_at(dvec3(1.0, 0.5, 1.0), 1e-6), Some(1));
         // What polygon_at replaces: obvhs skips the boxes a ray leaves within 1e-4 of its
-        // origin, in the hierarchy's units (the diagonal, sqrt(2 + 1e-6), is 8 x sqrt(2) of
-        // them). A ray from 1e-5 above the square leaves its box (padded by 1e-5 of the
-        // diagonal) 2.4e-5 scene units, 1.9e-4 units of the hierarchy, further on: it finds
-        // the square, at any scale of the scene.
+        // origin, in the hierarchy's units (the diagonal, sqrt(2 + 1e-6), is 16 of them
+        // times sqrt 2: a square far from these units would see the same). A ray of 2e-4
+        // scene units (3.2e-3 units of the hierarchy) finds the square; one of 2e-8 (3.2e-7
+        // units, below 1e-4) finds nothing. If the second starts to pass, obvhs has changed
+        // and the note at polygon_at can go.
         assert_eq!(
-            bvh.closest_hit(p + 1e-5 * DVec3::Z, -DVec3::Z, 0.0, 2e-5).map(|h| h.id),
+            bvh.closest_hit(p + 1e-4 * DVec3::Z, -DVec3::Z, 0.0, 2e-4).map(|h| h.id),
             Some(1)
+        );
+        assert_eq!(
+            bvh.closest_hit(p + 1e-8 * DVec3::Z, -DVec3::Z, 0.0, 2e-8),
+            None
         );
     }
 
