@@ -746,3 +746,57 @@ fn check_lists_surfaces_lying_on_others() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A box scene (a room facing in, its floor... all faces emitting) with the given ORIGIN
+/// and SIZE lines and MAX_PATCH_AREA.
+fn box_room_scene(max_area: &str, origin: &str, size: &str) -> String {
+    format!(
+        "MAX_PATCH_AREA {max_area}\nINTEGRAL_STEPS 1\nSCENEBEGIN\nBOXBEGIN\n#Room\nFACING IN\n\
+         Er 1\nEg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\nORIGIN {origin}\nSIZE {size}\nBOXEND\n\
+         SCENEEND\n"
+    )
+}
+
+// Regression (issue 12): these panicked (SIZE 1 1, the +-1e20 quad), headed for ~100 GB
+// (SIZE 1e-300 ...), or were refused without a file and line (SIZE 1e308, a tiny
+// MAX_PATCH_AREA); a floor given twice was accepted silently.
+#[test]
+fn hostile_scene_geometry_is_refused_with_file_and_line() {
+    let dir = scratch_dir("hostile_geometry");
+    let cases = [
+        ("1", "0 0 0", "1 1", "h.scene:14:9: error: expected a number (the z size)"),
+        ("1", "0 0 0", "1 abc 1", "h.scene:14:8: error: expected a number (the y size)"),
+        ("1", "0 0 0", "1e-300 1e-300 1e-300", "h.scene:14:1: error: the box's face \"Room.base\""),
+        ("1", "0 0 0", "1e308 1 1", "h.scene:14:6: error: the box reaches x = 1e308"),
+        ("1e-300", "0 0 0", "1 1 1", "error: h.scene:1: MAX_PATCH_AREA 1e-300: meshing"),
+    ];
+    for (max_area, origin, size, expected) in cases {
+        std::fs::write(dir.join("h.scene"), box_room_scene(max_area, origin, size)).unwrap();
+        let out = radiosity(&["check", "h.scene"], &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "SIZE {size}: {err}");
+        assert!(err.contains(expected), "SIZE {size}: {err}");
+        assert!(!err.contains("panicked") && !err.contains(" inf"), "SIZE {size}: {err}");
+    }
+    // The floor of the rug scene given twice.
+    let scene = floor_and_rug_scene(0.0).replace("#Rug", "#Floor2").replace(
+        "VERTEX0 3 0 1\nVERTEX1 1 0 1\nVERTEX2 1 0 2\nVERTEX3 3 0 2",
+        "VERTEX0 4 0 0\nVERTEX1 0 0 0\nVERTEX2 0 0 4\nVERTEX3 4 0 4",
+    );
+    std::fs::write(dir.join("twice.scene"), scene).unwrap();
+    let out = radiosity(&["check", "twice.scene"], &dir);
+    let err = stderr(&out);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("twice.scene:27:1: error: surface \"Floor2\" lies exactly on surface \"Floor\" (line 13)"),
+        "{err}"
+    );
+    // A quad of +-1e20 is within the supported range: solved.
+    let q = "MAX_PATCH_AREA 1e41\nINTEGRAL_STEPS 1\nSCENEBEGIN\nPATCHBEGIN\n#Q\nVERTICES 4\n\
+             Er 1\nEg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\nVERTEX0 -1e20 -1e20 0\n\
+             VERTEX1 1e20 -1e20 0\nVERTEX2 1e20 1e20 0\nVERTEX3 -1e20 1e20 0\nPATCHEND\nSCENEEND\n";
+    std::fs::write(dir.join("q.scene"), q).unwrap();
+    let out = radiosity(&["check", "q.scene"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
