@@ -157,7 +157,8 @@ fn convex_hull(mut points: Vec<(f64, f64, usize)>) -> Vec<(f64, f64, usize)> {
             Box::new(points.iter().rev())
         };
         for &p in ordered {
-            while hull.len() >= start + 2 && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            while hull.len() >= start + 2
+                && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
             {
                 hull.pop();
             }
@@ -362,7 +363,8 @@ pub fn validate_polygon(vertices: &[DVec3]) -> Result<(), PolygonError> {
 /// vertices[0] + unit * local[i]`. The coordinates are first scaled into [-1, 1], so the
 /// differences cannot overflow. Finite coordinates assumed.
 fn normalised(vertices: &[DVec3]) -> (Vec<DVec3>, f64) {
-    let largest = |vs: &mut dyn Iterator<Item = DVec3>| vs.map(|v| v.abs().max_element()).fold(0.0, f64::max);
+    let largest =
+        |vs: &mut dyn Iterator<Item = DVec3>| vs.map(|v| v.abs().max_element()).fold(0.0, f64::max);
     let first = power_of_two_at_least(largest(&mut vertices.iter().copied()));
     let o = vertices[0] / first;
     let moved: Vec<DVec3> = vertices.iter().map(|v| *v / first - o).collect();
@@ -448,7 +450,10 @@ fn repeated_corner(vertices: &[DVec3], diameter: f64) -> Option<(usize, usize)> 
                         continue;
                     };
                     for &j in near {
-                        if j > i && v.distance(vertices[j]) <= limit && first.is_none_or(|f| (i, j) < f) {
+                        if j > i
+                            && v.distance(vertices[j]) <= limit
+                            && first.is_none_or(|f| (i, j) < f)
+                        {
                             first = Some((i, j));
                         }
                     }

@@ -263,7 +263,11 @@ fn meshing_refuses_a_degenerate_surface_before_planning() {
         camera: None,
     };
     match mesh_scene(&scene, 1.0) {
-        Err(MeshError::InvalidSurface { surface: 0, error: PolygonError::TooSmall { .. }, .. }) => {}
+        Err(MeshError::InvalidSurface {
+            surface: 0,
+            error: PolygonError::TooSmall { .. },
+            ..
+        }) => {}
         other => panic!("{other:?}"),
     }
     // A MAX_PATCH_AREA so small that the count overflows: refused with a finite suggestion.
@@ -279,7 +283,11 @@ fn meshing_refuses_a_degenerate_surface_before_planning() {
         Err(e @ MeshError::TooManyElements { suggested, .. }) => {
             // Area 1 over 8 million elements, with the 5 % margin.
             assert!((suggested - 1.05 / 8e6).abs() < 1e-15, "{e}");
-            assert!(e.to_string().contains("MAX_PATCH_AREA = 1e-300 would make more than 1.8e19"), "{e}");
+            assert!(
+                e.to_string()
+                    .contains("MAX_PATCH_AREA = 1e-300 would make more than 1.8e19"),
+                "{e}"
+            );
         }
         other => panic!("{other:?}"),
     }
@@ -307,8 +315,14 @@ fn ray_queries_answer_the_same_at_any_scale_and_position() {
     ] {
         let bvh = PolygonBvh::new(&[square(s, shift)], &[7]);
         let at = |x: f64, y: f64, z: f64| dvec3(x, y, z) * s + shift;
-        assert!(bvh.segment_blocked(at(0.5, 0.5, 0.0), at(0.5, 0.5, 2.0)), "scale {s}");
-        assert!(!bvh.segment_blocked(at(1.5, 0.5, 0.0), at(1.5, 0.5, 2.0)), "scale {s}");
+        assert!(
+            bvh.segment_blocked(at(0.5, 0.5, 0.0), at(0.5, 0.5, 2.0)),
+            "scale {s}"
+        );
+        assert!(
+            !bvh.segment_blocked(at(1.5, 0.5, 0.0), at(1.5, 0.5, 2.0)),
+            "scale {s}"
+        );
         let hit = bvh.closest_hit(at(0.25, 0.75, 0.0), DVec3::Z, 0.0, f64::INFINITY);
         let hit = hit.unwrap_or_else(|| panic!("scale {s}, shift {shift}"));
         assert_eq!(hit.id, 7);
@@ -326,9 +340,17 @@ fn ray_queries_answer_the_same_at_any_scale_and_position() {
         );
         let mut ceiling = floor.clone();
         ceiling.name = "ceiling".into();
-        ceiling.vertices = floor.vertices.iter().rev().map(|v| *v + dvec3(0., q, 0.)).collect();
+        ceiling.vertices = floor
+            .vertices
+            .iter()
+            .rev()
+            .map(|v| *v + dvec3(0., q, 0.))
+            .collect();
         let p = prepared(
-            Scene { surfaces: vec![floor, ceiling], camera: None },
+            Scene {
+                surfaces: vec![floor, ceiling],
+                camera: None,
+            },
             0.1 * q * q,
         );
         let (f, _) = p.form_factors(&NoProgress).unwrap();
@@ -339,13 +361,20 @@ fn ray_queries_answer_the_same_at_any_scale_and_position() {
         floor_elements
             .map(|i| {
                 let i = i as usize;
-                areas[i] * (0..f.n()).filter(|&j| p.mesh.elements[j].surface == 1).map(|j| f.get(i, j)).sum::<f64>()
+                areas[i]
+                    * (0..f.n())
+                        .filter(|&j| p.mesh.elements[j].surface == 1)
+                        .map(|j| f.get(i, j))
+                        .sum::<f64>()
             })
             .sum::<f64>()
             / total
     };
     let (at_unit, at_1e20) = (opposed(1.0), opposed(1e20));
-    assert!((at_unit - at_1e20).abs() <= 2f64.powi(-22) * at_unit, "{at_unit} {at_1e20}");
+    assert!(
+        (at_unit - at_1e20).abs() <= 2f64.powi(-22) * at_unit,
+        "{at_unit} {at_1e20}"
+    );
     // Parallel opposed squares of side 2 at distance 1 (Howell's catalogue, C-11, X = Y = 2):
     // F = 0.415253. Forty elements a face and 2 x 2 points an element: within 1 %.
     assert!((at_1e20 - 0.415_253).abs() < 0.01 * 0.415_253, "{at_1e20}");

@@ -2,8 +2,8 @@
 //! primitive, and robustness against garbled input.
 
 use super::*;
-use glam::dvec3;
 use crate::geometry;
+use glam::dvec3;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -765,17 +765,27 @@ fn box_size_with_missing_or_bad_numbers_is_an_error_naming_the_axis() {
     let e = at("SIZE 1 1");
     assert_eq!(e.len(), 1, "{e:#?}");
     assert_eq!((e[0].0, e[0].1), (14, 9));
-    assert!(e[0].2.contains("(the z size)") && e[0].2.contains("end of line"), "{e:#?}");
+    assert!(
+        e[0].2.contains("(the z size)") && e[0].2.contains("end of line"),
+        "{e:#?}"
+    );
     let e = at("SIZE -1");
     assert!(e.iter().any(|e| e.2.contains("(the y size)")), "{e:#?}");
-    assert!(e.iter().any(|e| e.2.contains("greater than 0") && e.2.contains("for x")));
+    assert!(e
+        .iter()
+        .any(|e| e.2.contains("greater than 0") && e.2.contains("for x")));
     let e = at("SIZE 1 nan");
     assert_eq!(e.len(), 1, "{e:#?}");
-    assert!(e[0].2.contains("expected a finite number (the y size) after \"SIZE\", found \"nan\""));
+    assert!(e[0]
+        .2
+        .contains("expected a finite number (the y size) after \"SIZE\", found \"nan\""));
     let e = at("SIZE 1 abc 1");
     assert_eq!(e.len(), 1, "{e:#?}");
     assert_eq!((e[0].0, e[0].1), (14, 8));
-    assert!(e[0].2.contains("(the y size)") && !e[0].2.contains(" z"), "{e:#?}");
+    assert!(
+        e[0].2.contains("(the y size)") && !e[0].2.contains(" z"),
+        "{e:#?}"
+    );
 }
 
 // Regression (issue 12): box faces skipped the polygon checks, and the mesher planned a grid
@@ -786,7 +796,10 @@ fn box_faces_too_small_or_too_thin_are_refused_at_the_size_line() {
     let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1e-300 1e-300 1e-300"));
     assert_eq!(e.len(), 1, "{e:#?}");
     assert_eq!((e[0].0, e[0].1), (14, 1));
-    assert!(e[0].2.contains("\"Table.base\"") && e[0].2.contains("1e-30"), "{e:#?}");
+    assert!(
+        e[0].2.contains("\"Table.base\"") && e[0].2.contains("1e-30"),
+        "{e:#?}"
+    );
     // 1e-200 beside 0.2 is lost in rounding: two corners of the base are one point.
     let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1e-200 1e-200 0.2"));
     assert_eq!(e.len(), 1, "{e:#?}");
@@ -795,9 +808,13 @@ fn box_faces_too_small_or_too_thin_are_refused_at_the_size_line() {
     // corners are 1e-12 of their diameter apart, below the 1e-9 that counts as one point.
     let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1 1e-12 1"));
     assert_eq!(e.len(), 1, "{e:#?}");
-    assert!(e[0].2.contains("\"Table.side0\"") && e[0].2.contains("same point"), "{e:#?}");
+    assert!(
+        e[0].2.contains("\"Table.side0\"") && e[0].2.contains("same point"),
+        "{e:#?}"
+    );
     // A prism whose height is lost beside its base's coordinates: reported at HEIGHT.
-    let thin = "VERTICES 4\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 1 0 1\nVERTEX3 0 0 1\nHEIGHT 1e-300";
+    let thin =
+        "VERTICES 4\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 1 0 1\nVERTEX3 0 0 1\nHEIGHT 1e-300";
     let e = errors(&box_scene("OUT", thin));
     assert_eq!(e.len(), 1, "{e:#?}");
     assert_eq!(e[0].0, 18, "{e:#?}");
@@ -808,13 +825,25 @@ fn box_faces_too_small_or_too_thin_are_refused_at_the_size_line() {
 // overflowed). Coordinates beyond 1e30 are refused at their own word, with the range.
 #[test]
 fn coordinates_beyond_the_supported_range_are_refused_at_their_word() {
-    one_error(&with_line(13, "VERTEX0 1e31 0 0"), 13, 9, "(1e30 in magnitude)");
-    let e = errors(&with_lines(&[(13, "VERTEX0 -1e300 0 0"), (15, "VERTEX2 1 1e200 0")]));
+    one_error(
+        &with_line(13, "VERTEX0 1e31 0 0"),
+        13,
+        9,
+        "(1e30 in magnitude)",
+    );
+    let e = errors(&with_lines(&[
+        (13, "VERTEX0 -1e300 0 0"),
+        (15, "VERTEX2 1 1e200 0"),
+    ]));
     let at: Vec<(usize, usize)> = e.iter().map(|e| (e.0, e.1)).collect();
     assert_eq!(at, vec![(13, 9), (15, 11)], "{e:#?}");
     assert!(!e.iter().any(|e| e.2.contains("same point")), "{e:#?}");
     let e = errors(&box_scene("OUT", "ORIGIN 1e308 0 0\nSIZE 1e308 1 1"));
-    assert!(e.iter().any(|e| (e.0, e.1) == (13, 8) && e.2.contains("1e30")), "{e:#?}");
+    assert!(
+        e.iter()
+            .any(|e| (e.0, e.1) == (13, 8) && e.2.contains("1e30")),
+        "{e:#?}"
+    );
     let e = errors(&box_scene("OUT", "ORIGIN 0 0 0\nSIZE 1e308 1 1"));
     assert_eq!(e.len(), 1, "{e:#?}");
     assert_eq!((e[0].0, e[0].1), (14, 6));
@@ -843,7 +872,11 @@ fn scaled_and_moved_polygons_are_judged_as_at_unit_scale() {
             .collect();
         let edits: Vec<(usize, &str)> = (0..4).map(|k| (13 + k, lines[k].as_str())).collect();
         let text = with_lines(&edits);
-        assert!(parse_scene(&text, "t").is_ok(), "scale 1e{exp}: {:?}", errors(&text));
+        assert!(
+            parse_scene(&text, "t").is_ok(),
+            "scale 1e{exp}: {:?}",
+            errors(&text)
+        );
     }
     let tiny = with_lines(&[
         (13, "VERTEX0 0 0 0"),
@@ -866,7 +899,8 @@ fn a_surface_given_twice_is_refused_naming_both_lines() {
     assert_eq!(e.len(), 1, "{e:#?}");
     assert_eq!(e[0].0, 27, "{e:#?}");
     assert!(
-        e[0].2.contains("\"Floor2\" lies exactly on surface \"Floor\" (line 13)"),
+        e[0].2
+            .contains("\"Floor2\" lies exactly on surface \"Floor\" (line 13)"),
         "{e:#?}"
     );
     // Facing the other way (a two-sided wall), or a rug covering part of the floor: read.
