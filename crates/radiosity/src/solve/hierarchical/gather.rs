@@ -211,8 +211,8 @@ impl Solver<'_> {
         if nq.is_cluster() {
             let m = self.normal[nl.surface as usize];
             let d = (nl.centre - nq.centre).normalize_or(DVec3::Z);
-            let g = mean_cos_over_r2(nl.polygon(), m, nq.centre) / std::f64::consts::PI
-                * link.visible as f64;
+            let g = mean_cos_over_r2(nl.polygon(), m, nq.centre) / std::f64::consts::PI;
+            let g = g * self.cluster_link_factor(nl, nq, d, g) * link.visible as f64;
             if g > 0.0 {
                 terms
                     .clusters

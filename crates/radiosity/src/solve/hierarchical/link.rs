@@ -153,6 +153,7 @@ impl Solver<'_> {
                     return Estimate::Nothing;
                 }
                 let g = mean_cos_over_r2(np.polygon(), mp, nq.centre) / std::f64::consts::PI;
+                let g = g * self.cluster_link_factor(np, nq, d, g);
                 (g, self.cluster_oracle(np, nq, d, r))
             }
             (true, false) => {
@@ -163,12 +164,14 @@ impl Solver<'_> {
                 }
                 let g =
                     nq.area * mean_cos_over_r2(nq.polygon(), mq, np.centre) / std::f64::consts::PI;
+                let g = g * self.cluster_link_factor(np, nq, d, g);
                 (g, self.cluster_oracle(np, nq, d, r))
             }
-            (true, true) => (
-                1.0 / (std::f64::consts::PI * r * r),
-                self.cluster_oracle(np, nq, d, r),
-            ),
+            (true, true) => {
+                let g = 1.0 / (std::f64::consts::PI * r * r);
+                let g = g * self.cluster_link_factor(np, nq, d, g);
+                (g, self.cluster_oracle(np, nq, d, r))
+            }
         };
         if g <= 0.0 && oracle <= 0.0 {
             return Estimate::Nothing;

@@ -39,7 +39,11 @@
 //! * cluster <- patch: the patch's intensity B_q A_q cos+(theta_q) / pi into p's bins;
 //! * cluster <- cluster: I_q(d) into p's bins;
 //!
-//! each times the visible fraction of point pairs (see [`Solver::visibility`]). A link that
+//! each times the visible fraction of point pairs (see [`Solver::visibility`]), and each
+//! link that involves a cluster times the ratio of its exchange summed over the two nodes'
+//! sample points to the point model's (the `cluster_geometry` module: the point model
+//! overstates clusters that meet at an angle, and a closed room of coplanar wall pieces
+//! counted 7.3 % of its light twice without it). A link that
 //! involves a cluster is only made between a cluster and a node that its bounding sphere
 //! does not reach (a patch's box, another cluster's sphere); closer pairs are always
 //! refined. Initial linking is the root cluster's link to itself, refined: it costs about
@@ -132,6 +136,7 @@
 #![allow(clippy::needless_range_loop)] // bands and bins read best as indices
 
 mod bins;
+mod cluster_geometry;
 mod contact;
 mod export;
 mod gather;

@@ -19,7 +19,7 @@ const SPAN_WEIGHT: f64 = 2.0;
 impl Solver<'_> {
     /// The area of node `n` projected on the plane normal to unit `d`, seen from the side
     /// `d` points to (clusters: from their area bins).
-    fn projected_area(&self, n: &Node, d: DVec3) -> f64 {
+    pub(super) fn projected_area(&self, n: &Node, d: DVec3) -> f64 {
         if n.is_cluster() {
             let bins = &self.clusters[n.cluster as usize].area_bins;
             (0..3).map(|k| d[k].abs() * bins[bin(k, d[k])]).sum()

@@ -5,8 +5,6 @@
 use glam::DVec3;
 
 use super::solver::Solver;
-use super::tree::{ClusterSample, Node, CLUSTER_SAMPLES};
-use crate::form_factor::kernel::quarter_points;
 
 /// 16 stratified points of a triangle or a planar convex quadrilateral: one in each cell
 /// of a 4 x 4 grid of the quadrilateral's (u, v) square, or in each of the 16 sub-triangles
@@ -62,6 +60,26 @@ fn sample_points(poly: &[DVec3], seed: u64) -> [DVec3; 16] {
     out
 }
 
+/// A stride that visits 0..n in a spread-out order: the integer nearest 0.618 n that is
+/// coprime with n (1 for n <= 2).
+fn spread_stride(n: usize) -> usize {
+    fn gcd(a: usize, b: usize) -> usize {
+        if b == 0 {
+            a
+        } else {
+            gcd(b, a % b)
+        }
+    }
+    if n <= 2 {
+        return 1;
+    }
+    let mut s = ((n as f64 * 0.618).round() as usize).max(1);
+    while gcd(s, n) != 1 {
+        s += 1;
+    }
+    s
+}
+
 impl Solver<'_> {
     /// The visible fraction between p and q from a few point pairs, and the rays cast. Only
     /// pairs whose points face each other count (a pair with a point behind the other's
@@ -69,7 +87,7 @@ impl Solver<'_> {
     /// use 16 pairs (4 x 4 stratified points on each, paired by a fixed permutation) and
     /// only the occluders whose boxes overlap the pair's box (none: visible, no ray);
     /// cluster links use up to eight facing pairs of sample points (a cluster keeps up to
-    /// eight points drawn from its children's in proportion to area, see
+    /// sixteen points drawn from its children's in proportion to area, see
     /// [`super::tree::ClusterSample`]) and the whole BVH, and weigh each facing pair by what
     /// it stands for of the exchange, A_x cos_x A_y cos_y / d^2 (the point-to-point kernel
     /// of Cohen & Wallace 1993, eq. 4.16, times the areas), so that the legs hidden under a
@@ -129,38 +147,20 @@ impl Solver<'_> {
             weighted = weights.iter().all(|w| w.is_finite()) && weights.iter().sum::<f64>() > 0.0;
             count = 16;
         } else {
-            // Sample points on the stack: this runs for every cluster link estimated.
-            let samples_of = |n: &Node| -> ([ClusterSample; CLUSTER_SAMPLES], usize) {
-                let mut out = [ClusterSample {
-                    point: DVec3::ZERO,
-                    normal: DVec3::ZERO,
-                    area: 0.0,
-                }; CLUSTER_SAMPLES];
-                if n.is_cluster() {
-                    let samples = &self.clusters[n.cluster as usize].samples;
-                    out[..samples.len()].copy_from_slice(samples);
-                    (out, samples.len())
-                } else {
-                    let normal = self.normal[n.surface as usize];
-                    for (o, point) in out.iter_mut().zip(quarter_points(n.polygon())) {
-                        *o = ClusterSample {
-                            point,
-                            normal,
-                            area: 0.25 * n.area,
-                        };
-                    }
-                    (out, 4)
-                }
-            };
             // Up to eight pairs that face each other (from all pairs of sample points, in
             // a fixed spread-out order), kept in pairs[..8] with their weights; up to eight
             // non-facing ones in pairs[8..], used when none faces.
-            let ((a, na), (b, nb)) = (samples_of(np), samples_of(nq));
+            let ((a, na), (b, nb)) = (self.samples_of(np), self.samples_of(nq));
             let (a, b) = (&a[..na], &b[..nb]);
             let (mut m, mut spare) = (0, 8);
+            // The samples in a spread-out order (a stride near the golden section, coprime
+            // with the count): the first eight pairs then cover the whole of each cluster,
+            // not the first samples drawn, which lie together (drawn in order of area).
+            let (sa, sb) = (spread_stride(a.len()), spread_stride(b.len()));
             'outer: for shift in 0..b.len() {
-                for i in 0..a.len() {
-                    let (x, y) = (a[i], b[(i + shift) % b.len()]);
+                for k in 0..a.len() {
+                    let i = k * sa % a.len();
+                    let (x, y) = (a[i], b[(k + shift) * sb % b.len()]);
                     let d = y.point - x.point;
                     let (cx, cy) = (x.normal.dot(d), -y.normal.dot(d));
                     if cx > 0.0 && cy > 0.0 {
