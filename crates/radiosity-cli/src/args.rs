@@ -85,9 +85,10 @@ pub struct SceneArgs {
 /// How form factors are computed.
 #[derive(Args, Clone)]
 pub struct MethodArgs {
-    /// Form-factor method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Area)]
-    pub method: MethodArg,
+    /// Form-factor method [default: area]. (No clap default, so that an explicit
+    /// `--method area` can be told from none: hierarchical radiosity warns about either.)
+    #[arg(long, value_enum)]
+    pub method: Option<MethodArg>,
     /// Hemicube resolution: cells across the top face.
     #[arg(long, default_value_t = 128, value_name = "CELLS")]
     pub resolution: u32,

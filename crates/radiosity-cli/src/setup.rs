@@ -70,16 +70,16 @@ pub fn prepare_solve(
     Ok((prepared, stem, solver))
 }
 
-/// The method `--method` names when it is not the default (area), which every solver but
-/// hierarchical radiosity uses.
+/// The method `--method` names when it was given (an explicit `--method area` too), which
+/// every solver but hierarchical radiosity uses.
 fn method_flag_given(args: &crate::args::MethodArgs) -> Option<&'static str> {
-    match args.method {
-        MethodArg::Area => None,
-        MethodArg::Contour => Some("contour"),
-        MethodArg::Analytic => Some("analytic"),
-        MethodArg::Hemicube => Some("hemicube"),
-        MethodArg::Montecarlo => Some("montecarlo"),
-    }
+    Some(match args.method? {
+        MethodArg::Area => "area",
+        MethodArg::Contour => "contour",
+        MethodArg::Analytic => "analytic",
+        MethodArg::Hemicube => "hemicube",
+        MethodArg::Montecarlo => "montecarlo",
+    })
 }
 
 /// The scene loaded, meshed with its file's settings overridden by the flags, and its
@@ -106,7 +106,7 @@ fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, Str
         })?;
     let m = &args.method;
     let steps = prepared.settings.integral_steps;
-    prepared.method = match m.method {
+    prepared.method = match m.method.unwrap_or(MethodArg::Area) {
         MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
         MethodArg::Contour => FormFactorMethod::Contour { steps },
         MethodArg::Analytic => FormFactorMethod::Analytic { steps },
