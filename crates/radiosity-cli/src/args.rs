@@ -85,8 +85,9 @@ pub struct SceneArgs {
 /// How form factors are computed.
 #[derive(Args, Clone)]
 pub struct MethodArgs {
-    /// Form-factor method [default: area]. (No clap default, so that an explicit
-    /// `--method area` can be told from none: hierarchical radiosity warns about either.)
+    /// Form-factor method [default: area]
+    // No clap default, so that an explicit `--method area` can be told from none:
+    // hierarchical radiosity, which ignores the method, warns about any given.
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
     /// Hemicube resolution: cells across the top face.
