@@ -6,7 +6,7 @@
 //! | extension | format | reader |
 //! | --- | --- | --- |
 //! | `.scene` | the paper's Appendix A format | [`crate::io::scene_file`] |
-//! | `.obj` | Wavefront OBJ with its MTL materials | module `obj` |
+//! | `.obj` | Wavefront OBJ with its MTL materials | [`obj`] |
 //! | `.gltf`, `.glb` | glTF 2.0 | not yet: [`ImportError::NotSupportedYet`] |
 //! | `.dxf` | AutoCAD DXF | not yet: [`ImportError::NotSupportedYet`] |
 //! | `.wrl` | VRML97 | not yet: [`ImportError::NotSupportedYet`] |
@@ -53,6 +53,7 @@
 //! a binary file are checked with [`check_count`] before anything is allocated for them.
 
 mod face_soup;
+pub mod obj;
 
 use std::fmt;
 use std::path::Path;
@@ -370,7 +371,8 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
     };
     match format {
         Format::Scene => read_scene_scaled(path, options.scale),
-        Format::Gltf | Format::Glb | Format::Dxf | Format::Vrml | Format::Obj => {
+        Format::Obj => obj::read(path, options),
+        Format::Gltf | Format::Glb | Format::Dxf | Format::Vrml => {
             Err(ImportError::NotSupportedYet { file, format })
         }
     }
