@@ -171,6 +171,56 @@ pub(crate) fn duplicate_surfaces(surfaces: &[Surface]) -> Vec<(usize, usize)> {
     pairs
 }
 
+/// The keywords that start a block, or end the scene: where recovery after an error stops.
+fn is_block_start(k: Keyword) -> bool {
+    matches!(
+        k,
+        Keyword::PatchBegin
+            | Keyword::BoxBegin
+            | Keyword::SphereBegin
+            | Keyword::CylinderBegin
+            | Keyword::ConeBegin
+            | Keyword::SceneEnd
+    )
+}
+
+/// The round primitives.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Round {
+    Sphere,
+    Cylinder,
+    Cone,
+}
+
+impl Round {
+    fn keywords(self) -> (Keyword, Keyword) {
+        match self {
+            Round::Sphere => (Keyword::SphereBegin, Keyword::SphereEnd),
+            Round::Cylinder => (Keyword::CylinderBegin, Keyword::CylinderEnd),
+            Round::Cone => (Keyword::ConeBegin, Keyword::ConeEnd),
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Round::Sphere => "sphere",
+            Round::Cylinder => "cylinder",
+            Round::Cone => "cone",
+        }
+    }
+}
+
+/// A round primitive's geometry as written.
+struct RoundShape {
+    centre: DVec3,
+    radius: f64,
+    height: f64,
+    resolution: u32,
+    /// The `RADIUS` line, where problems with the faces are reported.
+    line: usize,
+    column: usize,
+}
+
 /// Marks a failed step whose error has already been recorded.
 struct Reported;
 
@@ -475,6 +525,16 @@ impl<'a> Parser<'a> {
                     surfaces.extend(self.box_block().into_iter().flatten());
                     self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
+                Some(k @ (Keyword::SphereBegin | Keyword::CylinderBegin | Keyword::ConeBegin)) => {
+                    blocks += 1;
+                    let kind = match k {
+                        Keyword::SphereBegin => Round::Sphere,
+                        Keyword::CylinderBegin => Round::Cylinder,
+                        _ => Round::Cone,
+                    };
+                    surfaces.extend(self.round_block(kind).into_iter().flatten());
+                    self.surface_lines.resize(surfaces.len(), self.block_line);
+                }
                 Some(Keyword::SceneEnd) => {
                     self.scene_end(blocks);
                     return surfaces;
@@ -539,10 +599,7 @@ impl<'a> Parser<'a> {
         self.unexpected("PATCHBEGIN, BOXBEGIN or SCENEEND");
         self.pos += 1;
         while let Some(k) = self.current_keyword() {
-            if matches!(
-                k,
-                Keyword::PatchBegin | Keyword::BoxBegin | Keyword::SceneEnd
-            ) {
+            if is_block_start(k) {
                 break;
             }
             self.pos += 1;
@@ -557,10 +614,7 @@ impl<'a> Parser<'a> {
                 self.pos += 1;
                 return;
             }
-            if matches!(
-                k,
-                Keyword::PatchBegin | Keyword::BoxBegin | Keyword::SceneEnd
-            ) {
+            if is_block_start(k) {
                 return;
             }
             self.pos += 1;
@@ -788,6 +842,122 @@ impl<'a> Parser<'a> {
         Some(surfaces)
     }
 
+    /// A `SPHEREBEGIN`, `CYLINDERBEGIN` or `CONEBEGIN` block as its checked faces.
+    fn round_block(&mut self, kind: Round) -> Option<Vec<Surface>> {
+        let (begin, end) = kind.keywords();
+        let (head, facing, shape) = self.block(begin, end, |p| {
+            let name = p.name_line()?;
+            let facing = p.facing()?;
+            let head = p.colours(name)?;
+            let shape = p.round_shape(kind)?;
+            Ok((head, facing, shape))
+        })?;
+        self.block_line = (shape.line, shape.column);
+        let RoundShape {
+            centre,
+            radius,
+            height,
+            resolution: n,
+            ..
+        } = shape;
+        let (faces, names): (Vec<Vec<DVec3>>, Vec<String>) = match kind {
+            Round::Sphere => {
+                let faces = shape::sphere_faces(centre, radius, n, facing);
+                let names = (0..faces.len()).map(|k| k.to_string()).collect();
+                (faces, names)
+            }
+            Round::Cylinder => {
+                let faces = shape::cylinder_faces(centre, radius, height, n, facing);
+                let names = ["base".to_string(), "top".to_string()]
+                    .into_iter()
+                    .chain((0..n).map(|k| format!("side{k}")))
+                    .collect();
+                (faces, names)
+            }
+            Round::Cone => {
+                let faces = shape::cone_faces(centre, radius, height, n, facing);
+                let names = std::iter::once("base".to_string())
+                    .chain((0..n).map(|k| format!("side{k}")))
+                    .collect();
+                (faces, names)
+            }
+        };
+        let mut surfaces = Vec::with_capacity(faces.len());
+        for (suffix, vertices) in names.into_iter().zip(faces) {
+            let name = format!("{}.{suffix}", head.name);
+            if let Err(e) = geometry::validate_polygon(&vertices) {
+                let msg = format!(
+                    "the {}'s face \"{name}\" is not a usable polygon: {e} (the {} is too small \
+                     or too thin for its position, or too large; rescale the scene or change \
+                     RESOLUTION)",
+                    kind.name(),
+                    kind.name()
+                );
+                self.error(shape.line, shape.column, msg);
+                return None;
+            }
+            surfaces.push(Surface {
+                name,
+                emission: head.emission,
+                reflectance: head.reflectance,
+                vertices,
+            });
+        }
+        Some(surfaces)
+    }
+
+    /// `CENTER`, `RADIUS`, `HEIGHT` (not for a sphere) and an optional `RESOLUTION`.
+    fn round_shape(&mut self, kind: Round) -> Step<RoundShape> {
+        let (read, centre_line) = self.triple_read(Keyword::Center, "coordinate")?;
+        let mut centre = [0.0; 3];
+        for (i, found) in read.iter().enumerate() {
+            let Some((v, token)) = *found else { break };
+            centre[i] = v;
+            self.check_range(v, token, &centre_line);
+        }
+        let (radius, token, line) = self.value(Keyword::Radius)?;
+        if radius <= 0.0 {
+            let msg = format!("RADIUS must be greater than 0, found \"{}\"", token.text);
+            self.error_at(token, &line, msg);
+        }
+        let (shape_line, shape_column) = (line.number, line.head().column);
+        let mut height = 0.0;
+        if kind != Round::Sphere {
+            let (h, token, line) = self.value(Keyword::Height)?;
+            if h <= 0.0 {
+                let msg = format!("HEIGHT must be greater than 0, found \"{}\"", token.text);
+                self.error_at(token, &line, msg);
+            }
+            height = h;
+        }
+        let mut resolution = shape::DEFAULT_RESOLUTION;
+        if self.current_keyword() == Some(Keyword::Resolution) {
+            let (v, token, line) = self.value(Keyword::Resolution)?;
+            match Self::whole(v) {
+                Some(n) if (3..=u64::from(shape::MAX_RESOLUTION)).contains(&n) => {
+                    resolution = n as u32;
+                }
+                _ => {
+                    let msg = format!(
+                        "RESOLUTION must be a whole number from 3 to {} (the segments round the \
+                         axis), found \"{}\"",
+                        shape::MAX_RESOLUTION,
+                        token.text
+                    );
+                    self.error_at(token, &line, msg);
+                }
+            }
+        }
+        Ok(RoundShape {
+            centre: centre.into(),
+            radius,
+            height,
+            resolution,
+            line: shape_line,
+            column: shape_column,
+        })
+    }
+
     /// `FACING OUT` or `FACING IN`.
     fn facing(&mut self) -> Step<Facing> {
         let line = self.expect(Keyword::Facing)?;
@@ -882,3 +1052,7 @@ impl<'a> Parser<'a> {
 #[cfg(test)]
 #[path = "read_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "round_tests.rs"]
+mod round_tests;
