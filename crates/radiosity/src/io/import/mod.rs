@@ -60,6 +60,7 @@ use std::path::Path;
 
 use thiserror::Error;
 
+pub(crate) use face_soup::triangulate;
 pub use face_soup::{FaceSoup, SoupFace, SoupMaterial};
 
 use crate::geometry;

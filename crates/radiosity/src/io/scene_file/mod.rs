@@ -79,7 +79,10 @@
 //! CONEEND
 //! ```
 //!
-//! A patch may have any number of vertices (3 or more), as long as it is planar and convex.
+//! A patch may have any number of vertices (3 or more). One that is planar but not convex,
+//! with an outline that does not cross itself (an L, a dart), is split into triangles
+//! `NAME.0`, `NAME.1`, ... (ear clipping on its plane); a crossing outline (a bow tie, most
+//! likely corners in the wrong order) is an error, as below.
 //!
 //! `//` starts a comment anywhere on a line, blank lines may go anywhere, and keywords are
 //! case-insensitive. Numbers are written as Rust reads an `f64` (`1`, `-0.5`, `.5`, `2.`,

@@ -171,6 +171,22 @@ pub(crate) fn duplicate_surfaces(surfaces: &[Surface]) -> Vec<(usize, usize)> {
     pairs
 }
 
+/// A planar polygon that is not convex, as triangles, when its outline does not cross
+/// itself: the corners flattened onto the best-fit plane and ear-clipped
+/// ([`crate::io::import`]'s triangulation), accepted only when every triangle is usable and
+/// their areas add up to the polygon's (to 1e-9: rounding), which fails for an outline that
+/// crosses itself (a bow tie, whose signed parts cancel) or goes round twice. `None` then:
+/// such a patch is more likely corners given in the wrong order than a shape, and stays an
+/// error.
+fn simple_triangles(corners: &[DVec3]) -> Option<Vec<[DVec3; 3]>> {
+    let mut flat = corners.to_vec();
+    geometry::project_to_plane(&mut flat);
+    let (triangles, lost) = crate::io::import::triangulate(&flat);
+    let area = geometry::polygon_area(&flat);
+    let sum: f64 = triangles.iter().map(|t| geometry::polygon_area(t)).sum();
+    (lost == 0 && !triangles.is_empty() && (sum - area).abs() <= 1e-9 * area).then_some(triangles)
+}
+
 /// The keywords that start a block, or end the scene: where recovery after an error stops.
 fn is_block_start(k: Keyword) -> bool {
     matches!(
@@ -517,7 +533,7 @@ impl<'a> Parser<'a> {
                 }
                 Some(Keyword::PatchBegin) => {
                     blocks += 1;
-                    surfaces.extend(self.patch());
+                    surfaces.extend(self.patch().into_iter().flatten());
                     self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
                 Some(Keyword::BoxBegin) => {
@@ -665,8 +681,10 @@ impl<'a> Parser<'a> {
 
     // ----- patches -----
 
-    /// A `PATCHBEGIN` block as a checked surface.
-    fn patch(&mut self) -> Option<Surface> {
+    /// A `PATCHBEGIN` block as a checked surface; a planar patch that is not convex but
+    /// whose outline does not cross itself (an L, a dart) as its triangles `NAME.0`,
+    /// `NAME.1`, ... ([`simple_triangles`]).
+    fn patch(&mut self) -> Option<Vec<Surface>> {
         let (head, mut corners) = self.block(Keyword::PatchBegin, Keyword::PatchEnd, |p| {
             let name = p.name_line()?;
             let count = p.vertex_count(3, "a patch")?;
@@ -674,13 +692,30 @@ impl<'a> Parser<'a> {
             Ok((head, p.vertex_lines(count)?))
         })?;
         self.block_line = (corners.line, corners.column);
+        if let Err(geometry::PolygonError::Reflex { .. }) =
+            geometry::validate_polygon(&corners.vertices)
+        {
+            if let Some(triangles) = simple_triangles(&corners.vertices) {
+                let surfaces = triangles
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, t)| Surface {
+                        name: format!("{}.{k}", head.name),
+                        emission: head.emission,
+                        reflectance: head.reflectance,
+                        vertices: t.to_vec(),
+                    })
+                    .collect();
+                return Some(surfaces);
+            }
+        }
         self.check_polygon(&mut corners)?;
-        Some(Surface {
+        Some(vec![Surface {
             name: head.name,
             emission: head.emission,
             reflectance: head.reflectance,
             vertices: corners.vertices,
-        })
+        }])
     }
 
     /// Checks and flattens a polygon ([`geometry::validate_polygon`], [`geometry::flatten`]),
