@@ -269,7 +269,7 @@ impl FaceSoup {
             }
             let scaled = *v * scale;
             for value in scaled.to_array() {
-                if !(value.abs() <= geometry::MAX_COORDINATE) {
+                if value.abs() > geometry::MAX_COORDINATE {
                     return Err(ImportError::OutOfRange {
                         file: self.file.clone(),
                         line,
