@@ -4,6 +4,7 @@
 mod fixtures;
 
 mod commands;
+mod formats_out;
 mod hostile;
 mod pathtrace;
 mod view;

@@ -8,6 +8,7 @@
 //! * [`path_traced_file`]: a path-traced view (means, standard errors, emitter mask, the
 //!   camera and settings) as OpenEXR, so that a reference is traced once.
 //! * [`png`]: rendered images as PNG files.
+//! * [`exr`]: linear images (radiance, no exposure, clamping or gamma) as OpenEXR files.
 //! * [`write_atomically`]: how every writer here replaces a file, so that a reader sees the
 //!   old file or the whole new one, never half of one.
 //!
@@ -15,6 +16,7 @@
 //! each beside [`scene_file`], converting to and from the scene model of [`crate::scene`].
 
 mod atomic_write;
+pub mod exr;
 pub mod form_factor_file;
 pub mod path_traced_file;
 pub mod png;
