@@ -377,6 +377,11 @@ pub struct SolveArgs {
     /// Output file: CSV, or JSON when it ends in .json (default: the scene's name with .csv).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Also write the per-surface report to this CSV file: one row per input surface with
+    /// its area and the area-weighted mean, min and max radiosity per band over its
+    /// elements and the mean's luminance (Rec. 709), under a comment line giving the units.
+    #[arg(long, value_name = "FILE.csv")]
+    pub report: Option<PathBuf>,
 }
 
 #[derive(Args)]

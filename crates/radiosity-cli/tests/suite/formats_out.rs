@@ -134,3 +134,82 @@ fn render_and_pathtrace_write_linear_radiance_exr() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn solve_report_has_one_row_per_surface_at_the_closed_form() {
+    let dir = scratch_dir("report");
+    std::fs::write(dir.join("furnace.scene"), FURNACE).unwrap();
+    // Two solvers on two meshes: every surface's mean, min and max are B = E / (1 - rho);
+    // 0.1 % covers the contour method's row sums and the solver's tolerance.
+    for (solver, area) in [("gauss-seidel", "0.3"), ("lu", "0.06")] {
+        let out = radiosity(
+            &[
+                "solve",
+                "furnace.scene",
+                "--method",
+                "contour",
+                "--solver",
+                solver,
+                "--max-area",
+                area,
+                "-q",
+                "-o",
+                "elements.csv",
+                "--report",
+                "report.csv",
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = std::fs::read_to_string(dir.join("report.csv")).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(
+            lines[0].starts_with("# radiosity in the scene's emission units"),
+            "{text}"
+        );
+        assert_eq!(
+            lines[1],
+            "surface,area,mean_r,mean_g,mean_b,min_r,min_g,min_b,max_r,max_g,max_b,mean_luminance"
+        );
+        // The box's six faces, each of area 1.
+        let names = ["base", "top", "side0", "side1", "side2", "side3"];
+        assert_eq!(lines.len(), 2 + names.len(), "{text}");
+        let y = 0.2126 * FURNACE_B[0] + 0.7152 * FURNACE_B[1] + 0.0722 * FURNACE_B[2];
+        for (line, name) in lines[2..].iter().zip(names) {
+            let fields: Vec<&str> = line.split(',').collect();
+            assert_eq!(fields[0], format!("Furnace.{name}"));
+            let v: Vec<f64> = fields[1..].iter().map(|x| x.parse().unwrap()).collect();
+            assert!((v[0] - 1.0).abs() < 1e-9, "area of {line}");
+            for k in 0..9 {
+                let want = FURNACE_B[k % 3];
+                assert!((v[1 + k] - want).abs() <= 1e-3 * want, "{solver}: {line}");
+            }
+            assert!((v[10] - y).abs() <= 1e-3 * y, "{solver}: {line}");
+        }
+    }
+    // The report may not replace an input or the solution.
+    for (report, needle) in [
+        ("furnace.scene", "would destroy the input"),
+        ("elements.csv", "another name"),
+    ] {
+        let out = radiosity(
+            &[
+                "solve",
+                "furnace.scene",
+                "-q",
+                "-o",
+                "elements.csv",
+                "--report",
+                report,
+            ],
+            &dir,
+        );
+        assert_eq!(out.status.code(), Some(1));
+        assert!(stderr(&out).contains(needle), "{}", stderr(&out));
+    }
+    assert_eq!(
+        std::fs::read_to_string(dir.join("furnace.scene")).unwrap(),
+        FURNACE
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -5,6 +5,8 @@
 //! * [`scene_file`]: the paper's Appendix A scene format, reader and writer.
 //! * [`form_factor_file`]: the form-factor matrix, written once and read back (paper 2.8).
 //! * [`solution`]: the per-element solution as CSV or JSON, for scripts.
+//! * [`surface_report`]: the per-surface report (area, mean, min and max radiosity,
+//!   luminance) as CSV.
 //! * [`path_traced_file`]: a path-traced view (means, standard errors, emitter mask, the
 //!   camera and settings) as OpenEXR, so that a reference is traced once.
 //! * [`png`]: rendered images as PNG files.
@@ -22,5 +24,6 @@ pub mod path_traced_file;
 pub mod png;
 pub mod scene_file;
 pub mod solution;
+pub mod surface_report;
 
 pub use atomic_write::{is_same_file, write_atomically};
