@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod check;
 pub mod compare;
+pub mod export;
 pub mod formfactors;
 pub mod generate;
 pub mod pathtrace;

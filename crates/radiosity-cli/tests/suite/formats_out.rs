@@ -213,3 +213,80 @@ fn solve_report_has_one_row_per_surface_at_the_closed_form() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn export_glb_and_gltf_bake_the_furnace_radiosity_into_vertex_colours() {
+    let dir = scratch_dir("export-gltf");
+    std::fs::write(dir.join("furnace.scene"), FURNACE).unwrap();
+    for out_name in ["furnace.glb", "furnace.gltf"] {
+        // Exposure 0.25: every vertex colour is 0.25 B = (0.5, 0.25, 0.25), within 0.1 %
+        // (the contour method's row sums, the solver's tolerance, f32).
+        let out = radiosity(
+            &[
+                "export",
+                "furnace.scene",
+                "--method",
+                "contour",
+                "--exposure",
+                "0.25",
+                "-o",
+                out_name,
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains("exposure scale 0.25"),
+            "{}",
+            stderr(&out)
+        );
+        let path = dir.join(out_name);
+        let (doc, buffers) = read_gltf(&path);
+        assert!(doc.extensions_used().any(|e| e == "KHR_materials_unlit"));
+        let (mut vertices, mut lo, mut hi) = (0, [f32::MAX; 3], [f32::MIN; 3]);
+        for mesh in doc.meshes() {
+            let p = mesh.primitives().next().unwrap();
+            let r = p.reader(|b| Some(&buffers[b.index()][..]));
+            for (pos, c) in r
+                .read_positions()
+                .unwrap()
+                .zip(r.read_colors(0).unwrap().into_rgb_f32())
+            {
+                vertices += 1;
+                for k in 0..3 {
+                    lo[k] = lo[k].min(pos[k]);
+                    hi[k] = hi[k].max(pos[k]);
+                    let want = 0.25 * FURNACE_B[k];
+                    assert!(
+                        ((c[k] as f64) - want).abs() <= 1e-3 * want,
+                        "{out_name}: {c:?}"
+                    );
+                }
+            }
+        }
+        // Six faces of the unit cube meshed at 0.3: 2 x 2 elements, 9 vertices each.
+        assert_eq!(doc.meshes().count(), 6);
+        assert_eq!(vertices, 6 * 9);
+        assert_eq!((lo, hi), ([0.0; 3], [1.0; 3]));
+    }
+    assert!(dir.join("furnace.bin").exists());
+    // Another extension is refused with what would work; the scene is never overwritten.
+    let out = radiosity(&["export", "furnace.scene", "-o", "furnace.fbx"], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains(".glb, or .gltf"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A glTF or GLB file's document and buffers (a `.gltf`'s from the files its URIs name).
+pub fn read_gltf(path: &Path) -> (gltf::Document, Vec<Vec<u8>>) {
+    let bytes = std::fs::read(path).unwrap();
+    let g = gltf::Gltf::from_slice(&bytes).unwrap();
+    let buffers = g
+        .buffers()
+        .map(|b| match b.source() {
+            gltf::buffer::Source::Bin => g.blob.clone().unwrap(),
+            gltf::buffer::Source::Uri(uri) => std::fs::read(path.with_file_name(uri)).unwrap(),
+        })
+        .collect();
+    (g.document, buffers)
+}

@@ -9,6 +9,7 @@
 //!   luminance) as CSV.
 //! * [`path_traced_file`]: a path-traced view (means, standard errors, emitter mask, the
 //!   camera and settings) as OpenEXR, so that a reference is traced once.
+//! * [`export`]: the solved scene as glTF (vertex colours) and the scene as OBJ + MTL.
 //! * [`png`]: rendered images as PNG files.
 //! * [`exr`]: linear images (radiance, no exposure, clamping or gamma) as OpenEXR files.
 //! * [`write_atomically`]: how every writer here replaces a file, so that a reader sees the
@@ -18,6 +19,7 @@
 //! each beside [`scene_file`], converting to and from the scene model of [`crate::scene`].
 
 mod atomic_write;
+pub mod export;
 pub mod exr;
 pub mod form_factor_file;
 pub mod path_traced_file;
