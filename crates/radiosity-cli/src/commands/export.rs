@@ -6,19 +6,21 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use radiosity::io::export::gltf::{self, Bake};
+use radiosity::io::export::obj;
 use radiosity::progress::{run_stage, Stage};
 use radiosity::shade::{self, Exposure};
 
 use super::{exposure_note, solve_scene};
 use crate::args::ExportArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{camera, prepare_solve, refuse_overwriting_inputs};
+use crate::setup::{camera, load_scene, prepare_solve, refuse_overwriting_inputs};
 
 /// What `-o` asks for, by extension.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Format {
     Glb,
     Gltf,
+    Obj,
 }
 
 fn format(output: &Path) -> Result<Format> {
@@ -28,9 +30,10 @@ fn format(output: &Path) -> Result<Format> {
     match ext.as_deref() {
         Some("glb") => Ok(Format::Glb),
         Some("gltf") => Ok(Format::Gltf),
+        Some("obj") => Ok(Format::Obj),
         _ => bail!(
-            "{}: export writes glTF (.glb, or .gltf with a .bin beside it); give the output \
-             one of these extensions",
+            "{}: export writes glTF (.glb, or .gltf with a .bin beside it) or OBJ (.obj, with \
+             an .mtl beside it); give the output one of these extensions",
             output.display()
         ),
     }
@@ -45,11 +48,16 @@ pub fn run(args: ExportArgs) -> Result<()> {
         ("form-factor file", args.solve.form_factors.as_deref()),
     ];
     let mut outputs = vec![output.clone()];
-    if format == Format::Gltf {
-        outputs.push(gltf::buffer_path(output));
+    match format {
+        Format::Gltf => outputs.push(gltf::buffer_path(output)),
+        Format::Obj => outputs.push(obj::mtl_path(output)),
+        Format::Glb => {}
     }
     for out in &outputs {
         refuse_overwriting_inputs(out, &inputs)?;
+    }
+    if format == Format::Obj {
+        return export_obj(&args, &reporter);
     }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let camera = camera(&args.camera, &prepared.scene)?;
@@ -79,7 +87,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
     };
     run_stage(&reporter, Stage::Write, 0, || match format {
         Format::Glb => gltf::write_glb(output, &bake),
-        Format::Gltf => gltf::write_gltf(output, &bake),
+        Format::Gltf | Format::Obj => gltf::write_gltf(output, &bake),
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
     // The exposure is part of what the file means; --quiet drops the note as for every
@@ -93,7 +101,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
     ));
     let extra = match format {
         Format::Gltf => format!(" and {}", gltf::buffer_path(output).display()),
-        Format::Glb => String::new(),
+        Format::Glb | Format::Obj => String::new(),
     };
     reporter.note(&format!(
         "wrote {}{extra} ({} surfaces, {} elements; COLOR_0 = min(1, {scale} x radiosity), \
@@ -103,5 +111,28 @@ pub fn run(args: ExportArgs) -> Result<()> {
         solution.mesh.len(),
     ));
     reporter.print_timings();
+    Ok(())
+}
+
+/// `-o out.obj`: the scene's surfaces as they are (no meshing or solving; the mesh and
+/// solver flags do not apply), with the file's meshing settings (and --max-area,
+/// --steps) as comments.
+fn export_obj(args: &ExportArgs, reporter: &Reporter) -> Result<()> {
+    let (file, _) = load_scene(args.scene.scene.as_deref(), reporter)?;
+    let settings = radiosity::mesh::MeshSettings {
+        max_patch_area: args.scene.max_area.unwrap_or(file.settings.max_patch_area),
+        integral_steps: args.scene.steps.unwrap_or(file.settings.integral_steps),
+    };
+    let output = &args.output;
+    run_stage(reporter, Stage::Write, 0, || {
+        obj::write_obj(output, &file.scene, Some(settings))
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!(
+        "wrote {} and {} ({} surfaces; Kd reflectance, Ke emission)",
+        output.display(),
+        obj::mtl_path(output).display(),
+        file.scene.surfaces.len()
+    ));
     Ok(())
 }

@@ -274,6 +274,7 @@ fn export_glb_and_gltf_bake_the_furnace_radiosity_into_vertex_colours() {
     let out = radiosity(&["export", "furnace.scene", "-o", "furnace.fbx"], &dir);
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains(".glb, or .gltf"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("OBJ (.obj"), "{}", stderr(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -289,4 +290,40 @@ pub fn read_gltf(path: &Path) -> (gltf::Document, Vec<Vec<u8>>) {
         })
         .collect();
     (g.document, buffers)
+}
+
+#[test]
+fn export_obj_writes_the_scene_surfaces_and_an_mtl_that_tobj_reads() {
+    let dir = scratch_dir("export-obj");
+    std::fs::write(dir.join("furnace.scene"), FURNACE).unwrap();
+    let out = radiosity(
+        &["export", "furnace.scene", "-o", "furnace.obj", "-q"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (models, materials) =
+        tobj::load_obj(dir.join("furnace.obj"), &tobj::LoadOptions::default()).unwrap();
+    let materials = materials.unwrap();
+    // The box's six faces, not its mesh: four corners each, one shared material.
+    assert_eq!(models.len(), 6);
+    assert_eq!(materials.len(), 1);
+    assert_eq!(materials[0].diffuse, Some([0.5, 0.5, 0.75]));
+    assert_eq!(materials[0].emissive, Some([1.0, 0.5, 0.25]));
+    for m in &models {
+        assert!(m.name.starts_with("Furnace."), "{}", m.name);
+        assert_eq!(m.mesh.positions.len(), 12);
+    }
+    let text = std::fs::read_to_string(dir.join("furnace.obj")).unwrap();
+    assert!(text.contains("# MAX_PATCH_AREA 0.3"), "{text}");
+    // The MTL may not replace the scene: an output named after the scene file is refused.
+    std::fs::copy(dir.join("furnace.scene"), dir.join("x.mtl")).unwrap();
+    let out = radiosity(&["export", "x.mtl", "-o", "x.obj", "-q"], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("would destroy the input"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(dir.join("x.mtl")).unwrap(), FURNACE);
+    std::fs::remove_dir_all(&dir).unwrap();
 }
