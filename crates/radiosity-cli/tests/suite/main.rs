@@ -3,6 +3,7 @@
 
 mod fixtures;
 
+mod browser;
 mod commands;
 mod formats_out;
 mod hostile;
