@@ -106,6 +106,32 @@ fn render_and_pathtrace_write_linear_radiance_exr() {
             "path-traced mean radiance {mean} in band {k}, expected {expect}"
         );
     }
+    // With --compare, the radiosity render goes beside it as linear radiance too, the
+    // same pixels as `render -o *.exr` with the same flags; the error map as a PNG. (The
+    // furnace shows only emitters, which the comparison leaves out: the Cornell box.)
+    let cornell = [
+        "--max-area",
+        "20000",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "-q",
+    ];
+    let mut args = vec!["pathtrace", "--compare", "--paths", "4", "-o", "cmp.exr"];
+    args.extend(cornell);
+    let out = radiosity(&args, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut args = vec!["render", "-o", "cornell.exr"];
+    args.extend(cornell);
+    let out = radiosity(&args, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let beside = radiosity::io::exr::read_rgb(&dir.join("cmp-radiosity.exr")).unwrap();
+    assert_eq!(
+        beside,
+        radiosity::io::exr::read_rgb(&dir.join("cornell.exr")).unwrap()
+    );
+    assert!(dir.join("cmp.exr").is_file() && dir.join("cmp-error.png").is_file());
     // A wireframe has no light to write; other names than .png and .exr are refused.
     let out = radiosity(
         &[
