@@ -12,7 +12,8 @@
 //! * `mean_luminance`: 0.2126 mean_r + 0.7152 mean_g + 0.0722 mean_b (ITU-R BT.709).
 //!
 //! Numbers are written as for [`crate::io::solution`] (shortest exact form, no exponent);
-//! names are quoted per RFC 4180 where needed. A surface that no element covers (none in a
+//! names are quoted per RFC 4180 where needed, and also when they start with `#` (so that
+//! no row reads as a comment line) or with or end in a space. A surface that no element covers (none in a
 //! mesh from [`crate::mesh::mesh_scene`]) gets area 0 and empty radiosity fields. The file
 //! is written atomically ([`crate::io::write_atomically`]).
 
@@ -120,25 +121,38 @@ pub fn write_surface_report(
         ));
     }
     let rows = surface_records(scene, mesh, element_b);
+    let three = |v: Option<[f64; 3]>| {
+        v.map_or([String::new(), String::new(), String::new()], |v| {
+            v.map(|x| x.to_string())
+        })
+    };
     crate::io::write_atomically(path, |w| {
         writeln!(w, "{UNIT_COMMENT}")?;
-        let mut csv = csv::Writer::from_writer(w);
-        csv.write_record(HEADER.split(','))?;
-        let three = |v: Option<[f64; 3]>| {
-            v.map_or([String::new(), String::new(), String::new()], |v| {
-                v.map(|x| x.to_string())
-            })
-        };
+        writeln!(w, "{HEADER}")?;
         for r in &rows {
-            let mut fields = vec![r.surface.clone(), r.area.to_string()];
+            let mut fields = vec![csv_name(&r.surface), r.area.to_string()];
             fields.extend(three(r.mean));
             fields.extend(three(r.min));
             fields.extend(three(r.max));
             fields.push(r.mean_luminance().map_or(String::new(), |y| y.to_string()));
-            csv.write_record(&fields)?;
+            writeln!(w, "{}", fields.join(","))?;
         }
-        csv.flush()
+        Ok(())
     })
+}
+
+/// A surface name as a CSV field: quoted (inner quotes doubled) when it holds a comma, a
+/// quote, a line break, or starts with '#' or a space (where a reader that skips comment
+/// lines, or trims, would misread it); as it is otherwise. The other fields are numbers.
+fn csv_name(name: &str) -> String {
+    let needs = name.starts_with(['#', ' ', '\t'])
+        || name.ends_with([' ', '\t'])
+        || name.contains([',', '"', '\r', '\n']);
+    if needs {
+        format!("\"{}\"", name.replace('"', "\"\""))
+    } else {
+        name.to_string()
+    }
 }
 
 #[cfg(test)]
@@ -147,6 +161,15 @@ mod tests {
     use crate::mesh::mesh_scene;
     use crate::scene::Surface;
     use glam::dvec3;
+
+    #[test]
+    fn names_a_reader_could_take_for_a_comment_or_trim_are_quoted() {
+        assert_eq!(csv_name("Floor"), "Floor");
+        assert_eq!(csv_name("#2 lamp"), "\"#2 lamp\"");
+        assert_eq!(csv_name("a \"b\""), "\"a \"\"b\"\"\"");
+        assert_eq!(csv_name(" x"), "\" x\"");
+        assert_eq!(csv_name("two\nlines"), "\"two\nlines\"");
+    }
 
     #[test]
     fn rows_are_area_weighted_means_with_extremes_and_luminance() {
