@@ -118,7 +118,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
 /// solver flags do not apply), with the file's meshing settings (and --max-area,
 /// --steps) as comments.
 fn export_obj(args: &ExportArgs, reporter: &Reporter) -> Result<()> {
-    let (file, _) = load_scene(args.scene.scene.as_deref(), reporter)?;
+    let (file, _) = load_scene(args.scene.scene.as_deref(), args.scene.scale, reporter)?;
     let settings = radiosity::mesh::MeshSettings {
         max_patch_area: args.scene.max_area.unwrap_or(file.settings.max_patch_area),
         integral_steps: args.scene.steps.unwrap_or(file.settings.integral_steps),

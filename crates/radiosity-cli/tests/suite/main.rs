@@ -7,5 +7,6 @@ mod browser;
 mod commands;
 mod formats_out;
 mod hostile;
+mod imports;
 mod pathtrace;
 mod view;

@@ -10,6 +10,9 @@
 //! * [`path_traced_file`]: a path-traced view (means, standard errors, emitter mask, the
 //!   camera and settings) as OpenEXR, so that a reference is traced once.
 //! * [`export`]: the solved scene as glTF (vertex colours) and the scene as OBJ + MTL.
+//! * [`import`]: scenes from other tools' formats (OBJ + MTL, ...), by the file's
+//!   extension, converted to a [`Scene`](crate::scene::Scene) through one shared face-soup
+//!   conversion; [`import::read_any_scene`] reads any supported file, `.scene` included.
 //! * [`png`]: rendered images as PNG files.
 //! * [`exr`]: linear images (radiance, no exposure, clamping or gamma) as OpenEXR files.
 //! * [`write_atomically`]: how every writer here replaces a file, so that a reader sees the
@@ -22,6 +25,7 @@ mod atomic_write;
 pub mod export;
 pub mod exr;
 pub mod form_factor_file;
+pub mod import;
 pub mod path_traced_file;
 pub mod png;
 pub mod scene_file;
