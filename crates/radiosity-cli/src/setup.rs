@@ -332,7 +332,7 @@ fn solver(
 }
 
 pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
-    check_png(args.output.as_deref())?;
+    image_format(args.output.as_deref())?;
     image_size(&args.camera)?;
     check_render_budget(
         &args.camera,
@@ -391,20 +391,33 @@ pub fn shading(arg: ShadingArg) -> Shading {
     }
 }
 
-/// Refuses an output image that is not named *.png.
-pub fn check_png(output: Option<&Path>) -> Result<()> {
-    if let Some(out) = output {
-        let png = out
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        if !png {
-            bail!(
-                "{}: only PNG images are written; give the output a .png name",
-                out.display()
-            );
-        }
+/// How an output image is written, by its name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// `*.png`: exposed, clamped, gamma-corrected 8-bit colour.
+    Png,
+    /// `*.exr`: linear radiance (radiosity / pi), no exposure, clamping or gamma.
+    Exr,
+}
+
+/// The format of an output image by its extension (any case); PNG when no output is
+/// named. Refuses any other name.
+pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
+    let Some(out) = output else {
+        return Ok(ImageFormat::Png);
+    };
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("png") => Ok(ImageFormat::Png),
+        Some("exr") => Ok(ImageFormat::Exr),
+        _ => bail!(
+            "{}: images are written as PNG (tone-mapped) or OpenEXR (linear radiance); \
+             give the output a .png name, or .exr for linear radiance",
+            out.display()
+        ),
     }
-    Ok(())
 }
 
 /// `--gamma`, checked.
