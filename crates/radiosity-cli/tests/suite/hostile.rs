@@ -293,3 +293,36 @@ fn memory_budget_honours_ulimit_v() {
     assert!(err.contains("at most --resolution"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_scene_far_from_the_origin_is_warned_about() {
+    // A 1 x 1 x 1 closed box of six quads shifted by 3e9 along x and z: 2e9 times its size
+    // out, where such scenes were measured to render wrong; the same box at the origin
+    // says nothing.
+    let dir = scratch_dir("far-origin");
+    let cube = |shift: f64| {
+        let v = |x: f64, y: f64, z: f64| format!("v {} {} {}\n", x + shift, y, z + shift);
+        let mut s = String::new();
+        for (x, y, z) in [
+            (0., 0., 0.), (1., 0., 0.), (1., 1., 0.), (0., 1., 0.),
+            (0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.),
+        ] {
+            s += &v(x, y, z);
+        }
+        // Faces looking in.
+        s += "f 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n";
+        s
+    };
+    for (name, shift, warned) in [("far.obj", 3e9, true), ("near.obj", 0.0, false)] {
+        let path = dir.join(name);
+        std::fs::write(&path, cube(shift)).unwrap();
+        let out = radiosity(&["check", path.to_str().unwrap(), "-q"], &dir);
+        let err = stderr(&out);
+        assert_eq!(err.contains("from the origin"), warned, "{name}: {err}");
+        if warned {
+            assert!(err.contains("far.obj: warning:"), "{err}");
+            assert!(err.contains("subtract about 3.000e9"), "{err}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
