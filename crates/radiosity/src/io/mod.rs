@@ -7,6 +7,9 @@
 //! * [`solution`]: the per-element solution as CSV or JSON, for scripts.
 //! * [`path_traced_file`]: a path-traced view (means, standard errors, emitter mask, the
 //!   camera and settings) as OpenEXR, so that a reference is traced once.
+//! * [`import`]: scenes from other tools' formats (OBJ + MTL, ...), by the file's
+//!   extension, converted to a [`Scene`](crate::scene::Scene) through one shared face-soup
+//!   conversion; [`import::read_any_scene`] reads any supported file, `.scene` included.
 //! * [`png`]: rendered images as PNG files.
 //! * [`write_atomically`]: how every writer here replaces a file, so that a reader sees the
 //!   old file or the whole new one, never half of one.
@@ -16,6 +19,7 @@
 
 mod atomic_write;
 pub mod form_factor_file;
+pub mod import;
 pub mod path_traced_file;
 pub mod png;
 pub mod scene_file;

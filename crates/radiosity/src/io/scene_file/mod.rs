@@ -75,6 +75,7 @@ mod polygon;
 mod read;
 mod write;
 
+pub(crate) use read::duplicate_surfaces;
 pub use read::{parse_scene, read_scene, ParseError, SceneError};
 pub use write::{write_scene, write_scene_file};
 

@@ -141,6 +141,36 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneErro
     }
 }
 
+/// Every pair (upper, lower) of surfaces where `upper` lies in the plane of `lower`, facing
+/// the same way, and covers all of it while being no larger: the same surface given twice
+/// (a second floor quad on the floor), in the order [`crate::scene::lying_on`] finds them.
+/// A surface on part of another (a rug on a floor, in its plane or above it) is a model the
+/// mesher handles (the covered part is left out); a duplicate leaves nothing of the lower
+/// one and is a mistake. The scene reader refuses duplicates; the importers
+/// ([`crate::io::import`]) drop the upper one with a warning.
+pub(crate) fn duplicate_surfaces(surfaces: &[Surface]) -> Vec<(usize, usize)> {
+    if surfaces.len() < 2 {
+        return Vec::new();
+    }
+    let scene = Scene {
+        surfaces: surfaces.to_vec(),
+        camera: None,
+    };
+    let bvh = crate::visibility::PolygonBvh::over_surfaces(&scene);
+    let mut pairs = Vec::new();
+    for o in crate::scene::lying_on(&scene, &bvh) {
+        let (lower, upper) = (o.lower as usize, o.upper as usize);
+        let area = |s: usize| geometry::polygon_area(&surfaces[s].vertices);
+        // Covering the whole of the lower surface and no larger than it, to 1e-6 (six
+        // significant digits, as scene files are often written).
+        let whole = (1.0 - DUPLICATE_TOLERANCE) * area(lower).max(area(upper));
+        if o.same_plane(bvh.scale()) && o.covered_area >= whole {
+            pairs.push((upper, lower));
+        }
+    }
+    pairs
+}
+
 /// Marks a failed step whose error has already been recorded.
 struct Reported;
 
@@ -464,23 +494,7 @@ impl<'a> Parser<'a> {
     /// above it) is a model the mesher handles ([`crate::scene::lying_on`]: the covered
     /// part is left out); a duplicate leaves nothing of the lower one and is a mistake.
     fn duplicates(&mut self, surfaces: &[Surface]) {
-        if surfaces.len() < 2 {
-            return;
-        }
-        let scene = Scene {
-            surfaces: surfaces.to_vec(),
-            camera: None,
-        };
-        let bvh = crate::visibility::PolygonBvh::over_surfaces(&scene);
-        for o in crate::scene::lying_on(&scene, &bvh) {
-            let (lower, upper) = (o.lower as usize, o.upper as usize);
-            let area = |s: usize| geometry::polygon_area(&surfaces[s].vertices);
-            // Covering the whole of the lower surface and no larger than it, to 1e-6 (six
-            // significant digits, as scene files are often written).
-            let whole = (1.0 - DUPLICATE_TOLERANCE) * area(lower).max(area(upper));
-            if !o.same_plane(bvh.scale()) || o.covered_area < whole {
-                continue;
-            }
+        for (upper, lower) in duplicate_surfaces(surfaces) {
             let (line, column) = self.surface_lines[upper];
             let (lower_line, _) = self.surface_lines[lower];
             let msg = format!(
