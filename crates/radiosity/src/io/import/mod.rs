@@ -7,7 +7,7 @@
 //! | --- | --- | --- |
 //! | `.scene` | the paper's Appendix A format | [`crate::io::scene_file`] |
 //! | `.obj` | Wavefront OBJ with its MTL materials | module `obj` |
-//! | `.gltf`, `.glb` | glTF 2.0 | not yet: [`ImportError::NotSupportedYet`] |
+//! | `.gltf`, `.glb` | glTF 2.0 | [`gltf`] |
 //! | `.dxf` | AutoCAD DXF | not yet: [`ImportError::NotSupportedYet`] |
 //! | `.wrl` | VRML97 | not yet: [`ImportError::NotSupportedYet`] |
 //!
@@ -53,6 +53,8 @@
 //! a binary file are checked with [`check_count`] before anything is allocated for them.
 
 mod face_soup;
+pub mod gltf;
+mod merge;
 
 use std::fmt;
 use std::path::Path;
@@ -370,7 +372,8 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
     };
     match format {
         Format::Scene => read_scene_scaled(path, options.scale),
-        Format::Gltf | Format::Glb | Format::Dxf | Format::Vrml | Format::Obj => {
+        Format::Gltf | Format::Glb => gltf::read(path, options),
+        Format::Dxf | Format::Vrml | Format::Obj => {
             Err(ImportError::NotSupportedYet { file, format })
         }
     }
