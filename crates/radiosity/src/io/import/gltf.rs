@@ -55,7 +55,7 @@ pub const MAX_REFLECTANCE: f64 = 0.99;
 /// The most triangles the scene may have once every node's mesh is placed (meshes used by
 /// several nodes count once per node): a file that asks for more is refused before it
 /// is expanded.
-pub const MAX_TRIANGLES: usize = 10_000_000;
+pub const MAX_TRIANGLES: usize = 2_000_000;
 
 /// Reads the glTF or binary glTF file at `path`; buffers and images it names by URI are
 /// read relative to the file's folder.
@@ -157,6 +157,13 @@ impl Reader<'_> {
         let mut default_used = false;
 
         let roots = self.roots(doc)?;
+        let planned = planned_triangles(doc, &roots);
+        if planned > MAX_TRIANGLES {
+            return Err(self.error(format!(
+                "the scene would have {planned} triangles once every node's mesh is placed, \
+                 more than the {MAX_TRIANGLES} this reader takes; split it or simplify it"
+            )));
+        }
         let mut counts = Counts::default();
         let mut triangles_total = 0usize;
         // Depth-first over the tree, each node with its parent's global transform.
@@ -677,6 +684,35 @@ impl Reader<'_> {
         soup.vertices.extend(points);
         Ok(n)
     }
+}
+
+/// How many triangles the nodes under `roots` ask for, from their accessors' counts,
+/// before anything is read (each node counted once; cycles are the walk's to report).
+fn planned_triangles(doc: &gltf::Document, roots: &[gltf::Node]) -> usize {
+    let mut seen = vec![false; doc.nodes().len()];
+    let mut stack: Vec<gltf::Node> = roots.to_vec();
+    let mut total = 0usize;
+    while let Some(node) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            continue;
+        }
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let count = match (prim.indices(), prim.get(&gltf::Semantic::Positions)) {
+                    (Some(i), _) => i.count(),
+                    (None, Some(p)) => p.count(),
+                    (None, None) => 0,
+                };
+                total = total.saturating_add(match prim.mode() {
+                    Mode::Triangles => count / 3,
+                    Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
+                    _ => 0,
+                });
+            }
+        }
+        stack.extend(node.children());
+    }
+    total
 }
 
 fn f32_at(bytes: &[u8], at: usize) -> f64 {

@@ -621,10 +621,15 @@ fn huge_counts_are_refused_before_allocating() {
                 "meshes": [{ "primitives": [{ "attributes": { "POSITION": pos } }] }] }),
         Some(""),
     );
+    // A count the plan refuses outright (1.3e9 triangles) ...
     doc["accessors"][0]["count"] = json!(4_000_000_000u64);
     let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(e.contains("would have 1333333333 triangles"), "{e}");
+    // ... and one it allows that the buffer cannot hold (36 bytes for 1.8 million).
+    doc["accessors"][0]["count"] = json!(1_800_000u64);
+    let e = read_doc(&doc).unwrap_err().to_string();
     assert!(
-        e.starts_with("t.gltf: error: accessor 0 (POSITION) says 4000000000 items, more than"),
+        e.starts_with("t.gltf: error: accessor 0 (POSITION) says 1800000 items, more than"),
         "{e}"
     );
     // A view past its buffer's end.
@@ -705,5 +710,27 @@ fn bad_base64_and_wrong_types_are_refused() {
     assert!(
         e.contains("POSITION (accessor 0) must be VEC3 of 32-bit floats"),
         "{e}"
+    );
+}
+
+#[test]
+fn a_mesh_placed_by_too_many_nodes_is_refused_before_it_is_read() {
+    // 1000 triangles (no indices: 3000 positions), placed by 2001 nodes: 2,001,000
+    // triangles, over the 2,000,000 allowed, from a 36 kB buffer.
+    let mut b = Builder::default();
+    let p: Vec<[f32; 3]> = (0..3000).map(|k| [k as f32, (k % 3) as f32, 0.0]).collect();
+    let pos = b.positions(&p);
+    let nodes: Vec<Value> = (0..2001).map(|_| json!({ "mesh": 0 })).collect();
+    let doc = b.json(
+        json!({ "scenes": [{ "nodes": (0..2001).collect::<Vec<_>>() }], "nodes": nodes,
+                "meshes": [{ "primitives": [{ "attributes": { "POSITION": pos } }] }] }),
+        Some(""),
+    );
+    assert_eq!(
+        read_doc(&doc).unwrap_err().to_string(),
+        format!(
+            "t.gltf: error: the scene would have 2001000 triangles once every node's mesh is \
+             placed, more than the {MAX_TRIANGLES} this reader takes; split it or simplify it"
+        )
     );
 }

@@ -9,7 +9,7 @@
 //! | `.obj` | Wavefront OBJ with its MTL materials | module `obj` |
 //! | `.gltf`, `.glb` | glTF 2.0 | [`gltf`] |
 //! | `.dxf` | AutoCAD DXF | not yet: [`ImportError::NotSupportedYet`] |
-//! | `.wrl` | VRML97 | not yet: [`ImportError::NotSupportedYet`] |
+//! | `.wrl` | VRML97 | [`vrml`] |
 //!
 //! Every importer other than the scene file's reads its file into a [`FaceSoup`] (named
 //! objects, faces as lists of indices into one vertex array, a material per face) and
@@ -55,6 +55,8 @@
 mod face_soup;
 pub mod gltf;
 mod merge;
+mod tessellate;
+pub mod vrml;
 
 use std::fmt;
 use std::path::Path;
@@ -373,9 +375,8 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
     match format {
         Format::Scene => read_scene_scaled(path, options.scale),
         Format::Gltf | Format::Glb => gltf::read(path, options),
-        Format::Dxf | Format::Vrml | Format::Obj => {
-            Err(ImportError::NotSupportedYet { file, format })
-        }
+        Format::Vrml => vrml::read(path, options),
+        Format::Dxf | Format::Obj => Err(ImportError::NotSupportedYet { file, format }),
     }
 }
 
