@@ -61,8 +61,14 @@ pub struct BuildingArgs {
 /// Options every command shares.
 #[derive(Args)]
 pub struct SceneArgs {
-    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    /// Scene file, by extension: .scene (Appendix A format) or .obj (with its MTL); the
+    /// built-in Cornell box when omitted.
     pub scene: Option<PathBuf>,
+    /// Multiply every coordinate of the scene file by this (0.001 reads a model in
+    /// millimetres as metres). OBJ states no unit: its numbers are taken as metres, times
+    /// SCALE. A .scene file's MAX_PATCH_AREA is scaled with it, so it meshes the same.
+    #[arg(long, default_value_t = 1.0, value_name = "SCALE")]
+    pub scale: f64,
     /// Override the scene's MAX_PATCH_AREA (scene units squared).
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,
@@ -406,8 +412,14 @@ pub struct CompareArgs {
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    /// Scene file, by extension: .scene (Appendix A format) or .obj (with its MTL); the
+    /// built-in Cornell box when omitted.
     pub scene: Option<PathBuf>,
+    /// Multiply every coordinate of the scene file by this (0.001 reads a model in
+    /// millimetres as metres). OBJ states no unit: its numbers are taken as metres, times
+    /// SCALE. A .scene file's MAX_PATCH_AREA is scaled with it, so it meshes the same.
+    #[arg(long, default_value_t = 1.0, value_name = "SCALE")]
+    pub scale: f64,
     #[command(flatten)]
     pub method: MethodArgs,
     /// MAX_PATCH_AREA values to time, one table row each (repeat the option or give several
@@ -445,8 +457,14 @@ pub struct BenchArgs {
 #[derive(Args)]
 #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub struct ViewArgs {
-    /// Scene file (Appendix A format); the built-in Cornell box when omitted.
+    /// Scene file, by extension: .scene (Appendix A format) or .obj (with its MTL); the
+    /// built-in Cornell box when omitted.
     pub scene: Option<PathBuf>,
+    /// Multiply every coordinate of the scene file by this (0.001 reads a model in
+    /// millimetres as metres). OBJ states no unit: its numbers are taken as metres, times
+    /// SCALE. A .scene file's MAX_PATCH_AREA is scaled with it, so it meshes the same.
+    #[arg(long, default_value_t = 1.0, value_name = "SCALE")]
+    pub scale: f64,
     /// Override the scene's MAX_PATCH_AREA (scene units squared).
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,

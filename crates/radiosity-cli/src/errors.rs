@@ -10,7 +10,7 @@ use radiosity::solve::SolveError;
 
 /// The message for a failed run: the error and the causes its text does not already
 /// include, then the command-line hint for it (see [`hint`]), after "error: " (scene errors
-/// carry their own "file:line:column: error:").
+/// carry their own "file:line:column: error:", and so do import errors).
 pub fn describe(err: &anyhow::Error) -> String {
     let mut text = err.to_string();
     for cause in err.chain().skip(1) {
@@ -22,7 +22,11 @@ pub fn describe(err: &anyhow::Error) -> String {
     if let Some(hint) = err.chain().find_map(hint) {
         text.push_str(&hint);
     }
-    if err.downcast_ref::<scene::SceneError>().is_some() {
+    if err.downcast_ref::<scene::SceneError>().is_some()
+        || err
+            .downcast_ref::<radiosity::io::import::ImportError>()
+            .is_some()
+    {
         text
     } else {
         format!("error: {text}")

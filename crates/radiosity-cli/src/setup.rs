@@ -7,6 +7,7 @@ use std::path::Path;
 use anyhow::{bail, Result};
 use glam::DVec3;
 use radiosity::form_factor::FormFactorMethod;
+use radiosity::io::import::{read_any_scene, Format, ImportOptions};
 use radiosity::mesh::{AdaptSettings, MeshError};
 use radiosity::pipeline::{Overrides, PipelineError, Prepared};
 use radiosity::progress::{run_stage, Stage};
@@ -85,7 +86,7 @@ fn method_flag_given(args: &crate::args::MethodArgs) -> Option<&'static str> {
 /// The scene loaded, meshed with its file's settings overridden by the flags, and its
 /// form-factor method set.
 fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
-    let (file, stem) = load_scene(args.scene.as_deref(), reporter)?;
+    let (file, stem) = load_scene(args.scene.as_deref(), args.scale, reporter)?;
     let overrides = Overrides {
         max_patch_area: args.max_area,
         integral_steps: args.steps,
@@ -96,14 +97,13 @@ fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, Str
         }
     }
     let settings = overrides.apply(file.settings);
-    let mut prepared =
-        Prepared::new(file.scene, settings, reporter).map_err(|e| match e {
-            // Say where the MAX_PATCH_AREA that cannot be met came from.
-            PipelineError::Mesh(
-                MeshError::TooManyElements { .. } | MeshError::BadElementArea { .. },
-            ) => anyhow::Error::new(e).context(max_area_origin(args)),
-            e => e.into(),
-        })?;
+    let mut prepared = Prepared::new(file.scene, settings, reporter).map_err(|e| match e {
+        // Say where the MAX_PATCH_AREA that cannot be met came from.
+        PipelineError::Mesh(
+            MeshError::TooManyElements { .. } | MeshError::BadElementArea { .. },
+        ) => anyhow::Error::new(e).context(max_area_origin(args)),
+        e => e.into(),
+    })?;
     let m = &args.method;
     let steps = prepared.settings.integral_steps;
     prepared.method = match m.method {
@@ -143,11 +143,21 @@ fn max_area_origin(args: &SceneArgs) -> String {
     let Some(path) = args.scene.as_deref() else {
         return "the built-in Cornell box's MAX_PATCH_AREA".to_string();
     };
+    if Format::of_path(path) != Some(Format::Scene) {
+        return format!(
+            "{}: the MAX_PATCH_AREA given to an imported scene (its total area / 1000)",
+            path.display()
+        );
+    }
     // The first line that starts with the keyword (the reader has accepted the file, so it
     // is there, in its place before SCENEBEGIN).
     let text = std::fs::read_to_string(path).unwrap_or_default();
     let line = text.lines().enumerate().find_map(|(i, l)| {
-        let code = l.split("//").next().unwrap_or("").trim_start_matches('\u{feff}');
+        let code = l
+            .split("//")
+            .next()
+            .unwrap_or("")
+            .trim_start_matches('\u{feff}');
         let mut words = code.split_whitespace();
         let head = words.next()?;
         head.eq_ignore_ascii_case("MAX_PATCH_AREA")
@@ -199,17 +209,43 @@ pub fn refuse_overwriting_inputs(output: &Path, inputs: &[(&str, Option<&Path>)]
     Ok(())
 }
 
-/// The scene file at `path`, or the built-in Cornell box, with a short name for default
-/// outputs ("cornell", or the file's stem).
-pub fn load_scene(path: Option<&Path>, reporter: &Reporter) -> Result<(SceneFile, String)> {
+/// The scene file at `path` (any format [`radiosity::io::import`] reads, by extension; every
+/// coordinate times `scale`), or the built-in Cornell box, with a short name for default
+/// outputs ("cornell", or the file's stem). The reader's warnings are printed (even with
+/// --quiet: they say what of the file was left out), and the scene's unit noted.
+pub fn load_scene(
+    path: Option<&Path>,
+    scale: f64,
+    reporter: &Reporter,
+) -> Result<(SceneFile, String)> {
     match path {
-        None => Ok((
-            run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
-            "cornell".to_string(),
-        )),
+        None => {
+            if scale != 1.0 {
+                bail!(
+                    "--scale applies to a scene file; the built-in Cornell box is in millimetres"
+                );
+            }
+            Ok((
+                run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
+                "cornell".to_string(),
+            ))
+        }
         Some(path) => {
-            let file = run_stage(reporter, Stage::Parse, 0, || scene::read_scene(path))?;
-            Ok((file, stem_of(Some(path))))
+            let options = ImportOptions {
+                scale,
+                settings: None,
+            };
+            let imported = run_stage(reporter, Stage::Parse, 0, || read_any_scene(path, &options))?;
+            for w in &imported.warnings {
+                errln!("{w}");
+            }
+            reporter.note(&format!(
+                "{}: read as {}; unit: {}",
+                path.display(),
+                imported.format,
+                imported.unit
+            ));
+            Ok((imported.file, stem_of(Some(path))))
         }
     }
 }

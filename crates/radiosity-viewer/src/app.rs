@@ -146,10 +146,12 @@ impl ViewerApp {
                 texture,
             }
         });
+        // The window saves in the scene format: beside an imported model (room.obj), as
+        // room.scene, never over the model.
         let save_path = options
             .path
             .as_ref()
-            .map(|p| p.display().to_string())
+            .map(|p| p.with_extension("scene").display().to_string())
             .unwrap_or_else(|| "cornell_box.scene".into());
         let show_panel = options.screenshot.is_none() || options.panel;
         ViewerApp {

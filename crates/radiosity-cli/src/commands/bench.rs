@@ -101,6 +101,7 @@ const BENCH_STAGES: [Stage; 7] = [
 fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     let scene_args = SceneArgs {
         scene: args.scene.clone(),
+        scale: args.scale,
         max_area,
         steps: args.steps,
         method: args.method.clone(),

@@ -65,7 +65,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     let (scene, stem): (&Scene, &str) = match &prepared {
         Some((p, stem, _)) => (&p.scene, stem),
         None => {
-            loaded = load_scene(args.scene.scene.as_deref(), &reporter)?;
+            loaded = load_scene(args.scene.scene.as_deref(), args.scene.scale, &reporter)?;
             (&loaded.0.scene, &loaded.1)
         }
     };

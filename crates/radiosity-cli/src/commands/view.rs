@@ -26,7 +26,20 @@ pub fn run(args: ViewArgs) -> Result<()> {
         return Ok(());
     }
     let file = match &args.scene {
-        Some(path) => radiosity::scene::read_scene(path)?,
+        Some(path) => {
+            let options = radiosity::io::import::ImportOptions {
+                scale: args.scale,
+                settings: None,
+            };
+            let imported = radiosity::io::import::read_any_scene(path, &options)?;
+            for w in &imported.warnings {
+                errln!("{w}");
+            }
+            imported.file
+        }
+        None if args.scale != 1.0 => {
+            bail!("--scale applies to a scene file; the built-in Cornell box is in millimetres")
+        }
         None => radiosity::scene::cornell_box(),
     };
     let mut options = ViewerOptions::new(file, args.scene.clone());

@@ -764,11 +764,36 @@ fn box_room_scene(max_area: &str, origin: &str, size: &str) -> String {
 fn hostile_scene_geometry_is_refused_with_file_and_line() {
     let dir = scratch_dir("hostile_geometry");
     let cases = [
-        ("1", "0 0 0", "1 1", "h.scene:14:9: error: expected a number (the z size)"),
-        ("1", "0 0 0", "1 abc 1", "h.scene:14:8: error: expected a number (the y size)"),
-        ("1", "0 0 0", "1e-300 1e-300 1e-300", "h.scene:14:1: error: the box's face \"Room.base\""),
-        ("1", "0 0 0", "1e308 1 1", "h.scene:14:6: error: the box reaches x = 1e308"),
-        ("1e-300", "0 0 0", "1 1 1", "error: h.scene:1: MAX_PATCH_AREA 1e-300: meshing"),
+        (
+            "1",
+            "0 0 0",
+            "1 1",
+            "h.scene:14:9: error: expected a number (the z size)",
+        ),
+        (
+            "1",
+            "0 0 0",
+            "1 abc 1",
+            "h.scene:14:8: error: expected a number (the y size)",
+        ),
+        (
+            "1",
+            "0 0 0",
+            "1e-300 1e-300 1e-300",
+            "h.scene:14:1: error: the box's face \"Room.base\"",
+        ),
+        (
+            "1",
+            "0 0 0",
+            "1e308 1 1",
+            "h.scene:14:6: error: the box reaches x = 1e308",
+        ),
+        (
+            "1e-300",
+            "0 0 0",
+            "1 1 1",
+            "error: h.scene:1: MAX_PATCH_AREA 1e-300: meshing",
+        ),
     ];
     for (max_area, origin, size, expected) in cases {
         std::fs::write(dir.join("h.scene"), box_room_scene(max_area, origin, size)).unwrap();
@@ -776,7 +801,10 @@ fn hostile_scene_geometry_is_refused_with_file_and_line() {
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(1), "SIZE {size}: {err}");
         assert!(err.contains(expected), "SIZE {size}: {err}");
-        assert!(!err.contains("panicked") && !err.contains(" inf"), "SIZE {size}: {err}");
+        assert!(
+            !err.contains("panicked") && !err.contains(" inf"),
+            "SIZE {size}: {err}"
+        );
     }
     // The floor of the rug scene given twice.
     let scene = floor_and_rug_scene(0.0).replace("#Rug", "#Floor2").replace(

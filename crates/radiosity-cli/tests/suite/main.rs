@@ -5,5 +5,6 @@ mod fixtures;
 
 mod commands;
 mod hostile;
+mod imports;
 mod pathtrace;
 mod view;

@@ -59,3 +59,126 @@ pub(crate) fn box_faces(base: &[DVec3; 4], height: f64, facing: Facing) -> [Vec<
     }
     faces
 }
+
+/// The largest `RESOLUTION` of a sphere, cylinder or cone: 512 segments round the axis (a
+/// sphere of 512 x 256 = 131,072 faces).
+pub(crate) const MAX_RESOLUTION: u32 = 512;
+
+/// The `RESOLUTION` of a sphere, cylinder or cone that gives none: 16 segments round the
+/// axis (a sphere of 16 x 8 = 128 faces, 3.2 % short of the sphere's area).
+pub(crate) const DEFAULT_RESOLUTION: u32 = 16;
+
+/// The point at `angle` round the y axis on the circle of `radius` at height `y` about
+/// `centre`: angle 0 is +x, and angles grow from +x towards -z, counter-clockwise seen from
+/// +y.
+fn on_circle(centre: DVec3, radius: f64, y: f64, angle: f64) -> DVec3 {
+    let (s, c) = angle.sin_cos();
+    centre + DVec3::new(radius * c, y, -radius * s)
+}
+
+/// Reverses every face for [`Facing::In`] and flattens it (each is planar by construction;
+/// this only rounds away what the sines and cosines left).
+fn finish(mut faces: Vec<Vec<DVec3>>, facing: Facing) -> Vec<Vec<DVec3>> {
+    for face in &mut faces {
+        if facing == Facing::In {
+            face.reverse();
+        }
+        geometry::flatten(face);
+    }
+    faces
+}
+
+/// The faces of a sphere: `n` segments round the y axis and `max(2, n / 2)` bands from
+/// pole to pole, each of the same angle 2 pi / n (for even `n`); the corners lie on the
+/// sphere (it is inscribed). The bands at the poles are triangles, the others quads (each
+/// an isosceles trapezoid between two circles of latitude, so planar). In order from the
+/// bottom (-y) pole up, each band round from +x; counter-clockwise seen from outside for
+/// [`Facing::Out`].
+pub(crate) fn sphere_faces(centre: DVec3, radius: f64, n: u32, facing: Facing) -> Vec<Vec<DVec3>> {
+    let bands = (n / 2).max(2);
+    let point = |band: u32, seg: u32| {
+        // Polar angle from the bottom pole.
+        let theta = std::f64::consts::PI * f64::from(band) / f64::from(bands);
+        let phi = std::f64::consts::TAU * f64::from(seg % n) / f64::from(n);
+        let (st, ct) = theta.sin_cos();
+        on_circle(centre, radius * st, -radius * ct, phi)
+    };
+    let mut faces = Vec::with_capacity((n * bands) as usize);
+    for band in 0..bands {
+        for seg in 0..n {
+            // Round (counter-clockwise seen from +y) along the lower circle, up, back along
+            // the upper one: counter-clockwise seen from outside, as a cylinder's side.
+            let face = if band == 0 {
+                vec![
+                    centre - DVec3::new(0.0, radius, 0.0),
+                    point(1, seg + 1),
+                    point(1, seg),
+                ]
+            } else if band == bands - 1 {
+                vec![
+                    point(band, seg),
+                    point(band, seg + 1),
+                    centre + DVec3::new(0.0, radius, 0.0),
+                ]
+            } else {
+                vec![
+                    point(band, seg),
+                    point(band, seg + 1),
+                    point(band + 1, seg + 1),
+                    point(band + 1, seg),
+                ]
+            };
+            faces.push(face);
+        }
+    }
+    finish(faces, facing)
+}
+
+/// The faces of a cylinder round the y axis: the base disc (centre `centre`, facing -y
+/// when out), the top disc at `centre + height y`, then the `n` side quads round from +x.
+/// Names: `base`, `top`, `side0` .. `side(n-1)`.
+pub(crate) fn cylinder_faces(
+    centre: DVec3,
+    radius: f64,
+    height: f64,
+    n: u32,
+    facing: Facing,
+) -> Vec<Vec<DVec3>> {
+    let angle = |k: u32| std::f64::consts::TAU * f64::from(k % n) / f64::from(n);
+    let bottom: Vec<DVec3> = (0..n)
+        .map(|k| on_circle(centre, radius, 0.0, angle(k)))
+        .collect();
+    let top: Vec<DVec3> = (0..n)
+        .map(|k| on_circle(centre, radius, height, angle(k)))
+        .collect();
+    let mut faces = vec![bottom.iter().rev().copied().collect(), top.clone()];
+    for k in 0..n as usize {
+        let j = (k + 1) % n as usize;
+        // Counter-clockwise seen from outside: along the bottom edge, then up.
+        faces.push(vec![bottom[k], bottom[j], top[j], top[k]]);
+    }
+    finish(faces, facing)
+}
+
+/// The faces of a cone round the y axis: the base disc (centre `centre`, facing -y when
+/// out), then the `n` side triangles up to the apex `centre + height y`, round from +x.
+/// Names: `base`, `side0` .. `side(n-1)`.
+pub(crate) fn cone_faces(
+    centre: DVec3,
+    radius: f64,
+    height: f64,
+    n: u32,
+    facing: Facing,
+) -> Vec<Vec<DVec3>> {
+    let angle = |k: u32| std::f64::consts::TAU * f64::from(k % n) / f64::from(n);
+    let bottom: Vec<DVec3> = (0..n)
+        .map(|k| on_circle(centre, radius, 0.0, angle(k)))
+        .collect();
+    let apex = centre + DVec3::new(0.0, height, 0.0);
+    let mut faces = vec![bottom.iter().rev().copied().collect()];
+    for k in 0..n as usize {
+        let j = (k + 1) % n as usize;
+        faces.push(vec![bottom[k], bottom[j], apex]);
+    }
+    finish(faces, facing)
+}

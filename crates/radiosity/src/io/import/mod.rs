@@ -6,7 +6,7 @@
 //! | extension | format | reader |
 //! | --- | --- | --- |
 //! | `.scene` | the paper's Appendix A format | [`crate::io::scene_file`] |
-//! | `.obj` | Wavefront OBJ with its MTL materials | module `obj` |
+//! | `.obj` | Wavefront OBJ with its MTL materials | [`obj`] |
 //! | `.gltf`, `.glb` | glTF 2.0 | [`gltf`] |
 //! | `.dxf` | AutoCAD DXF | not yet: [`ImportError::NotSupportedYet`] |
 //! | `.wrl` | VRML97 | [`vrml`] |
@@ -55,6 +55,7 @@
 mod face_soup;
 pub mod gltf;
 mod merge;
+pub mod obj;
 mod tessellate;
 pub mod vrml;
 
@@ -63,6 +64,7 @@ use std::path::Path;
 
 use thiserror::Error;
 
+pub(crate) use face_soup::triangulate;
 pub use face_soup::{FaceSoup, SoupFace, SoupMaterial};
 
 use crate::geometry;
@@ -374,9 +376,10 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
     };
     match format {
         Format::Scene => read_scene_scaled(path, options.scale),
+        Format::Obj => obj::read(path, options),
         Format::Gltf | Format::Glb => gltf::read(path, options),
         Format::Vrml => vrml::read(path, options),
-        Format::Dxf | Format::Obj => Err(ImportError::NotSupportedYet { file, format }),
+        Format::Dxf => Err(ImportError::NotSupportedYet { file, format }),
     }
 }
 

@@ -23,9 +23,9 @@
 //!   brighter than that). A `Shape` without a `Material` gets `Material`'s defaults;
 //! * geometry: `IndexedFaceSet` (`coord`, `coordIndex` faces separated by -1, `ccw`), and
 //!   the primitives `Box`, `Sphere`, `Cone` and `Cylinder` (with their `side`, `top` and
-//!   `bottom` flags), tessellated into quads and triangles whose fronts face outwards:
-//!   [`DEFAULT_SEGMENTS`] around the axis, a sphere in half as many bands (module
-//!   `tessellate`);
+//!   `bottom` flags), tessellated as the scene format's `BOX`, `SPHERE`, `CYLINDER` and
+//!   `CONE` are (fronts facing outwards; [`DEFAULT_SEGMENTS`] round the axis, a sphere in
+//!   half as many bands of quads with triangles at the poles, caps one convex polygon);
 //! * the first `Viewpoint` (position, orientation, fieldOfView) as the scene's camera.
 //!
 //! Each `Shape` is one object, named after its `DEF` name, or its nearest `DEF`-named
@@ -56,8 +56,9 @@ use crate::scene::CameraHint;
 /// The reflectance a `diffuseColor` of 1 or more becomes.
 pub const MAX_REFLECTANCE: f64 = 0.99;
 
-/// Segments round the axis of a tessellated `Sphere`, `Cone` or `Cylinder`.
-pub const DEFAULT_SEGMENTS: u32 = 24;
+/// Segments round the axis of a tessellated `Sphere`, `Cone` or `Cylinder`: the scene
+/// format's default `RESOLUTION`, 16 (a sphere of 16 x 8 faces, 3.2% short of its area).
+pub const DEFAULT_SEGMENTS: u32 = crate::scene::shape::DEFAULT_RESOLUTION;
 
 /// How deeply nodes may nest in the file.
 pub const MAX_DEPTH: usize = 200;
@@ -568,19 +569,23 @@ impl Parser<'_> {
                     let f = self.field_value(name, fl)?;
                     fields.push(f);
                 }
-                Tok::End => return Err(self.error(
-                    fl,
-                    format!(
+                Tok::End => {
+                    return Err(self.error(
+                        fl,
+                        format!(
                         "the file ends inside the {kind} node of line {line} (a '}}' is missing)"
                     ),
-                )),
-                other => return Err(self.error(
-                    fl,
-                    format!(
+                    ))
+                }
+                other => {
+                    return Err(self.error(
+                        fl,
+                        format!(
                         "expected a field name or '}}' in the {kind} node of line {line}, found {}",
                         other.describe()
                     ),
-                )),
+                    ))
+                }
             }
         }
         self.depth -= 1;

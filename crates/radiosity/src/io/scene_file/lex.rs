@@ -110,12 +110,21 @@ pub(super) enum Keyword {
     Origin,
     Size,
     Height,
+    SphereBegin,
+    SphereEnd,
+    CylinderBegin,
+    CylinderEnd,
+    ConeBegin,
+    ConeEnd,
+    Center,
+    Radius,
+    Resolution,
     /// Anything else.
     Unknown,
 }
 
 /// The fixed keywords and their canonical spelling.
-const WORDS: [(&str, Keyword); 20] = [
+const WORDS: [(&str, Keyword); 29] = [
     ("MAX_PATCH_AREA", Keyword::MaxPatchArea),
     ("INTEGRAL_STEPS", Keyword::IntegralSteps),
     ("SCENEBEGIN", Keyword::SceneBegin),
@@ -136,6 +145,15 @@ const WORDS: [(&str, Keyword); 20] = [
     ("ORIGIN", Keyword::Origin),
     ("SIZE", Keyword::Size),
     ("HEIGHT", Keyword::Height),
+    ("SPHEREBEGIN", Keyword::SphereBegin),
+    ("SPHEREEND", Keyword::SphereEnd),
+    ("CYLINDERBEGIN", Keyword::CylinderBegin),
+    ("CYLINDEREND", Keyword::CylinderEnd),
+    ("CONEBEGIN", Keyword::ConeBegin),
+    ("CONEEND", Keyword::ConeEnd),
+    ("CENTER", Keyword::Center),
+    ("RADIUS", Keyword::Radius),
+    ("RESOLUTION", Keyword::Resolution),
 ];
 
 impl Keyword {

@@ -9,8 +9,8 @@
 //! # The scene format
 //!
 //! The format is the one of De Angelis, *Radiosity: A Study in Photorealistic Rendering*
-//! (1998), Appendix A, with one addition, the box primitive the paper proposes in section
-//! 3.1. Each value stands on its own labelled line, in this order:
+//! (1998), Appendix A, with two additions, the box primitive the paper proposes in section
+//! 3.1 and the sphere, cylinder and cone it wishes for there. Each value stands on its own labelled line, in this order:
 //!
 //! ```text
 //! MAX_PATCH_AREA 100        // meshing threshold, scene units squared; > 0, may be decimal
@@ -48,6 +48,41 @@
 //! Instead of `ORIGIN` and `SIZE` a box may be given as one face and a height:
 //! `VERTICES 4`, `VERTEX0` .. `VERTEX3` (a planar convex quad, the base) and `HEIGHT h`
 //! (h > 0); the box is the prism swept from the base along its right-hand-rule normal by h.
+//!
+//! Spheres, cylinders and cones (the primitives the paper wishes for in section 3.1) are
+//! blocks like the box, tessellated into planar quads and triangles whose corners lie on
+//! the exact shape:
+//!
+//! ```text
+//! SPHEREBEGIN               // NAME.0, NAME.1, ...: n segments round the y axis times
+//! #Ball                     // max(2, n/2) bands from the bottom pole up; triangles at the
+//! FACING OUT                // poles, quads between
+//! Er 0                      // the same six colour lines as a patch
+//! Eg 0
+//! Eb 0
+//! Rr 0.5
+//! Rg 0.5
+//! Rb 0.5
+//! CENTER 0 1 0              // the centre
+//! RADIUS 0.5                // > 0
+//! RESOLUTION 16             // optional: n, from 3 to 512 (16 when left out)
+//! SPHEREEND
+//! CYLINDERBEGIN             // NAME.base, NAME.top, NAME.side0 .. side(n-1)
+//! ...                       // #NAME, FACING, the colours, as above
+//! CENTER 2 0 0              // the centre of the base disc; the axis runs up +y from it
+//! RADIUS 0.3
+//! HEIGHT 1.2                // > 0
+//! RESOLUTION 12             // optional
+//! CYLINDEREND
+//! CONEBEGIN                 // NAME.base, NAME.side0 .. side(n-1); the apex at CENTER + HEIGHT y
+//! ...
+//! CONEEND
+//! ```
+//!
+//! A patch may have any number of vertices (3 or more). One that is planar but not convex,
+//! with an outline that does not cross itself (an L, a dart), is split into triangles
+//! `NAME.0`, `NAME.1`, ... (ear clipping on its plane); a crossing outline (a bow tie, most
+//! likely corners in the wrong order) is an error, as below.
 //!
 //! `//` starts a comment anywhere on a line, blank lines may go anywhere, and keywords are
 //! case-insensitive. Numbers are written as Rust reads an `f64` (`1`, `-0.5`, `.5`, `2.`,

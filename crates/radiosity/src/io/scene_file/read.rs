@@ -171,6 +171,72 @@ pub(crate) fn duplicate_surfaces(surfaces: &[Surface]) -> Vec<(usize, usize)> {
     pairs
 }
 
+/// A planar polygon that is not convex, as triangles, when its outline does not cross
+/// itself: the corners flattened onto the best-fit plane and ear-clipped
+/// ([`crate::io::import`]'s triangulation), accepted only when every triangle is usable and
+/// their areas add up to the polygon's (to 1e-9: rounding), which fails for an outline that
+/// crosses itself (a bow tie, whose signed parts cancel) or goes round twice. `None` then:
+/// such a patch is more likely corners given in the wrong order than a shape, and stays an
+/// error.
+fn simple_triangles(corners: &[DVec3]) -> Option<Vec<[DVec3; 3]>> {
+    let mut flat = corners.to_vec();
+    geometry::project_to_plane(&mut flat);
+    let (triangles, lost) = crate::io::import::triangulate(&flat);
+    let area = geometry::polygon_area(&flat);
+    let sum: f64 = triangles.iter().map(|t| geometry::polygon_area(t)).sum();
+    (lost == 0 && !triangles.is_empty() && (sum - area).abs() <= 1e-9 * area).then_some(triangles)
+}
+
+/// The keywords that start a block, or end the scene: where recovery after an error stops.
+fn is_block_start(k: Keyword) -> bool {
+    matches!(
+        k,
+        Keyword::PatchBegin
+            | Keyword::BoxBegin
+            | Keyword::SphereBegin
+            | Keyword::CylinderBegin
+            | Keyword::ConeBegin
+            | Keyword::SceneEnd
+    )
+}
+
+/// The round primitives.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Round {
+    Sphere,
+    Cylinder,
+    Cone,
+}
+
+impl Round {
+    fn keywords(self) -> (Keyword, Keyword) {
+        match self {
+            Round::Sphere => (Keyword::SphereBegin, Keyword::SphereEnd),
+            Round::Cylinder => (Keyword::CylinderBegin, Keyword::CylinderEnd),
+            Round::Cone => (Keyword::ConeBegin, Keyword::ConeEnd),
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Round::Sphere => "sphere",
+            Round::Cylinder => "cylinder",
+            Round::Cone => "cone",
+        }
+    }
+}
+
+/// A round primitive's geometry as written.
+struct RoundShape {
+    centre: DVec3,
+    radius: f64,
+    height: f64,
+    resolution: u32,
+    /// The `RADIUS` line, where problems with the faces are reported.
+    line: usize,
+    column: usize,
+}
+
 /// Marks a failed step whose error has already been recorded.
 struct Reported;
 
@@ -467,12 +533,22 @@ impl<'a> Parser<'a> {
                 }
                 Some(Keyword::PatchBegin) => {
                     blocks += 1;
-                    surfaces.extend(self.patch());
+                    surfaces.extend(self.patch().into_iter().flatten());
                     self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
                 Some(Keyword::BoxBegin) => {
                     blocks += 1;
                     surfaces.extend(self.box_block().into_iter().flatten());
+                    self.surface_lines.resize(surfaces.len(), self.block_line);
+                }
+                Some(k @ (Keyword::SphereBegin | Keyword::CylinderBegin | Keyword::ConeBegin)) => {
+                    blocks += 1;
+                    let kind = match k {
+                        Keyword::SphereBegin => Round::Sphere,
+                        Keyword::CylinderBegin => Round::Cylinder,
+                        _ => Round::Cone,
+                    };
+                    surfaces.extend(self.round_block(kind).into_iter().flatten());
                     self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
                 Some(Keyword::SceneEnd) => {
@@ -539,10 +615,7 @@ impl<'a> Parser<'a> {
         self.unexpected("PATCHBEGIN, BOXBEGIN or SCENEEND");
         self.pos += 1;
         while let Some(k) = self.current_keyword() {
-            if matches!(
-                k,
-                Keyword::PatchBegin | Keyword::BoxBegin | Keyword::SceneEnd
-            ) {
+            if is_block_start(k) {
                 break;
             }
             self.pos += 1;
@@ -557,10 +630,7 @@ impl<'a> Parser<'a> {
                 self.pos += 1;
                 return;
             }
-            if matches!(
-                k,
-                Keyword::PatchBegin | Keyword::BoxBegin | Keyword::SceneEnd
-            ) {
+            if is_block_start(k) {
                 return;
             }
             self.pos += 1;
@@ -611,8 +681,10 @@ impl<'a> Parser<'a> {
 
     // ----- patches -----
 
-    /// A `PATCHBEGIN` block as a checked surface.
-    fn patch(&mut self) -> Option<Surface> {
+    /// A `PATCHBEGIN` block as a checked surface; a planar patch that is not convex but
+    /// whose outline does not cross itself (an L, a dart) as its triangles `NAME.0`,
+    /// `NAME.1`, ... ([`simple_triangles`]).
+    fn patch(&mut self) -> Option<Vec<Surface>> {
         let (head, mut corners) = self.block(Keyword::PatchBegin, Keyword::PatchEnd, |p| {
             let name = p.name_line()?;
             let count = p.vertex_count(3, "a patch")?;
@@ -620,13 +692,30 @@ impl<'a> Parser<'a> {
             Ok((head, p.vertex_lines(count)?))
         })?;
         self.block_line = (corners.line, corners.column);
+        if let Err(geometry::PolygonError::Reflex { .. }) =
+            geometry::validate_polygon(&corners.vertices)
+        {
+            if let Some(triangles) = simple_triangles(&corners.vertices) {
+                let surfaces = triangles
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, t)| Surface {
+                        name: format!("{}.{k}", head.name),
+                        emission: head.emission,
+                        reflectance: head.reflectance,
+                        vertices: t.to_vec(),
+                    })
+                    .collect();
+                return Some(surfaces);
+            }
+        }
         self.check_polygon(&mut corners)?;
-        Some(Surface {
+        Some(vec![Surface {
             name: head.name,
             emission: head.emission,
             reflectance: head.reflectance,
             vertices: corners.vertices,
-        })
+        }])
     }
 
     /// Checks and flattens a polygon ([`geometry::validate_polygon`], [`geometry::flatten`]),
@@ -788,6 +877,122 @@ impl<'a> Parser<'a> {
         Some(surfaces)
     }
 
+    /// A `SPHEREBEGIN`, `CYLINDERBEGIN` or `CONEBEGIN` block as its checked faces.
+    fn round_block(&mut self, kind: Round) -> Option<Vec<Surface>> {
+        let (begin, end) = kind.keywords();
+        let (head, facing, shape) = self.block(begin, end, |p| {
+            let name = p.name_line()?;
+            let facing = p.facing()?;
+            let head = p.colours(name)?;
+            let shape = p.round_shape(kind)?;
+            Ok((head, facing, shape))
+        })?;
+        self.block_line = (shape.line, shape.column);
+        let RoundShape {
+            centre,
+            radius,
+            height,
+            resolution: n,
+            ..
+        } = shape;
+        let (faces, names): (Vec<Vec<DVec3>>, Vec<String>) = match kind {
+            Round::Sphere => {
+                let faces = shape::sphere_faces(centre, radius, n, facing);
+                let names = (0..faces.len()).map(|k| k.to_string()).collect();
+                (faces, names)
+            }
+            Round::Cylinder => {
+                let faces = shape::cylinder_faces(centre, radius, height, n, facing);
+                let names = ["base".to_string(), "top".to_string()]
+                    .into_iter()
+                    .chain((0..n).map(|k| format!("side{k}")))
+                    .collect();
+                (faces, names)
+            }
+            Round::Cone => {
+                let faces = shape::cone_faces(centre, radius, height, n, facing);
+                let names = std::iter::once("base".to_string())
+                    .chain((0..n).map(|k| format!("side{k}")))
+                    .collect();
+                (faces, names)
+            }
+        };
+        let mut surfaces = Vec::with_capacity(faces.len());
+        for (suffix, vertices) in names.into_iter().zip(faces) {
+            let name = format!("{}.{suffix}", head.name);
+            if let Err(e) = geometry::validate_polygon(&vertices) {
+                let msg = format!(
+                    "the {}'s face \"{name}\" is not a usable polygon: {e} (the {} is too small \
+                     or too thin for its position, or too large; rescale the scene or change \
+                     RESOLUTION)",
+                    kind.name(),
+                    kind.name()
+                );
+                self.error(shape.line, shape.column, msg);
+                return None;
+            }
+            surfaces.push(Surface {
+                name,
+                emission: head.emission,
+                reflectance: head.reflectance,
+                vertices,
+            });
+        }
+        Some(surfaces)
+    }
+
+    /// `CENTER`, `RADIUS`, `HEIGHT` (not for a sphere) and an optional `RESOLUTION`.
+    fn round_shape(&mut self, kind: Round) -> Step<RoundShape> {
+        let (read, centre_line) = self.triple_read(Keyword::Center, "coordinate")?;
+        let mut centre = [0.0; 3];
+        for (i, found) in read.iter().enumerate() {
+            let Some((v, token)) = *found else { break };
+            centre[i] = v;
+            self.check_range(v, token, &centre_line);
+        }
+        let (radius, token, line) = self.value(Keyword::Radius)?;
+        if radius <= 0.0 {
+            let msg = format!("RADIUS must be greater than 0, found \"{}\"", token.text);
+            self.error_at(token, &line, msg);
+        }
+        let (shape_line, shape_column) = (line.number, line.head().column);
+        let mut height = 0.0;
+        if kind != Round::Sphere {
+            let (h, token, line) = self.value(Keyword::Height)?;
+            if h <= 0.0 {
+                let msg = format!("HEIGHT must be greater than 0, found \"{}\"", token.text);
+                self.error_at(token, &line, msg);
+            }
+            height = h;
+        }
+        let mut resolution = shape::DEFAULT_RESOLUTION;
+        if self.current_keyword() == Some(Keyword::Resolution) {
+            let (v, token, line) = self.value(Keyword::Resolution)?;
+            match Self::whole(v) {
+                Some(n) if (3..=u64::from(shape::MAX_RESOLUTION)).contains(&n) => {
+                    resolution = n as u32;
+                }
+                _ => {
+                    let msg = format!(
+                        "RESOLUTION must be a whole number from 3 to {} (the segments round the \
+                         axis), found \"{}\"",
+                        shape::MAX_RESOLUTION,
+                        token.text
+                    );
+                    self.error_at(token, &line, msg);
+                }
+            }
+        }
+        Ok(RoundShape {
+            centre: centre.into(),
+            radius,
+            height,
+            resolution,
+            line: shape_line,
+            column: shape_column,
+        })
+    }
+
     /// `FACING OUT` or `FACING IN`.
     fn facing(&mut self) -> Step<Facing> {
         let line = self.expect(Keyword::Facing)?;
@@ -882,3 +1087,7 @@ impl<'a> Parser<'a> {
 #[cfg(test)]
 #[path = "read_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "round_tests.rs"]
+mod round_tests;

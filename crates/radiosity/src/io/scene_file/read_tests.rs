@@ -320,7 +320,14 @@ fn vertex_count() {
 #[test]
 fn polygon_errors_point_at_vertex0() {
     one_error(&with_line(15, "VERTEX2 1 1 0.1"), 13, 1, "not planar");
-    one_error(&with_line(15, "VERTEX2 0.2 0.2 0"), 13, 1, "not convex");
+    // A bow tie (the outline crosses itself: corners in the wrong order) is not convex and
+    // stays an error; a simple non-convex outline is triangulated (next test).
+    one_error(
+        &with_lines(&[(15, "VERTEX2 0 1 0"), (16, "VERTEX3 2 1 0")]),
+        13,
+        1,
+        "not convex",
+    );
     one_error(
         &with_line(15, "VERTEX2 1 0 0"),
         13,
@@ -913,4 +920,37 @@ fn a_surface_given_twice_is_refused_naming_both_lines() {
         + &patch("Rug", "Rg 0.5", "VERTEX2 1 0.5 0").replace("VERTEX3 0 1 0", "VERTEX3 0 0.5 0")
         + "SCENEEND\n";
     assert_eq!(errors(&rug), vec![]);
+}
+
+#[test]
+fn non_convex_patch_is_triangulated() {
+    // A dart: (0,0) (1,0) (0.2,0.2) (0,1), area 0.2 by the shoelace formula, reflex at
+    // VERTEX2.
+    let file = parse_scene(&with_line(15, "VERTEX2 0.2 0.2 0"), "t").unwrap();
+    let s = &file.scene.surfaces;
+    assert_eq!(s.len(), 2);
+    assert_eq!(
+        (s[0].name.as_str(), s[1].name.as_str()),
+        ("Floor.0", "Floor.1")
+    );
+    let area: f64 = s.iter().map(|s| geometry::polygon_area(&s.vertices)).sum();
+    assert!((area - 0.2).abs() < 1e-12, "{area}");
+    for t in s {
+        assert!(geometry::polygon_normal(&t.vertices).unwrap().z > 0.999_999);
+        assert_eq!(t.reflectance.0, [0.5; 3]);
+    }
+    // An L of six corners, area 3.
+    let l = "VERTICES 6\nEr 0\nEg 0\nEb 0\nRr 0.5\nRg 0.5\nRb 0.5\nVERTEX0 0 0 0\n\
+             VERTEX1 2 0 0\nVERTEX2 2 1 0\nVERTEX3 1 1 0\nVERTEX4 1 2 0\nVERTEX5 0 2 0";
+    let blank: Vec<(usize, &str)> = (7..=16).map(|n| (n, "")).collect();
+    let text = with_lines(&[&[(6, l)], &blank[..]].concat());
+    let file = parse_scene(&text, "t").unwrap();
+    let area: f64 = file
+        .scene
+        .surfaces
+        .iter()
+        .map(|s| geometry::polygon_area(&s.vertices))
+        .sum();
+    assert_eq!(file.scene.surfaces.len(), 4);
+    assert!((area - 3.0).abs() < 1e-12, "{area}");
 }

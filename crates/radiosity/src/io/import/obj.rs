@@ -1,0 +1,532 @@
+//! Wavefront OBJ with its MTL material files.
+//!
+//! # What is read
+//!
+//! * `v x y z` vertices (`v x y z w` is divided by `w`; the colours of `v x y z r g b` are
+//!   ignored);
+//! * `f` faces of any number of corners, each corner `v`, `v/vt`, `v//vn` or `v/vt/vn`
+//!   (only `v` is used), counting from 1, or back from the last vertex read when negative;
+//! * `o` and `g` names: a face belongs to the object named by the last `o` or `g` line
+//!   before it (its surfaces are named after it, see [`super`]); `default` before any;
+//! * `mtllib` files (relative to the OBJ's folder) and `usemtl`: in each material,
+//!   `Kd r [g b]` is the reflectance and `Ke r [g b]` the emission (an exitance, in the
+//!   scene's emission units, as `Er Eg Eb` in the scene format). A material without `Kd`
+//!   reflects 0.5 in each band, one without `Ke` emits nothing.
+//!
+//! `Kd` must be at least 0 and below 1 in every band, as the scene format's reflectance:
+//! a material with `Kd 1 1 1` is refused (naming the MTL file and line), not clamped or
+//! scaled, since either would change the light in the scene without saying so.
+//!
+//! # What is ignored
+//!
+//! Texture coordinates and normals (`vt`, `vn`), smoothing groups (`s`), points and lines
+//! (`p`, `l`: no area), free-form geometry (`curv`, `surf`, ...), and every other MTL
+//! statement (`Ka`, `Ks`, `Ns`, `d`, `illum`, texture maps). Statements other than those read
+//! or listed are counted in one warning. A missing MTL file, or a `usemtl` naming a material
+//! none of them has, gives a warning and the default grey (reflectance 0.5).
+//!
+//! OBJ states no unit: the numbers are taken as metres, times
+//! [`ImportOptions::scale`](super::ImportOptions::scale).
+//!
+//! # Why not the `tobj` crate
+//!
+//! tobj 4.0 (MIT) was looked at first: its `LoadError` (e.g. "face vertex index out of
+//! bounds") carries neither line nor element, so it cannot say where a file is wrong, and it
+//! reads coordinates as `f32` unless built with a feature (the Cornell box's 548.8 mm
+//! becomes 548.7999878), which would keep an OBJ from giving the scene file's solution.
+//! The subset above is a few hundred lines, reports every problem at its line, and
+//! allocates only in proportion to the file's lines.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::{
+    default_settings, scaled_unit, FaceSoup, Format, ImportError, ImportOptions, ImportWarning,
+    Imported, SoupFace, SoupMaterial,
+};
+use crate::io::scene_file::SceneFile;
+use crate::light::Rgb;
+
+/// The reflectance of a face without a material, or whose material is missing.
+pub const DEFAULT_REFLECTANCE: f64 = 0.5;
+
+/// The unit an OBJ file is read in.
+const UNIT: &str = "metres (OBJ states no unit; metres assumed)";
+
+/// Reads the OBJ file at `path` and the MTL files it names.
+pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
+        file: file.clone(),
+        message: e.to_string(),
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let mut loader = |name: &str| {
+        let p = folder.join(name);
+        std::fs::read(&p)
+            .map(|b| {
+                (
+                    p.display().to_string(),
+                    String::from_utf8_lossy(&b).into_owned(),
+                )
+            })
+            .map_err(|e| e.to_string())
+    };
+    parse(&text, &file, options, &mut loader)
+}
+
+/// Reads OBJ text; `load_mtl` gives an MTL file's name for messages and its text, from the
+/// name a `mtllib` line gives, or why it cannot be read. The fuzz target calls this with
+/// a loader that finds nothing.
+pub fn parse(
+    text: &str,
+    file: &str,
+    options: &ImportOptions,
+    load_mtl: &mut dyn FnMut(&str) -> Result<(String, String), String>,
+) -> Result<Imported, ImportError> {
+    let mut reader = Reader {
+        soup: FaceSoup {
+            file: file.to_string(),
+            ..FaceSoup::default()
+        },
+        library: HashMap::new(),
+        used: HashMap::new(),
+        objects: HashMap::new(),
+        object: None,
+        material: None,
+        warnings: Vec::new(),
+        ignored: HashMap::new(),
+        missing: Vec::new(),
+    };
+    for (i, raw) in text.lines().enumerate() {
+        reader.line(i + 1, raw, load_mtl)?;
+    }
+    let Reader {
+        soup,
+        mut warnings,
+        ignored,
+        missing,
+        ..
+    } = reader;
+    if soup.faces.is_empty() {
+        return Err(ImportError::NoSurfaces {
+            file: file.to_string(),
+            faces: 0,
+        });
+    }
+    let (scene, more) = soup.to_scene(options.scale)?;
+    if !missing.is_empty() {
+        let names: Vec<String> = missing
+            .iter()
+            .map(|(n, l)| format!("\"{n}\" (line {l})"))
+            .collect();
+        warnings.push(ImportWarning {
+            file: file.to_string(),
+            line: 0,
+            message: format!(
+                "no material file defines {}: {} given the default reflectance {DEFAULT_REFLECTANCE}",
+                names.join(", "),
+                if missing.len() == 1 { "its faces are" } else { "their faces are" }
+            ),
+        });
+    }
+    if !ignored.is_empty() {
+        let mut kinds: Vec<(&String, &usize)> = ignored.iter().collect();
+        kinds.sort();
+        let list: Vec<String> = kinds.iter().map(|(k, n)| format!("{n} \"{k}\"")).collect();
+        warnings.push(ImportWarning {
+            file: file.to_string(),
+            line: 0,
+            message: format!(
+                "ignored statements this reader does not use: {}",
+                list.join(", ")
+            ),
+        });
+    }
+    warnings.extend(more);
+    let settings = options.settings.unwrap_or_else(|| default_settings(&scene));
+    Ok(Imported {
+        file: SceneFile { settings, scene },
+        warnings,
+        unit: scaled_unit(UNIT, options.scale),
+        format: Format::Obj,
+    })
+}
+
+/// One material of an MTL file as written.
+#[derive(Clone)]
+struct MtlEntry {
+    file: String,
+    line: usize,
+    kd: Option<(Rgb, usize)>,
+    ke: Option<(Rgb, usize)>,
+}
+
+struct Reader {
+    soup: FaceSoup,
+    /// Every material the MTL files define, by name.
+    library: HashMap<String, MtlEntry>,
+    /// The soup's index of each material used so far, by name.
+    used: HashMap<String, u32>,
+    /// The soup's index of each object name.
+    objects: HashMap<String, u32>,
+    object: Option<u32>,
+    material: Option<u32>,
+    warnings: Vec<ImportWarning>,
+    /// Statements ignored, by keyword, with counts.
+    ignored: HashMap<String, usize>,
+    /// `usemtl` names no MTL file defines, with the first line naming each.
+    missing: Vec<(String, usize)>,
+}
+
+/// Statements read silently for what they are: ignored by design (see the module
+/// documentation) and not worth a warning.
+const QUIET: [&str; 4] = ["vt", "vn", "s", "vp"];
+
+impl Reader {
+    fn syntax(&self, line: usize, message: String) -> ImportError {
+        ImportError::Syntax {
+            file: self.soup.file.clone(),
+            line,
+            message,
+        }
+    }
+
+    fn line(
+        &mut self,
+        n: usize,
+        raw: &str,
+        load_mtl: &mut dyn FnMut(&str) -> Result<(String, String), String>,
+    ) -> Result<(), ImportError> {
+        let code = raw.split('#').next().unwrap_or("");
+        let mut words = code.split_whitespace();
+        let Some(key) = words.next() else {
+            return Ok(());
+        };
+        let rest = || code.trim_start().get(key.len()..).unwrap_or("").trim();
+        match key {
+            "v" => self.vertex(n, words.collect()),
+            "f" | "fo" => self.face(n, words),
+            "o" | "g" => {
+                let name = rest().to_string();
+                let name = if name.is_empty() {
+                    "default".to_string()
+                } else {
+                    name
+                };
+                let next = self.soup.objects.len() as u32;
+                let index = *self.objects.entry(name.clone()).or_insert_with(|| {
+                    self.soup.objects.push(name);
+                    next
+                });
+                self.object = Some(index);
+                Ok(())
+            }
+            "usemtl" => {
+                let name = rest().to_string();
+                self.material = Some(self.use_material(&name, n)?);
+                Ok(())
+            }
+            "mtllib" => {
+                for name in words {
+                    match load_mtl(name) {
+                        Ok((mtl_file, text)) => self.read_mtl(&mtl_file, &text)?,
+                        Err(why) => self.warnings.push(ImportWarning {
+                            file: self.soup.file.clone(),
+                            line: n,
+                            message: format!(
+                                "cannot read the material file \"{name}\" ({why}): its \
+                                 materials get the default reflectance {DEFAULT_REFLECTANCE}"
+                            ),
+                        }),
+                    }
+                }
+                Ok(())
+            }
+            k if QUIET.contains(&k) => Ok(()),
+            k => {
+                // Bounded: at most one entry per distinct keyword, each at most a line long;
+                // a file of distinct junk words is counted under one key.
+                let key = if self.ignored.len() < 32 { k } else { "other" };
+                *self.ignored.entry(key.to_string()).or_insert(0) += 1;
+                Ok(())
+            }
+        }
+    }
+
+    fn vertex(&mut self, n: usize, words: Vec<&str>) -> Result<(), ImportError> {
+        if !matches!(words.len(), 3 | 4 | 6 | 7) {
+            return Err(self.syntax(
+                n,
+                format!(
+                    "a vertex needs 3 coordinates (\"v x y z\", optionally a w or an r g b \
+                     colour after them), found {} numbers",
+                    words.len()
+                ),
+            ));
+        }
+        let mut xyzw = [0.0, 0.0, 0.0, 1.0];
+        let count = if words.len() == 4 { 4 } else { 3 };
+        for (k, w) in words.iter().take(count).enumerate() {
+            xyzw[k] = w.parse::<f64>().map_err(|_| {
+                self.syntax(
+                    n,
+                    format!(
+                        "expected a number for the {} coordinate of the vertex, found \"{w}\"",
+                        ["x", "y", "z", "w"][k]
+                    ),
+                )
+            })?;
+        }
+        for w in words.iter().skip(count) {
+            if w.parse::<f64>().is_err() {
+                return Err(self.syntax(
+                    n,
+                    format!("expected a number for the vertex colour, found \"{w}\""),
+                ));
+            }
+        }
+        let element = || format!("vertex {}", self.soup.vertices.len() + 1);
+        for value in xyzw {
+            if !value.is_finite() {
+                return Err(ImportError::NotFinite {
+                    file: self.soup.file.clone(),
+                    line: n,
+                    element: element(),
+                    value,
+                });
+            }
+        }
+        if xyzw[3] == 0.0 {
+            return Err(self.syntax(
+                n,
+                format!("{}: its weight w is 0 (a point at infinity)", element()),
+            ));
+        }
+        if self.soup.vertices.len() >= u32::MAX as usize {
+            return Err(self.syntax(n, "more than 4294967295 vertices".into()));
+        }
+        let w = xyzw[3];
+        self.soup
+            .vertices
+            .push(DVec3::new(xyzw[0] / w, xyzw[1] / w, xyzw[2] / w));
+        self.soup.vertex_lines.push(n);
+        Ok(())
+    }
+
+    fn face<'a>(
+        &mut self,
+        n: usize,
+        words: impl Iterator<Item = &'a str>,
+    ) -> Result<(), ImportError> {
+        let object = match self.object {
+            Some(o) => o,
+            None => {
+                self.soup.objects.push("default".into());
+                let o = self.soup.objects.len() as u32 - 1;
+                self.objects.insert("default".into(), o);
+                self.object = Some(o);
+                o
+            }
+        };
+        let material = match self.material {
+            Some(m) => m,
+            None => {
+                let m = self.default_material();
+                self.material = Some(m);
+                m
+            }
+        };
+        let first = self.soup.indices.len();
+        let face_number = self.soup.faces.len() + 1;
+        let count = self.soup.vertices.len();
+        for word in words {
+            let v = word.split('/').next().unwrap_or("");
+            let element = || {
+                format!(
+                    "face {face_number} of object \"{}\"",
+                    self.soup.objects[object as usize]
+                )
+            };
+            let Ok(index) = v.parse::<i64>() else {
+                return Err(self.syntax(
+                    n,
+                    format!(
+                        "{}: expected a vertex index (a whole number, optionally followed by \
+                         /TEXTURE/NORMAL) for a corner, found \"{word}\"",
+                        element()
+                    ),
+                ));
+            };
+            // 1 .. count forwards, -1 .. -count back from the last vertex read.
+            let resolved = match index {
+                i if i > 0 && (i as u64) <= count as u64 => Some(i as u64 - 1),
+                i if i < 0 && i.unsigned_abs() <= count as u64 => {
+                    Some(count as u64 - i.unsigned_abs())
+                }
+                _ => None,
+            };
+            let Some(resolved) = resolved else {
+                return Err(ImportError::BadIndex {
+                    file: self.soup.file.clone(),
+                    line: n,
+                    element: element(),
+                    index,
+                    count,
+                });
+            };
+            self.soup.indices.push(resolved as u32);
+        }
+        let corners = self.soup.indices.len() - first;
+        self.soup.faces.push(SoupFace {
+            object,
+            material,
+            first,
+            count: u32::try_from(corners).unwrap_or(u32::MAX),
+            line: n,
+        });
+        Ok(())
+    }
+
+    fn default_material(&mut self) -> u32 {
+        *self.used.entry(String::new()).or_insert_with(|| {
+            self.soup.materials.push(SoupMaterial {
+                name: "(none)".into(),
+                reflectance: Rgb([DEFAULT_REFLECTANCE; 3]),
+                emission: Rgb([0.0; 3]),
+                defined_at: None,
+            });
+            self.soup.materials.len() as u32 - 1
+        })
+    }
+
+    /// The soup's material for `usemtl name` at line `n`: checked on first use.
+    fn use_material(&mut self, name: &str, n: usize) -> Result<u32, ImportError> {
+        if let Some(&m) = self.used.get(name) {
+            return Ok(m);
+        }
+        let Some(entry) = self.library.get(name).cloned() else {
+            if self.missing.len() < 1000 && !self.missing.iter().any(|(m, _)| m == name) {
+                self.missing.push((name.to_string(), n));
+            }
+            let m = self.default_material();
+            self.used.insert(name.to_string(), m);
+            return Ok(m);
+        };
+        let bad = |line: usize, message: String| ImportError::BadMaterial {
+            file: entry.file.clone(),
+            line,
+            name: name.to_string(),
+            message,
+        };
+        let reflectance = entry.kd.map_or(Rgb([DEFAULT_REFLECTANCE; 3]), |(c, _)| c);
+        if let Some((c, line)) = entry.kd {
+            if let Some((band, v)) = bands(&c).find(|(_, v)| !(0.0..1.0).contains(v)) {
+                return Err(bad(
+                    line,
+                    format!(
+                        "Kd (the reflectance) is {v} in the {band} band; it must be at least 0 \
+                         and below 1 in every band (a surface cannot reflect all the light it \
+                         receives): edit the line to values below 1, such as 0.8"
+                    ),
+                ));
+            }
+        }
+        let emission = entry.ke.map_or(Rgb([0.0; 3]), |(c, _)| c);
+        if let Some((c, line)) = entry.ke {
+            if let Some((band, v)) = bands(&c).find(|(_, v)| *v < 0.0) {
+                return Err(bad(
+                    line,
+                    format!("Ke (the emission) is {v} in the {band} band; it must be at least 0"),
+                ));
+            }
+        }
+        self.soup.materials.push(SoupMaterial {
+            name: name.to_string(),
+            reflectance,
+            emission,
+            defined_at: Some((entry.file.clone(), entry.line)),
+        });
+        let m = self.soup.materials.len() as u32 - 1;
+        self.used.insert(name.to_string(), m);
+        Ok(m)
+    }
+
+    /// Adds the materials of one MTL file to the library (a later definition of a name
+    /// replaces an earlier one, as in the file).
+    fn read_mtl(&mut self, file: &str, text: &str) -> Result<(), ImportError> {
+        let mut current: Option<String> = None;
+        for (i, raw) in text.lines().enumerate() {
+            let n = i + 1;
+            let code = raw.split('#').next().unwrap_or("");
+            let mut words = code.split_whitespace();
+            let Some(key) = words.next() else { continue };
+            let syntax = |message: String| ImportError::Syntax {
+                file: file.to_string(),
+                line: n,
+                message,
+            };
+            match key {
+                "newmtl" => {
+                    let name = code.trim_start().get(key.len()..).unwrap_or("").trim();
+                    self.library.insert(
+                        name.to_string(),
+                        MtlEntry {
+                            file: file.to_string(),
+                            line: n,
+                            kd: None,
+                            ke: None,
+                        },
+                    );
+                    current = Some(name.to_string());
+                }
+                "Kd" | "Ke" => {
+                    let Some(entry) = current.as_ref().and_then(|c| self.library.get_mut(c)) else {
+                        return Err(syntax(format!("{key} before any \"newmtl\" line")));
+                    };
+                    let values: Vec<&str> = words.collect();
+                    let colour = colour(&values).ok_or_else(|| {
+                        syntax(format!(
+                            "expected \"{key} r g b\" (or \"{key} v\" for a grey) with finite \
+                             numbers, found \"{}\"",
+                            code.trim()
+                        ))
+                    })?;
+                    if key == "Kd" {
+                        entry.kd = Some((colour, n));
+                    } else {
+                        entry.ke = Some((colour, n));
+                    }
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `r g b`, or one value for all three; every number finite.
+fn colour(values: &[&str]) -> Option<Rgb> {
+    let numbers: Vec<f64> = values
+        .iter()
+        .map(|v| v.parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<_>>()?;
+    match numbers[..] {
+        [v] => Some(Rgb([v; 3])),
+        [r, g, b] => Some(Rgb([r, g, b])),
+        _ => None,
+    }
+}
+
+fn bands(c: &Rgb) -> impl Iterator<Item = (&'static str, f64)> + '_ {
+    ["red", "green", "blue"]
+        .into_iter()
+        .zip(c.0.iter().copied())
+}
+
+#[cfg(test)]
+#[path = "obj_tests.rs"]
+mod tests;
