@@ -8,7 +8,7 @@
 //! | `.scene` | the paper's Appendix A format | [`crate::io::scene_file`] |
 //! | `.obj` | Wavefront OBJ with its MTL materials | [`obj`] |
 //! | `.gltf`, `.glb` | glTF 2.0 | [`gltf`] |
-//! | `.dxf` | AutoCAD DXF | not yet: [`ImportError::NotSupportedYet`] |
+//! | `.dxf` | AutoCAD DXF (ASCII) with a `.materials.toml` side file | [`dxf`] |
 //! | `.wrl` | VRML97 | [`vrml`] |
 //!
 //! Every importer other than the scene file's reads its file into a [`FaceSoup`] (named
@@ -52,6 +52,7 @@
 //! [`FaceSoup`], calls [`FaceSoup::to_scene`], and adds its own warnings. Counts read from
 //! a binary file are checked with [`check_count`] before anything is allocated for them.
 
+pub mod dxf;
 mod face_soup;
 pub mod gltf;
 mod merge;
@@ -379,7 +380,7 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
         Format::Obj => obj::read(path, options),
         Format::Gltf | Format::Glb => gltf::read(path, options),
         Format::Vrml => vrml::read(path, options),
-        Format::Dxf => Err(ImportError::NotSupportedYet { file, format }),
+        Format::Dxf => dxf::read(path, options),
     }
 }
 
