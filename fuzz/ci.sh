@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CI's bounded fuzz run (called by .ci/run): builds both targets (a release build of this
+# CI's bounded fuzz run (called by .ci/run): builds the targets (a release build of this
 # crate alone) and runs each for FUZZ_SECONDS (default 60) from the seed corpus. A crash, a
 # timeout or an out-of-memory input makes libFuzzer exit non-zero, and so this script.
 set -euo pipefail
@@ -20,7 +20,7 @@ fi
 
 seconds=${FUZZ_SECONDS:-60}
 ./build.sh
-for target in scene_file form_factor_file; do
+for target in scene_file form_factor_file obj; do
     echo "fuzzing $target for $seconds s"
     # libFuzzer's progress lines are many; its final statistics and any crash report are
     # what CI needs, so the log is kept and shown in full only on failure.

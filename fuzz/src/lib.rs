@@ -242,3 +242,55 @@ fn read_and_solve(data: &[u8]) {
     request.form_factors = pipeline::FormFactors::Matrix(&matrix);
     let _ = pipeline::solve(prepared, &request, &mut keep_going, &NoProgress);
 }
+
+/// Where an `obj` input's MTL text starts: the bytes after this line are the material file
+/// that every `mtllib` of the OBJ text before it reads.
+pub const MTL_SEPARATOR: &str = "\n%%MTL\n";
+
+/// The OBJ reader (`io::import::obj::parse`) on arbitrary bytes (read as UTF-8 with
+/// replacement characters, as the reader reads a file), with the bytes after
+/// [`MTL_SEPARATOR`] as the text of every material file named. Every error must format; a
+/// scene read must hold only usable polygons with colours in the scene format's ranges, and
+/// written in the scene format it must parse again (the writer may refuse, cleanly, a name
+/// the OBJ reader accepts: see `scene_file`).
+pub fn obj(data: &[u8]) {
+    use radiosity::io::import::{obj, ImportOptions};
+    init();
+    let text = String::from_utf8_lossy(data);
+    let (obj_text, mtl_text) = match text.split_once(MTL_SEPARATOR) {
+        Some((o, m)) => (o, Some(m)),
+        None => (&*text, None),
+    };
+    let mut loader = |name: &str| match mtl_text {
+        Some(m) => Ok((format!("fuzz/{name}"), m.to_string())),
+        None => Err("no material file in this input".to_string()),
+    };
+    let imported = match obj::parse(obj_text, "fuzz.obj", &ImportOptions::default(), &mut loader)
+    {
+        Ok(imported) => imported,
+        Err(error) => {
+            assert!(!error.to_string().is_empty(), "an error without a message");
+            return;
+        }
+    };
+    for w in &imported.warnings {
+        assert!(!w.to_string().is_empty());
+    }
+    let file = imported.file;
+    assert!(!file.scene.surfaces.is_empty(), "an imported scene without surfaces");
+    for s in &file.scene.surfaces {
+        if let Err(e) = geometry::validate_polygon(&s.vertices) {
+            panic!("surface {:?} is not a usable polygon: {e}: {:?}", s.name, s.vertices);
+        }
+        assert!(s.reflectance.0.iter().all(|r| (0.0..1.0).contains(r)));
+        assert!(s.emission.0.iter().all(|e| *e >= 0.0 && e.is_finite()));
+    }
+    assert!(file.settings.max_patch_area > 0.0 && file.settings.max_patch_area.is_finite());
+    let mut written = Vec::new();
+    if write_scene(&file.scene, file.settings, &mut written).is_ok() {
+        let written = String::from_utf8(written).expect("the writer writes UTF-8");
+        if let Err(e) = parse_scene(&written, "written.scene") {
+            panic!("an imported scene, written, does not parse: {e}\n--- written:\n{written}");
+        }
+    }
+}

@@ -107,7 +107,13 @@ impl FaceSoup {
                 Ok(()) => {
                     let mut corners = corners;
                     geometry::flatten(&mut corners);
-                    push(&mut pieces, corners);
+                    // Flattening can bring two corners of a sliver within the same-point
+                    // distance of each other (found by the obj fuzz target): checked again.
+                    if geometry::validate_polygon(&corners).is_ok() {
+                        push(&mut pieces, corners);
+                    } else {
+                        degenerate.push(f);
+                    }
                 }
                 Err(
                     PolygonError::NotPlanar { .. }
@@ -263,7 +269,7 @@ impl FaceSoup {
             }
             let scaled = *v * scale;
             for value in scaled.to_array() {
-                if !(value.abs() <= geometry::MAX_COORDINATE) {
+                if value.abs() > geometry::MAX_COORDINATE {
                     return Err(ImportError::OutOfRange {
                         file: self.file.clone(),
                         line,

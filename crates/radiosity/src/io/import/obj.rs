@@ -55,6 +55,10 @@ pub const DEFAULT_REFLECTANCE: f64 = 0.5;
 /// The unit an OBJ file is read in.
 const UNIT: &str = "metres (OBJ states no unit; metres assumed)";
 
+/// Gives an MTL file's name for messages and its text, from the name a `mtllib` line
+/// gives, or why it cannot be read.
+pub type MtlLoader<'a> = dyn FnMut(&str) -> Result<(String, String), String> + 'a;
+
 /// Reads the OBJ file at `path` and the MTL files it names.
 pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportError> {
     let file = path.display().to_string();
@@ -85,7 +89,7 @@ pub fn parse(
     text: &str,
     file: &str,
     options: &ImportOptions,
-    load_mtl: &mut dyn FnMut(&str) -> Result<(String, String), String>,
+    load_mtl: &mut MtlLoader,
 ) -> Result<Imported, ImportError> {
     let mut reader = Reader {
         soup: FaceSoup {
@@ -195,12 +199,7 @@ impl Reader {
         }
     }
 
-    fn line(
-        &mut self,
-        n: usize,
-        raw: &str,
-        load_mtl: &mut dyn FnMut(&str) -> Result<(String, String), String>,
-    ) -> Result<(), ImportError> {
+    fn line(&mut self, n: usize, raw: &str, load_mtl: &mut MtlLoader) -> Result<(), ImportError> {
         let code = raw.split('#').next().unwrap_or("");
         let mut words = code.split_whitespace();
         let Some(key) = words.next() else {

@@ -395,3 +395,31 @@ fn default_settings_give_about_a_thousand_elements() {
     assert_eq!(s.max_patch_area, 1.0 / 1000.0);
     assert_eq!(s.integral_steps, 2);
 }
+
+/// Regression (obj fuzz target): a quad with one corner 1e8 times further off than the
+/// others passes the polygon checks, but flattened onto its plane two corners fall within
+/// the same-point distance (1e-9 of its diameter): it must be dropped as degenerate, not
+/// kept as an unusable surface.
+#[test]
+fn sliver_that_flattening_makes_degenerate_is_dropped() {
+    let v = [
+        dvec3(213.0, 548.8, 227.0),
+        dvec3(213.0, 548.8, 332.0),
+        dvec3(0.0, 548.8e8, 332.0),
+        dvec3(0.0, 548.8, 227.0),
+        dvec3(0.0, 0.0, 0.0),
+        dvec3(1.0, 0.0, 0.0),
+        dvec3(0.0, 1.0, 0.0),
+    ];
+    let (scene, _) = soup(&v, &[("Sliver", &[&[0, 1, 2, 3], &[4, 5, 6]])])
+        .to_scene(1.0)
+        .unwrap();
+    for s in &scene.surfaces {
+        assert_eq!(
+            geometry::validate_polygon(&s.vertices),
+            Ok(()),
+            "{}",
+            s.name
+        );
+    }
+}

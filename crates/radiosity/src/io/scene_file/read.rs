@@ -721,11 +721,14 @@ impl<'a> Parser<'a> {
     /// Checks and flattens a polygon ([`geometry::validate_polygon`], [`geometry::flatten`]),
     /// reporting a problem at its `VERTEX0` line.
     fn check_polygon(&mut self, corners: &mut Corners) -> Option<()> {
-        match geometry::validate_polygon(&corners.vertices) {
-            Ok(()) => {
-                geometry::flatten(&mut corners.vertices);
-                Some(())
-            }
+        // Checked again once flattened: flattening can bring two corners of a sliver within
+        // the same-point distance of each other (found by the obj fuzz target).
+        let checked = geometry::validate_polygon(&corners.vertices).and_then(|()| {
+            geometry::flatten(&mut corners.vertices);
+            geometry::validate_polygon(&corners.vertices)
+        });
+        match checked {
+            Ok(()) => Some(()),
             Err(e) => {
                 self.error(corners.line, corners.column, polygon::message(&e));
                 None

@@ -954,3 +954,23 @@ fn non_convex_patch_is_triangulated() {
     assert_eq!(file.scene.surfaces.len(), 4);
     assert!((area - 3.0).abs() < 1e-12, "{area}");
 }
+
+/// Regression (found by the obj fuzz target, the same check here): a quad with one corner
+/// 1e8 times further off than the others passes the polygon checks, but flattened two
+/// corners fall within the same-point distance; the reader must refuse it, not accept an
+/// unusable surface.
+#[test]
+fn sliver_that_flattening_makes_degenerate_is_refused() {
+    let text = with_lines(&[
+        (13, "VERTEX0 213 548.8 227"),
+        (14, "VERTEX1 213 548.8 332"),
+        (15, "VERTEX2 0 548.8e8 332"),
+        (16, "VERTEX3 0 548.8 227"),
+    ]);
+    one_error(
+        &text,
+        13,
+        1,
+        "degenerate polygon: VERTEX0 and VERTEX1 are the same point",
+    );
+}
