@@ -556,3 +556,36 @@ fn other_entities_are_counted_in_a_warning() {
         "entities left out (no faces read from them): 1 CIRCLE, 2 LINE"
     );
 }
+
+#[test]
+fn an_insert_grid_stacking_hundreds_of_copies_drops_them_without_a_panic() {
+    // The DXF fuzz target's crash (corpus/dxf/insert_grid_stacked_copies.dxf): a grid of
+    // 64 x 4 cells spaced 0 puts 256 copies of a triangle in one place; the duplicate
+    // check's hierarchy over 256 identical boxes was deeper than obvhs's traversal stack.
+    let mut tri = String::new();
+    g(&mut tri, 0, "3DFACE");
+    g(&mut tri, 8, "0");
+    for (k, p) in [
+        dvec3(-1.0, 0.0, 0.0),
+        dvec3(-1.1, 0.0, 0.0),
+        dvec3(-1.0, 0.0, -1.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        point(&mut tri, k as i32, p);
+    }
+    let text = dxf(
+        &block("Leg", DVec3::ZERO, &tri),
+        &insert_of("Leg", "Legs", DVec3::ZERO, &[(70, 64.0), (71, 4.0)]),
+    );
+    let got = read(&text, Some(GREY)).unwrap();
+    assert_eq!(got.file.scene.surfaces.len(), 1);
+    assert!(
+        got.warnings
+            .iter()
+            .any(|w| w.message.starts_with("dropped 255 faces given twice")),
+        "{:?}",
+        got.warnings
+    );
+}

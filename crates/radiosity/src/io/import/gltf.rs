@@ -136,11 +136,18 @@ impl Reader<'_> {
         } else {
             Format::Gltf
         };
-        let gltf = gltf::Gltf::from_slice(bytes)
-            .map_err(|e| self.error(format!("not a valid glTF 2.0 file: {e}")))?;
-        let doc = &gltf.document;
+        let invalid = |e: gltf::Error| self.error(format!("not a valid glTF 2.0 file: {e}"));
+        // Read, then validated in two steps: the `gltf` crate's own validation indexes the
+        // accessor list with a primitive's POSITION index unchecked (gltf-json 1.4.1,
+        // mesh.rs:151), so that index is checked here first (the fuzz target's first crash).
+        let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+        let blob = raw.blob;
+        let json = raw.document.into_json();
+        self.check_position_indices(&json)?;
+        let document = gltf::Document::from_json(json).map_err(invalid)?;
+        let doc = &document;
         for buffer in doc.buffers() {
-            let data = self.buffer(&buffer, gltf.blob.as_deref())?;
+            let data = self.buffer(&buffer, blob.as_deref())?;
             self.buffers.push(data);
         }
         let mut soup = FaceSoup {
@@ -241,6 +248,27 @@ impl Reader<'_> {
             ));
         }
         Ok((soup, format))
+    }
+
+    /// Every primitive's POSITION names an accessor the file has (checked before the
+    /// `gltf` crate's validation, which would index out of bounds).
+    fn check_position_indices(&self, json: &gltf::json::Root) -> Result<(), ImportError> {
+        let accessors = json.accessors.len();
+        for (m, mesh) in json.meshes.iter().enumerate() {
+            for (p, prim) in mesh.primitives.iter().enumerate() {
+                let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+                if let Some(index) = prim.attributes.get(&position) {
+                    if index.value() >= accessors {
+                        return Err(self.error(format!(
+                            "mesh {m} primitive {p}: POSITION names accessor {}, but the file \
+                             has {accessors} accessors",
+                            index.value()
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The GLB header's length must be one the file can hold: the `gltf` crate subtracts

@@ -734,3 +734,17 @@ fn a_mesh_placed_by_too_many_nodes_is_refused_before_it_is_read() {
         )
     );
 }
+
+#[test]
+fn a_position_accessor_the_file_lacks_is_refused_not_a_panic() {
+    // The gltf crate's validation indexes the accessors with it unchecked: the glTF fuzz
+    // target's first crash (corpus/gltf/position_accessor_missing.gltf).
+    let mut doc = square_doc(json!([{ "mesh": 0 }]), grey(), None);
+    doc.as_object_mut().unwrap().remove("accessors");
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "t.gltf: error: mesh 0 primitive 0: POSITION names accessor 0, but the file has 0 \
+         accessors"
+    );
+}
