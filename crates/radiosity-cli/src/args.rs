@@ -91,9 +91,11 @@ pub struct SceneArgs {
 /// How form factors are computed.
 #[derive(Args, Clone)]
 pub struct MethodArgs {
-    /// Form-factor method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Area)]
-    pub method: MethodArg,
+    /// Form-factor method [default: area]
+    // No clap default, so that an explicit `--method area` can be told from none:
+    // hierarchical radiosity, which ignores the method, warns about any given.
+    #[arg(long, value_enum)]
+    pub method: Option<MethodArg>,
     /// Hemicube resolution: cells across the top face.
     #[arg(long, default_value_t = 128, value_name = "CELLS")]
     pub resolution: u32,
@@ -366,6 +368,27 @@ pub struct PathTraceArgs {
 }
 
 #[derive(Args)]
+pub struct ExportArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveOptions,
+    /// Output file, by its extension: .glb (binary glTF) or .gltf (JSON, its buffer in a
+    /// .bin file beside it): the solved mesh, radiosity as vertex colours on unlit
+    /// materials; .obj: the scene's surfaces (not the mesh) with an .mtl file beside it.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// glTF: the factor vertex colours are radiosity times (then clamped to 1): "auto", as
+    /// for `render` (the mean radiosity of the brightest 2 % of the non-emitting area is
+    /// white), or a number. Printed and written to the file's asset.extras.
+    #[arg(long, default_value = "auto", value_parser = parse_exposure)]
+    pub exposure: Exposure,
+    /// glTF: the camera node (as `render`'s camera for the same flags).
+    #[command(flatten)]
+    pub camera: CameraArgs,
+}
+
+#[derive(Args)]
 pub struct FormFactorArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
@@ -383,6 +406,11 @@ pub struct SolveArgs {
     /// Output file: CSV, or JSON when it ends in .json (default: the scene's name with .csv).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Also write the per-surface report to this CSV file: one row per input surface with
+    /// its area and the area-weighted mean, min and max radiosity per band over its
+    /// elements and the mean's luminance (Rec. 709), under a comment line giving the units.
+    #[arg(long, value_name = "FILE.csv")]
+    pub report: Option<PathBuf>,
 }
 
 #[derive(Args)]

@@ -21,8 +21,8 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 use args::{
-    BenchArgs, CheckArgs, CompareArgs, FormFactorArgs, GenerateCommand, PathTraceArgs, RenderArgs,
-    SolveArgs, ViewArgs,
+    BenchArgs, CheckArgs, CompareArgs, ExportArgs, FormFactorArgs, GenerateCommand, PathTraceArgs,
+    RenderArgs, SolveArgs, ViewArgs,
 };
 use errors::describe;
 
@@ -60,6 +60,10 @@ enum Command {
     /// no form factors) to a PNG image and print its noise; with --compare, also render the
     /// radiosity solution and print its pixel difference from the path-traced view.
     Pathtrace(PathTraceArgs),
+    /// Export a scene for other tools: the solved mesh with the radiosity baked into vertex
+    /// colours as glTF (-o out.glb or out.gltf), or the scene's surfaces as OBJ + MTL
+    /// (-o out.obj).
+    Export(ExportArgs),
     /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
     View(ViewArgs),
     /// Generate a scene file procedurally.
@@ -89,6 +93,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => commands::bench::run(args),
         Command::Compare(args) => commands::compare::run(args),
         Command::Pathtrace(args) => commands::pathtrace::run(args),
+        Command::Export(args) => commands::export::run(args),
         Command::View(args) => commands::view::run(args),
         Command::Generate {
             what: GenerateCommand::Building(args),

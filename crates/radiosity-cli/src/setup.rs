@@ -71,16 +71,16 @@ pub fn prepare_solve(
     Ok((prepared, stem, solver))
 }
 
-/// The method `--method` names when it is not the default (area), which every solver but
-/// hierarchical radiosity uses.
+/// The method `--method` names when it was given (an explicit `--method area` too), which
+/// every solver but hierarchical radiosity uses.
 fn method_flag_given(args: &crate::args::MethodArgs) -> Option<&'static str> {
-    match args.method {
-        MethodArg::Area => None,
-        MethodArg::Contour => Some("contour"),
-        MethodArg::Analytic => Some("analytic"),
-        MethodArg::Hemicube => Some("hemicube"),
-        MethodArg::Montecarlo => Some("montecarlo"),
-    }
+    Some(match args.method? {
+        MethodArg::Area => "area",
+        MethodArg::Contour => "contour",
+        MethodArg::Analytic => "analytic",
+        MethodArg::Hemicube => "hemicube",
+        MethodArg::Montecarlo => "montecarlo",
+    })
 }
 
 /// The scene loaded, meshed with its file's settings overridden by the flags, and its
@@ -106,7 +106,7 @@ fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, Str
     })?;
     let m = &args.method;
     let steps = prepared.settings.integral_steps;
-    prepared.method = match m.method {
+    prepared.method = match m.method.unwrap_or(MethodArg::Area) {
         MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
         MethodArg::Contour => FormFactorMethod::Contour { steps },
         MethodArg::Analytic => FormFactorMethod::Analytic { steps },
@@ -332,7 +332,7 @@ fn solver(
 }
 
 pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
-    check_png(args.output.as_deref())?;
+    image_format(args.output.as_deref())?;
     image_size(&args.camera)?;
     check_render_budget(
         &args.camera,
@@ -391,20 +391,33 @@ pub fn shading(arg: ShadingArg) -> Shading {
     }
 }
 
-/// Refuses an output image that is not named *.png.
-pub fn check_png(output: Option<&Path>) -> Result<()> {
-    if let Some(out) = output {
-        let png = out
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        if !png {
-            bail!(
-                "{}: only PNG images are written; give the output a .png name",
-                out.display()
-            );
-        }
+/// How an output image is written, by its name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// `*.png`: exposed, clamped, gamma-corrected 8-bit colour.
+    Png,
+    /// `*.exr`: linear radiance (radiosity / pi), no exposure, clamping or gamma.
+    Exr,
+}
+
+/// The format of an output image by its extension (any case); PNG when no output is
+/// named. Refuses any other name.
+pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
+    let Some(out) = output else {
+        return Ok(ImageFormat::Png);
+    };
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("png") => Ok(ImageFormat::Png),
+        Some("exr") => Ok(ImageFormat::Exr),
+        _ => bail!(
+            "{}: images are written as PNG (tone-mapped) or OpenEXR (linear radiance); \
+             give the output a .png name, or .exr for linear radiance",
+            out.display()
+        ),
     }
-    Ok(())
 }
 
 /// `--gamma`, checked.

@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod check;
 pub mod compare;
+pub mod export;
 pub mod formfactors;
 pub mod generate;
 pub mod pathtrace;
@@ -92,6 +93,24 @@ pub fn shade_and_render(
     };
     let renderer = Renderer::for_settings(mesh, &prepared.scene, &settings);
     radiosity::render::try_render(&renderer, camera, element_b, &vertex_b, &settings, reporter)
+}
+
+/// Vertex radiosities (the shade stage), then the linear image (the render stage): each
+/// pixel the mean of its samples' radiosity, no exposure, clamping or gamma. `None` for a
+/// wireframe, which has no light to give.
+pub fn shade_and_render_linear(
+    prepared: &Prepared,
+    mesh: &Mesh,
+    element_b: &[[f64; 3]],
+    camera: &Camera,
+    settings: RenderSettings,
+    reporter: &Reporter,
+) -> Result<Option<Vec<[f64; 3]>>, radiosity::render::NonFiniteImage> {
+    let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
+        shade::vertex_radiosity(mesh, element_b)
+    });
+    let renderer = Renderer::for_settings(mesh, &prepared.scene, &settings);
+    radiosity::render::render_linear(&renderer, camera, element_b, &vertex_b, &settings, reporter)
 }
 
 /// What `render` says about the exposure `scale` it used: for `auto`, the radiosity it

@@ -18,11 +18,11 @@ use super::solve_scene;
 use crate::args::PathTraceArgs;
 use crate::progress_bar::Reporter;
 use crate::report;
-use crate::setup::{self, camera, check_png, gamma, load_scene, prepare_solve};
+use crate::setup::{self, camera, gamma, image_format, load_scene, prepare_solve, ImageFormat};
 
 pub fn run(args: PathTraceArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    check_png(args.output.as_deref())?;
+    let format = image_format(args.output.as_deref())?;
     let gamma = gamma(&args.tone)?;
     let settings = PathTraceSettings {
         samples_per_pixel: args.paths,
@@ -81,7 +81,10 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     ];
     let mut outputs = vec![output.clone()];
     if args.compare {
-        outputs.extend([sibling(&output, "radiosity"), sibling(&output, "error")]);
+        outputs.extend([
+            sibling(&output, "radiosity", format),
+            sibling(&output, "error", ImageFormat::Png),
+        ]);
     }
     outputs.extend(args.save_reference.clone());
     for out in &outputs {
@@ -133,6 +136,11 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             Exposure::Fixed(s) => s,
             Exposure::Auto => view.auto_exposure_scale(),
         };
+        if format == ImageFormat::Exr {
+            write_linear(view.film(), &camera, &output, &reporter)?;
+            reporter.print_timings();
+            return Ok(());
+        }
         reporter.note(&format!(
             "exposure scale {scale} (`render --exposure {scale}` shows a render with it)"
         ));
@@ -174,18 +182,26 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     let comparison = view.compare_excluding(&film, &emitters)?;
     let scale = args.tone.exposure.scale(scene, &solution.mesh, b);
     report::path_trace_comparison(&comparison, solution.mesh.len());
-    let radiosity_png = sibling(&output, "radiosity");
-    let error_png = sibling(&output, "error");
-    write_image(
-        &tonemap::to_image(view.film(), scale, gamma),
-        &output,
-        &reporter,
-    )?;
-    write_image(
-        &tonemap::to_image(&film, scale, gamma),
-        &radiosity_png,
-        &reporter,
-    )?;
+    let radiosity_image = sibling(&output, "radiosity", format);
+    let error_png = sibling(&output, "error", ImageFormat::Png);
+    match format {
+        ImageFormat::Png => {
+            write_image(
+                &tonemap::to_image(view.film(), scale, gamma),
+                &output,
+                &reporter,
+            )?;
+            write_image(
+                &tonemap::to_image(&film, scale, gamma),
+                &radiosity_image,
+                &reporter,
+            )?;
+        }
+        ImageFormat::Exr => {
+            write_linear(view.film(), &camera, &output, &reporter)?;
+            write_linear(&film, &camera, &radiosity_image, &reporter)?;
+        }
+    }
     write_image(
         &comparison.error_map.to_image(args.error_scale),
         &error_png,
@@ -207,12 +223,44 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     Ok(())
 }
 
-/// `out.png` -> `out-<suffix>.png`, beside it.
-fn sibling(output: &Path, suffix: &str) -> PathBuf {
+/// `out.png` -> `out-<suffix>.png` (or `.exr`), beside it.
+fn sibling(output: &Path, suffix: &str, format: ImageFormat) -> PathBuf {
     let stem = output
         .file_stem()
         .map_or("pathtrace".into(), |s| s.to_string_lossy().into_owned());
-    output.with_file_name(format!("{stem}-{suffix}.png"))
+    let ext = match format {
+        ImageFormat::Png => "png",
+        ImageFormat::Exr => "exr",
+    };
+    output.with_file_name(format!("{stem}-{suffix}.{ext}"))
+}
+
+/// Writes `film` as linear radiance (radiosity / pi) to the OpenEXR file `path`.
+fn write_linear(
+    film: &render::Film,
+    camera: &render::Camera,
+    path: &Path,
+    reporter: &Reporter,
+) -> Result<()> {
+    run_stage(reporter, Stage::Write, 0, || {
+        radiosity::io::exr::write_radiance(
+            path,
+            film.width(),
+            film.height(),
+            &film.pixel_means(),
+            camera,
+            "radiosity pathtrace",
+        )
+    })
+    .with_context(|| format!("cannot write {}", path.display()))?;
+    reporter.note(&format!(
+        "wrote {} ({} x {}, linear radiance = radiosity / pi in the scene's units per \
+         steradian; --exposure and --gamma are not applied)",
+        path.display(),
+        film.width(),
+        film.height()
+    ));
+    Ok(())
 }
 
 /// Refuses a reference file not named *.exr.

@@ -8,10 +8,13 @@ use radiosity::progress::{run_stage, Stage};
 use radiosity::render::{self};
 use radiosity::solve::Step;
 
-use super::{exposure_note, shade_and_render, solve_scene};
+use super::{exposure_note, shade_and_render, shade_and_render_linear, solve_scene};
 use crate::args::RenderArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{camera, prepare_solve, refuse_overwriting_inputs, render_settings, stem_of};
+use crate::setup::{
+    camera, image_format, prepare_solve, refuse_overwriting_inputs, render_settings, stem_of,
+    ImageFormat,
+};
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
@@ -27,6 +30,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
         ],
     )?;
     let settings = render_settings(&args)?;
+    let format = image_format(Some(&output))?;
+    if format == ImageFormat::Exr && settings.shading == render::Shading::Wireframe {
+        bail!(
+            "{}: a wireframe has no light to write as linear radiance; give --shading smooth \
+             or flat for an .exr, or a .png name",
+            output.display()
+        );
+    }
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
@@ -91,6 +102,37 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     if let Some(dir) = &args.snapshots {
         reporter.note(&format!("wrote {written} snapshots to {}", dir.display()));
+    }
+    if format == ImageFormat::Exr {
+        let pixels = shade_and_render_linear(
+            &prepared,
+            &solution.mesh,
+            solution.element_rgb(),
+            &camera,
+            settings,
+            &reporter,
+        )?
+        .expect("a wireframe .exr is refused above");
+        run_stage(&reporter, Stage::Write, 0, || {
+            radiosity::io::exr::write_radiance(
+                &output,
+                camera.width as usize,
+                camera.height as usize,
+                &pixels,
+                &camera,
+                "radiosity render",
+            )
+        })
+        .with_context(|| format!("cannot write {}", output.display()))?;
+        reporter.note(&format!(
+            "wrote {} ({} x {}, linear radiance = radiosity / pi in the scene's units per \
+             steradian; --exposure and --gamma are not applied)",
+            output.display(),
+            camera.width,
+            camera.height
+        ));
+        reporter.print_timings();
+        return Ok(());
     }
     let scale = exposure.scale(&prepared.scene, &solution.mesh, solution.element_rgb());
     let image = shade_and_render(

@@ -3,7 +3,7 @@
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use radiosity::progress::{run_stage, Stage};
 
 use super::solve_scene;
@@ -17,13 +17,20 @@ pub fn run(args: SolveArgs) -> Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.csv", stem_of(args.scene.scene.as_deref()))));
-    refuse_overwriting_inputs(
-        &output,
-        &[
-            ("scene file", args.scene.scene.as_deref()),
-            ("form-factor file", args.solve.form_factors.as_deref()),
-        ],
-    )?;
+    let inputs = [
+        ("scene file", args.scene.scene.as_deref()),
+        ("form-factor file", args.solve.form_factors.as_deref()),
+    ];
+    refuse_overwriting_inputs(&output, &inputs)?;
+    if let Some(report) = &args.report {
+        refuse_overwriting_inputs(report, &inputs)?;
+        if radiosity::io::is_same_file(report, &output) || report == &output {
+            bail!(
+                "--report {} is the solution's output too; give the report another name",
+                report.display()
+            );
+        }
+    }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let (solution, _) = solve_scene(
         &prepared,
@@ -47,6 +54,22 @@ pub fn run(args: SolveArgs) -> Result<()> {
         output.display(),
         solution.mesh.len()
     ));
+    if let Some(report) = &args.report {
+        run_stage(&reporter, Stage::Write, 0, || {
+            radiosity::io::surface_report::write_surface_report(
+                report,
+                &prepared.scene,
+                &solution.mesh,
+                solution.element_rgb(),
+            )
+        })
+        .with_context(|| format!("cannot write {}", report.display()))?;
+        reporter.note(&format!(
+            "wrote {} ({} surfaces; radiosity in the scene's emission units)",
+            report.display(),
+            prepared.scene.surfaces.len()
+        ));
+    }
     reporter.print_timings();
     Ok(())
 }

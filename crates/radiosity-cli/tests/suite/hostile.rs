@@ -147,8 +147,21 @@ fn hierarchical_solver_warns_that_it_ignores_method() {
         "{}",
         stderr(&out)
     );
-    // The default method, or a dense solver, says nothing.
+    // An explicit `--method area` is ignored as well, and said so.
+    let mut area = args;
+    area[6] = "area";
+    let out = radiosity(&area, &dir);
+    assert!(
+        stderr(&out).contains("warning: --method area is ignored"),
+        "{}",
+        stderr(&out)
+    );
+    // No --method, or a dense solver, says nothing.
     let out = radiosity(&args[..5], &dir);
+    assert!(!stderr(&out).contains("is ignored"), "{}", stderr(&out));
+    let mut dense = args;
+    dense[2] = "gauss-seidel";
+    let out = radiosity(&dense[..], &dir);
     assert!(!stderr(&out).contains("is ignored"), "{}", stderr(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }

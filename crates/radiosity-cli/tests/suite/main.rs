@@ -3,7 +3,9 @@
 
 mod fixtures;
 
+mod browser;
 mod commands;
+mod formats_out;
 mod hostile;
 mod imports;
 mod pathtrace;

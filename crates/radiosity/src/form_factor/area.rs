@@ -25,10 +25,14 @@ use glam::DVec3;
 use super::{exact, FormFactorContext, RayCounter};
 
 /// How close, in units of the larger element's size, a pair must be for
-/// [`PairKernel::AreaExactNear`] to take the exact value: half an element. At that
-/// distance the area rule at k = 2 is within about 1 % of the exact value (parallel unit
-/// squares half a unit apart: 1.1 %; tests/suite/form_factors.rs).
-pub(super) const NEAR: f64 = 0.5;
+/// [`PairKernel::AreaExactNear`] to take the exact value: two elements. Half an element
+/// (where the area rule at k = 2 is within about 1 % of the exact value: parallel unit
+/// squares half a unit apart, 1.1 %; tests/suite/form_factors.rs) left its small errors
+/// over the many pairs a little farther apart adding up: closed rooms escaped 0.29 to
+/// 0.63 % of their light; at two elements 0.13 to 0.39 %, and the pixels against the path
+/// tracer improved (building_small 5.33 -> 5.06 %, room.scene 4.16 -> 3.92 %), for twice
+/// building_small's form-factor time and 1.1 times the Cornell box's (BENCHMARKS.md).
+pub(super) const NEAR: f64 = 2.0;
 
 /// Points per axis of each element that judge the visibility of a near pair that
 /// something may block ([`PairKernel::AreaExactNear`]): 4 x 4, so 256 point pairs.

@@ -3,14 +3,14 @@
 //! run time and are therefore computed once, written to a file, and read by the part of the
 //! program that solves and renders).
 //!
-//! # Layout (version 2)
+//! # Layout (version 3)
 //!
 //! All integers and floats little-endian. L is the length of the method string in bytes.
 //!
 //! | offset        | size   | content                                                  |
 //! |---------------|--------|----------------------------------------------------------|
 //! | 0             | 8      | magic `RADFF\0\0\0`                                      |
-//! | 8             | 4      | format version, u32 (2)                                  |
+//! | 8             | 4      | format version, u32 (3)                                  |
 //! | 12            | 8      | element count n, u64                                     |
 //! | 20            | 4      | L, u32 (at most [`MAX_METHOD_LEN`])                      |
 //! | 24            | L      | method, UTF-8 (the `FormFactorMethod` Display, `area k=2`) |
@@ -40,10 +40,11 @@ use crate::mesh::Mesh;
 /// The first 8 bytes of every form-factor file.
 pub const FORM_FACTOR_MAGIC: [u8; 8] = *b"RADFF\0\0\0";
 
-/// The format version this library writes and reads: 2 since the `area` method computes
-/// near pairs exactly (the layout of version 1, whose `area` values are the older rule's
-/// and are refused so that they are computed again).
-pub const FORM_FACTOR_FILE_VERSION: u32 = 2;
+/// The format version this library writes and reads: 3 since the `area` method computes
+/// pairs within two elements exactly (2: within half an element; 1: none). The layout is
+/// version 1's; older files' `area` values are the older rules' and are refused so that
+/// they are computed again.
+pub const FORM_FACTOR_FILE_VERSION: u32 = 3;
 
 /// The longest method string a form-factor file may hold, in bytes.
 pub const MAX_METHOD_LEN: u32 = 4096;

@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 
 use exr::prelude::{
     AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer, LayerAttributes,
-    ReadChannels, ReadLayers, Text, WritableImage,
+    ReadChannels, ReadLayers, Text,
 };
 use thiserror::Error;
 
@@ -166,7 +166,7 @@ const BANDS: [&str; 3] = ["R", "G", "B"];
 const SE_BANDS: [&str; 3] = ["se.R", "se.G", "se.B"];
 
 /// The camera's doubles, by attribute name.
-fn camera_attributes(c: &Camera) -> [(&'static str, f64); 10] {
+pub(crate) fn camera_attributes(c: &Camera) -> [(&'static str, f64); 10] {
     [
         ("radiosity.eye.x", c.eye.x),
         ("radiosity.eye.y", c.eye.y),
@@ -268,16 +268,11 @@ pub fn write_path_traced(
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(channels.into()),
     );
-    let image = Image::from_layer(layer);
-    crate::io::write_atomically(path, |out| {
-        image.write().to_buffered(out).map_err(|e| match e {
-            exr::error::Error::Io(e) => e,
-            other => io::Error::other(other.to_string()),
-        })
-    })
-    .map_err(|source| PathTracedFileError::Io {
-        path: path.to_path_buf(),
-        source,
+    crate::io::exr::write_image(path, Image::from_layer(layer)).map_err(|source| {
+        PathTracedFileError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     })
 }
 
@@ -447,6 +442,7 @@ mod tests {
     use crate::pathtrace::path_trace;
     use crate::progress::NoProgress;
     use crate::scene::cornell_box;
+    use exr::prelude::WritableImage;
 
     fn scratch(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("radiosity-ptfile-{}", std::process::id()));

@@ -246,10 +246,9 @@ pub struct DirectCorrection<'m> {
     mesh: &'m Mesh,
     /// Reflectance per surface.
     reflectance: Vec<Rgb>,
-    /// Per vertex, the elements that touch it (have it as a corner of their display polygon,
-    /// T-vertices included: the rule of `vertex_radiosity`), as CSR offsets and list.
-    vertex_offsets: Vec<u32>,
-    vertex_elements: Vec<u32>,
+    /// How each vertex takes its value from the elements' ([`crate::shade::vertex_rule`],
+    /// the rule of `vertex_radiosity`), so that D is interpolated exactly as B is.
+    rule: crate::shade::VertexRule,
     /// Per element, its average direct irradiance, once computed.
     element_direct: Vec<OnceLock<Rgb>>,
     /// Per vertex, the area-weighted mean of its elements' averages, once computed.
@@ -259,30 +258,11 @@ pub struct DirectCorrection<'m> {
 impl<'m> DirectCorrection<'m> {
     /// The correction for `mesh`, which was cut from `scene`.
     pub fn new(scene: &Scene, mesh: &'m Mesh) -> DirectCorrection<'m> {
-        let display = mesh.display();
-        let mut counts = vec![0u32; mesh.vertices.len() + 1];
-        for e in 0..mesh.len() {
-            for &c in display.polygon(e) {
-                counts[c as usize + 1] += 1;
-            }
-        }
-        for i in 1..counts.len() {
-            counts[i] += counts[i - 1];
-        }
-        let mut fill = counts.clone();
-        let mut list = vec![0u32; counts[mesh.vertices.len()] as usize];
-        for e in 0..mesh.len() {
-            for &c in display.polygon(e) {
-                list[fill[c as usize] as usize] = e as u32;
-                fill[c as usize] += 1;
-            }
-        }
         DirectCorrection {
             light: DirectLight::new(scene),
             mesh,
             reflectance: scene.surfaces.iter().map(|s| s.reflectance).collect(),
-            vertex_offsets: counts,
-            vertex_elements: list,
+            rule: crate::shade::vertex_rule(mesh),
             element_direct: (0..mesh.len()).map(|_| OnceLock::new()).collect(),
             vertex_direct: (0..mesh.vertices.len()).map(|_| OnceLock::new()).collect(),
         }
@@ -310,23 +290,16 @@ impl<'m> DirectCorrection<'m> {
         })
     }
 
-    /// The area-weighted mean of the element averages around vertex `v` (the rule of
-    /// [`crate::shade::vertex_radiosity`]).
+    /// The element averages around vertex `v` combined by the rule of
+    /// [`crate::shade::vertex_radiosity`] (not raised to zero: D_smooth enters a
+    /// difference, and must cancel what the same rule does to the direct part of B).
     fn vertex(&self, v: usize) -> Rgb {
         *self.vertex_direct[v].get_or_init(|| {
-            let range = self.vertex_offsets[v] as usize..self.vertex_offsets[v + 1] as usize;
             let mut sum = Rgb::default();
-            let mut weight = 0.0;
-            for &e in &self.vertex_elements[range] {
-                let a = self.mesh.elements[e as usize].area;
-                sum += self.element(e as usize) * a;
-                weight += a;
+            for (e, w) in self.rule.terms(v) {
+                sum += self.element(e) * w;
             }
-            if weight > 0.0 {
-                sum * (1.0 / weight)
-            } else {
-                Rgb::default()
-            }
+            sum
         })
     }
 

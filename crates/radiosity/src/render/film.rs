@@ -110,6 +110,24 @@ impl Film {
         let row = (self.width * self.samples_per_pixel()).max(1);
         self.samples.par_chunks_mut(row).enumerate()
     }
+
+    /// Each pixel's value: the plain mean of its samples, unclamped and unexposed (what a
+    /// linear image such as OpenEXR holds), pixels row by row from the top-left corner.
+    pub fn pixel_means(&self) -> Vec<[f64; 3]> {
+        let n = self.samples_per_pixel();
+        self.samples
+            .chunks_exact(n)
+            .map(|pixel| {
+                let mut sum = [0.0; 3];
+                for s in pixel {
+                    for k in 0..3 {
+                        sum[k] += s[k];
+                    }
+                }
+                sum.map(|x| x / n as f64)
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]
@@ -142,6 +160,10 @@ mod tests {
             [0.125, 0.375, 0.625, 0.875]
         );
         assert_eq!(sample_offset(0, 1), 0.5);
+        // Pixel means: the mean of each pixel's four samples, nothing clamped.
+        let means = film.pixel_means();
+        assert_eq!(means.len(), 6);
+        assert_eq!(means[5], [1.0, 2.0, 1.5]);
         // An empty film has no rows to write.
         assert_eq!(
             Film::new(0, 5, 1, FilmContent::Radiosity)

@@ -148,22 +148,89 @@ fn render_counting(
     settings: &RenderSettings,
     progress: &dyn Progress,
 ) -> (RgbImage, u64, u64) {
+    let w = camera.width as usize;
+    let tone = ToneMap::new(settings.exposure_scale, settings.gamma);
+    let mut buf = vec![0u8; w * camera.height as usize * 3];
+    let (bad, total) = film_strips(
+        renderer,
+        camera,
+        element_b,
+        vertex_b,
+        settings,
+        progress,
+        |film, rows| tone.encode_film(film, &mut buf[rows.start * w * 3..rows.end * w * 3]),
+    );
+    let image =
+        RgbImage::from_raw(camera.width, camera.height, buf).expect("buffer has the image's size");
+    (image, bad, total)
+}
+
+/// Renders the view of `camera` as linear pixels: each pixel the mean of its
+/// `settings.supersample`^2 film samples, in the scene's radiosity units (a surface of
+/// uniform radiosity B shows as B), with no exposure, clamping or gamma
+/// (`settings.exposure_scale` and `settings.gamma` are not used). Pixels row by row from
+/// the top-left corner. Traced in strips like [`render`], so a large supersampled image
+/// never holds its whole film.
+///
+/// Refuses [`Shading::Wireframe`], whose film holds line coverage, not light (returned as
+/// `Ok(None)`), and an image any of whose samples is not finite.
+///
+/// # Panics
+/// As [`render`].
+pub fn render_linear(
+    renderer: &Renderer,
+    camera: &Camera,
+    element_b: &[[f64; 3]],
+    vertex_b: &[[f64; 3]],
+    settings: &RenderSettings,
+    progress: &dyn Progress,
+) -> Result<Option<Vec<[f64; 3]>>, NonFiniteImage> {
+    if settings.shading == Shading::Wireframe {
+        return Ok(None);
+    }
+    let w = camera.width as usize;
+    let mut pixels = vec![[0.0; 3]; w * camera.height as usize];
+    let (bad, total) = film_strips(
+        renderer,
+        camera,
+        element_b,
+        vertex_b,
+        settings,
+        progress,
+        |film, rows| pixels[rows.start * w..rows.end * w].copy_from_slice(&film.pixel_means()),
+    );
+    if bad > 0 {
+        return Err(NonFiniteImage { bad, total });
+    }
+    Ok(Some(pixels))
+}
+
+/// Traces the view of `camera` in strips of rows of at most [`STRIP_SAMPLES`] samples,
+/// handing each strip's film and its rows to `sink`, top to bottom; returns the count of
+/// samples that were not finite and of all samples.
+fn film_strips(
+    renderer: &Renderer,
+    camera: &Camera,
+    element_b: &[[f64; 3]],
+    vertex_b: &[[f64; 3]],
+    settings: &RenderSettings,
+    progress: &dyn Progress,
+    mut sink: impl FnMut(&Film, std::ops::Range<usize>),
+) -> (u64, u64) {
     renderer.check_inputs(element_b, vertex_b, settings.shading);
     let (w, h) = (camera.width as usize, camera.height as usize);
     if w == 0 || h == 0 {
-        return (RgbImage::new(camera.width, camera.height), 0, 0);
+        return (0, 0);
     }
     let (mut bad, mut total) = (0u64, 0u64);
     let n = settings.supersample.max(1) as usize;
-    let tone = ToneMap::new(settings.exposure_scale, settings.gamma);
     let strip = (STRIP_SAMPLES / (w * n * n)).max(1);
-    let mut buf = vec![0u8; w * h * 3];
     run_stage(progress, Stage::Render, h as u64, || {
-        for (k, out) in buf.chunks_mut(strip * w * 3).enumerate() {
-            let rows = k * strip..k * strip + out.len() / (w * 3);
+        for first in (0..h).step_by(strip) {
+            let rows = first..(first + strip).min(h);
             let film = renderer.film_rows(
                 camera,
-                rows,
+                rows.clone(),
                 element_b,
                 vertex_b,
                 settings.shading,
@@ -176,12 +243,10 @@ fn render_counting(
                 .par_iter()
                 .filter(|s| !s.iter().all(|x| x.is_finite()))
                 .count() as u64;
-            tone.encode_film(&film, out);
+            sink(&film, rows);
         }
     });
-    let image =
-        RgbImage::from_raw(camera.width, camera.height, buf).expect("buffer has the image's size");
-    (image, bad, total)
+    (bad, total)
 }
 
 #[cfg(test)]
@@ -314,6 +379,13 @@ mod tests {
                 shading == Shading::Wireframe
             );
             assert_eq!(img, tonemap::to_image(&film, 0.7, 1.8), "{shading:?}");
+            // The linear image is the whole film's pixel means, strips or not; wireframe
+            // has no light to give.
+            let linear = render_linear(&r, &cam, &eb, &vb, &settings, &NoProgress).unwrap();
+            match shading {
+                Shading::Wireframe => assert_eq!(linear, None),
+                _ => assert_eq!(linear, Some(film.pixel_means()), "{shading:?}"),
+            }
         }
     }
 }

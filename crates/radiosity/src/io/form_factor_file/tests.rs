@@ -112,7 +112,7 @@ fn layout_matches_documentation() {
     // 40 fixed bytes + L = 2 + 4 n^2 = 16.
     assert_eq!(bytes.len(), 58);
     assert_eq!(&bytes[0..8], b"RADFF\0\0\0");
-    assert_eq!(bytes[8..12], 2u32.to_le_bytes());
+    assert_eq!(bytes[8..12], 3u32.to_le_bytes());
     assert_eq!(bytes[12..20], 2u64.to_le_bytes());
     assert_eq!(bytes[20..24], 2u32.to_le_bytes());
     assert_eq!(&bytes[24..26], b"ab");
@@ -324,13 +324,13 @@ fn newer_version_is_refused() {
     let dir = temp_dir("version");
     let (path, fp, _) = valid_file(&dir, 3);
     let mut bytes = std::fs::read(&path).unwrap();
-    bytes[8..12].copy_from_slice(&3u32.to_le_bytes());
+    bytes[8..12].copy_from_slice(&4u32.to_le_bytes());
     std::fs::write(&path, &bytes).unwrap();
     let err = read_form_factors(&path, fp, None).unwrap_err();
     assert!(
         matches!(
             err,
-            FormFactorFileError::UnsupportedVersion { version: 3, .. }
+            FormFactorFileError::UnsupportedVersion { version: 4, .. }
         ),
         "{err}"
     );
@@ -338,22 +338,22 @@ fn newer_version_is_refused() {
 }
 
 #[test]
-fn version_1_files_of_the_older_area_rule_are_refused() {
-    // Version 1 files hold the area method's values from before its near pairs were exact:
-    // refused, so that they are computed again rather than solved with stale values.
+fn version_1_and_2_files_of_the_older_area_rules_are_refused() {
+    // Version 1 files hold the area method's values from before its near pairs were exact,
+    // version 2 from when only pairs within half an element were: refused, so that they
+    // are computed again rather than solved with stale values.
     let dir = temp_dir("version1");
-    let (path, fp, _) = valid_file(&dir, 3);
-    let mut bytes = std::fs::read(&path).unwrap();
-    bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
-    std::fs::write(&path, &bytes).unwrap();
-    let err = read_form_factors(&path, fp, None).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            FormFactorFileError::UnsupportedVersion { version: 1, .. }
-        ),
-        "{err}"
-    );
+    for old in [1u32, 2] {
+        let (path, fp, _) = valid_file(&dir, 3);
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes[8..12].copy_from_slice(&old.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read_form_factors(&path, fp, None).unwrap_err();
+        assert!(
+            matches!(err, FormFactorFileError::UnsupportedVersion { version, .. } if version == old),
+            "{err}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -1,0 +1,138 @@
+//! `radiosity export`: the solved scene as glTF with the radiosity in vertex colours, or
+//! the scene's surfaces as OBJ + MTL.
+
+use std::ops::ControlFlow;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use radiosity::io::export::gltf::{self, Bake};
+use radiosity::io::export::obj;
+use radiosity::progress::{run_stage, Stage};
+use radiosity::shade::{self, Exposure};
+
+use super::{exposure_note, solve_scene};
+use crate::args::ExportArgs;
+use crate::progress_bar::Reporter;
+use crate::setup::{camera, load_scene, prepare_solve, refuse_overwriting_inputs};
+
+/// What `-o` asks for, by extension.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Format {
+    Glb,
+    Gltf,
+    Obj,
+}
+
+fn format(output: &Path) -> Result<Format> {
+    let ext = output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("glb") => Ok(Format::Glb),
+        Some("gltf") => Ok(Format::Gltf),
+        Some("obj") => Ok(Format::Obj),
+        _ => bail!(
+            "{}: export writes glTF (.glb, or .gltf with a .bin beside it) or OBJ (.obj, with \
+             an .mtl beside it); give the output one of these extensions",
+            output.display()
+        ),
+    }
+}
+
+pub fn run(args: ExportArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let output = &args.output;
+    let format = format(output)?;
+    let inputs = [
+        ("scene file", args.scene.scene.as_deref()),
+        ("form-factor file", args.solve.form_factors.as_deref()),
+    ];
+    let mut outputs = vec![output.clone()];
+    match format {
+        Format::Gltf => outputs.push(gltf::buffer_path(output)),
+        Format::Obj => outputs.push(obj::mtl_path(output)),
+        Format::Glb => {}
+    }
+    for out in &outputs {
+        refuse_overwriting_inputs(out, &inputs)?;
+    }
+    if format == Format::Obj {
+        return export_obj(&args, &reporter);
+    }
+    let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    let camera = camera(&args.camera, &prepared.scene)?;
+    let (solution, _) = solve_scene(
+        &prepared,
+        solver,
+        crate::setup::adapt(&args.solve, &prepared, &solver)?,
+        args.solve.form_factors.as_deref(),
+        &mut |_| ControlFlow::Continue(()),
+        &reporter,
+    )?;
+    let b = solution.element_rgb();
+    let scale = args.exposure.scale(&prepared.scene, &solution.mesh, b);
+    let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
+        shade::vertex_radiosity(&solution.mesh, b)
+    });
+    let bake = Bake {
+        scene: &prepared.scene,
+        mesh: &solution.mesh,
+        vertex_b: &vertex_b,
+        exposure_scale: scale,
+        exposure: match args.exposure {
+            Exposure::Auto => "auto",
+            Exposure::Fixed(_) => "fixed",
+        },
+        camera: &camera,
+    };
+    run_stage(&reporter, Stage::Write, 0, || match format {
+        Format::Glb => gltf::write_glb(output, &bake),
+        Format::Gltf | Format::Obj => gltf::write_gltf(output, &bake),
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
+    // The exposure is part of what the file means; --quiet drops the note as for every
+    // command, and the file's asset.extras keeps it.
+    reporter.note(&exposure_note(
+        &prepared,
+        &solution.mesh,
+        b,
+        args.exposure,
+        scale,
+    ));
+    let extra = match format {
+        Format::Gltf => format!(" and {}", gltf::buffer_path(output).display()),
+        Format::Glb | Format::Obj => String::new(),
+    };
+    reporter.note(&format!(
+        "wrote {}{extra} ({} surfaces, {} elements; COLOR_0 = min(1, {scale} x radiosity), \
+         linear, on KHR_materials_unlit)",
+        output.display(),
+        prepared.scene.surfaces.len(),
+        solution.mesh.len(),
+    ));
+    reporter.print_timings();
+    Ok(())
+}
+
+/// `-o out.obj`: the scene's surfaces as they are (no meshing or solving; the mesh and
+/// solver flags do not apply), with the file's meshing settings (and --max-area,
+/// --steps) as comments.
+fn export_obj(args: &ExportArgs, reporter: &Reporter) -> Result<()> {
+    let (file, _) = load_scene(args.scene.scene.as_deref(), args.scene.scale, reporter)?;
+    let settings = radiosity::mesh::MeshSettings {
+        max_patch_area: args.scene.max_area.unwrap_or(file.settings.max_patch_area),
+        integral_steps: args.scene.steps.unwrap_or(file.settings.integral_steps),
+    };
+    let output = &args.output;
+    run_stage(reporter, Stage::Write, 0, || {
+        obj::write_obj(output, &file.scene, Some(settings))
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!(
+        "wrote {} and {} ({} surfaces; Kd reflectance, Ke emission)",
+        output.display(),
+        obj::mtl_path(output).display(),
+        file.scene.surfaces.len()
+    ));
+    Ok(())
+}

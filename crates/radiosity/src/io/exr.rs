@@ -1,0 +1,163 @@
+//! Linear images as OpenEXR files (`render -o out.exr`, `pathtrace -o out.exr`), for
+//! compositing and measurement: no exposure, no clamping, no gamma.
+//!
+//! One scan-line layer, ZIP-compressed (lossless), channels `R`, `G`, `B` as 32-bit floats
+//! (7 significant digits), pixels row by row from the top-left corner. Each value is the
+//! pixel's **radiance** L per band, in the scene's emission units per steradian: the
+//! renderer's and the path tracer's films hold the radiosity B seen through the pixel (a
+//! surface of uniform radiosity B shows as B), and a Lambertian surface of radiosity B has
+//! radiance L = B / pi in every direction, so the file holds film / pi. A closed box whose
+//! surfaces all emit E and reflect rho (B = E / (1 - rho)) shows E / (pi (1 - rho))
+//! everywhere. (The path tracer's *reference* files, [`super::path_traced_file`], keep B
+//! itself, as the comparison needs; they are another format.)
+//!
+//! Layer attributes say what the file holds: `radiosity.quantity` ("radiance = radiosity
+//! / pi, scene emission units per steradian"), the camera (`radiosity.eye.x` ...
+//! `radiosity.fovY`, as in the reference files) and the software.
+
+use std::collections::HashMap;
+use std::io;
+use std::path::Path;
+
+use exr::prelude::{
+    AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image, Layer, LayerAttributes,
+    Text, WritableImage,
+};
+
+use crate::render::Camera;
+
+/// The `radiosity.quantity` attribute of a linear image.
+pub const QUANTITY: &str = "radiance = radiosity / pi, scene emission units per steradian";
+
+/// Writes `image` (a layer with its attributes) to `path`, atomically (see
+/// [`crate::io::write_atomically`]); the `exr` crate's errors become I/O errors.
+pub(crate) fn write_image(
+    path: &Path,
+    image: Image<Layer<AnyChannels<FlatSamples>>>,
+) -> io::Result<()> {
+    crate::io::write_atomically(path, |out| {
+        image.write().to_buffered(out).map_err(|e| match e {
+            exr::error::Error::Io(e) => e,
+            other => io::Error::other(other.to_string()),
+        })
+    })
+}
+
+/// Writes a `width` x `height` linear image whose pixels (row by row from the top left)
+/// hold the radiosity `film_b` seen through them, as radiance `film_b / pi` (module
+/// documentation), at `path`, atomically. `camera` and `software` go into the attributes.
+///
+/// Returns an `InvalidInput` error, writing nothing, when `film_b` does not have
+/// `width * height` pixels.
+pub fn write_radiance(
+    path: &Path,
+    width: usize,
+    height: usize,
+    film_b: &[[f64; 3]],
+    camera: &Camera,
+    software: &str,
+) -> io::Result<()> {
+    if film_b.len() != width * height {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("{} pixels for a {width} x {height} image", film_b.len()),
+        ));
+    }
+    let channels: Vec<AnyChannel<FlatSamples>> = ["R", "G", "B"]
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let values = film_b
+                .iter()
+                .map(|p| (p[k] / std::f64::consts::PI) as f32)
+                .collect();
+            AnyChannel::new(*name, FlatSamples::F32(values))
+        })
+        .collect();
+    let mut attributes = LayerAttributes::named("radiance");
+    attributes.software_name = Some(Text::from(software));
+    let mut other: HashMap<Text, AttributeValue> =
+        super::path_traced_file::camera_attributes(camera)
+            .into_iter()
+            .map(|(name, x)| (Text::from(name), AttributeValue::F64(x)))
+            .collect();
+    other.insert(
+        Text::from("radiosity.quantity"),
+        AttributeValue::Text(Text::from(QUANTITY)),
+    );
+    attributes.other = other;
+    let layer = Layer::new(
+        (width, height),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels.into()),
+    );
+    write_image(path, Image::from_layer(layer))
+}
+
+/// A linear image read back: width, height and the `R`, `G`, `B` values row by row (for
+/// tests and scripts; any RGB float OpenEXR file reads).
+pub fn read_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), exr::error::Error> {
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |size, _| {
+            (
+                size.width(),
+                vec![[0.0f32; 3]; size.width() * size.height()],
+            )
+        },
+        |(w, pixels), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            pixels[pos.y() * *w + pos.x()] = [r, g, b];
+        },
+    )?;
+    let size = image.layer_data.size;
+    let (_, pixels) = image.layer_data.channel_data.pixels;
+    Ok((size.width(), size.height(), pixels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn radiance_is_radiosity_over_pi_unclamped_and_in_order() {
+        // Values far above 1 and a pixel order that a transposition would break.
+        let film: Vec<[f64; 3]> = (0..6)
+            .map(|i| [i as f64 * 10.0, 0.5, std::f64::consts::PI * 1000.0])
+            .collect();
+        let camera = Camera {
+            eye: DVec3::new(0.0, 0.0, -3.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+            width: 3,
+            height: 2,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("view.exr");
+        write_radiance(&path, 3, 2, &film, &camera, "test").unwrap();
+        let (w, h, pixels) = read_rgb(&path).unwrap();
+        assert_eq!((w, h), (3, 2));
+        for (i, p) in pixels.iter().enumerate() {
+            let expect = [
+                i as f64 * 10.0 / std::f64::consts::PI,
+                0.5 / std::f64::consts::PI,
+                1000.0,
+            ];
+            for k in 0..3 {
+                // f32 keeps 24 bits: a relative error of at most 2^-24 (6e-8).
+                let err = (p[k] as f64 - expect[k]).abs();
+                assert!(
+                    err <= 1e-7 * expect[k].abs(),
+                    "pixel {i} band {k}: {p:?} vs {expect:?}"
+                );
+            }
+        }
+        // A pixel count that is not the size's is refused, and nothing is written.
+        let other = dir.path().join("bad.exr");
+        let err = write_radiance(&other, 2, 2, &film, &camera, "test").unwrap_err();
+        assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
+        assert!(!other.exists());
+    }
+}
