@@ -294,3 +294,88 @@ pub fn obj(data: &[u8]) {
         }
     }
 }
+
+/// What every importer's target checks of a read: an error must format; a scene read must
+/// hold only usable polygons with colours in the scene format's ranges, have usable
+/// settings, and, written in the scene format, parse again (the writer may refuse, cleanly,
+/// a name the importer accepts: see `scene_file`).
+fn check_import(
+    result: Result<radiosity::io::import::Imported, radiosity::io::import::ImportError>,
+) {
+    let imported = match result {
+        Ok(imported) => imported,
+        Err(error) => {
+            assert!(!error.to_string().is_empty(), "an error without a message");
+            return;
+        }
+    };
+    for w in &imported.warnings {
+        assert!(!w.to_string().is_empty());
+    }
+    let file = imported.file;
+    assert!(!file.scene.surfaces.is_empty(), "an imported scene without surfaces");
+    for s in &file.scene.surfaces {
+        if let Err(e) = geometry::validate_polygon(&s.vertices) {
+            panic!("surface {:?} is not a usable polygon: {e}: {:?}", s.name, s.vertices);
+        }
+        assert!(s.reflectance.0.iter().all(|r| (0.0..1.0).contains(r)));
+        assert!(s.emission.0.iter().all(|e| *e >= 0.0 && e.is_finite()));
+    }
+    assert!(file.settings.max_patch_area > 0.0 && file.settings.max_patch_area.is_finite());
+    let mut written = Vec::new();
+    if write_scene(&file.scene, file.settings, &mut written).is_ok() {
+        let written = String::from_utf8(written).expect("the writer writes UTF-8");
+        if let Err(e) = parse_scene(&written, "written.scene") {
+            panic!("an imported scene, written, does not parse: {e}\n--- written:\n{written}");
+        }
+    }
+}
+
+/// The glTF reader (`io::import::gltf::parse`) on arbitrary bytes: JSON glTF or binary
+/// `.glb` (told apart by the `glTF` magic, as the reader does), with no folder, so that
+/// URIs other than `data:` are refused; then [`check_import`].
+pub fn gltf(data: &[u8]) {
+    use radiosity::io::import::{gltf, ImportOptions};
+    init();
+    check_import(gltf::parse("fuzz.gltf", data, None, &ImportOptions::default()));
+}
+
+/// The VRML97 reader (`io::import::vrml::parse`) on arbitrary bytes, then [`check_import`].
+pub fn vrml(data: &[u8]) {
+    use radiosity::io::import::{vrml, ImportOptions};
+    init();
+    check_import(vrml::parse("fuzz.wrl", data, &ImportOptions::default()));
+}
+
+/// Where a `dxf` input's materials file starts: the bytes after this line are the TOML
+/// side file; without it the materials are [`DXF_DEFAULT_MATERIALS`].
+pub const TOML_SEPARATOR: &[u8] = b"\n%%TOML\n";
+
+/// The materials of a `dxf` input that gives none: every layer grey (so that the drawing's
+/// faces get past the layer lookup).
+pub const DXF_DEFAULT_MATERIALS: &str = "[default]\nreflectance = [0.5, 0.5, 0.5]\n";
+
+/// The DXF reader (`io::import::dxf::parse`) on arbitrary bytes, the bytes after
+/// [`TOML_SEPARATOR`] as its materials file (read as UTF-8 with replacement characters),
+/// then [`check_import`].
+pub fn dxf(data: &[u8]) {
+    use radiosity::io::import::{dxf, ImportOptions};
+    init();
+    let split = data
+        .windows(TOML_SEPARATOR.len())
+        .position(|w| w == TOML_SEPARATOR);
+    let (drawing, materials) = match split {
+        Some(k) => (
+            &data[..k],
+            String::from_utf8_lossy(&data[k + TOML_SEPARATOR.len()..]).into_owned(),
+        ),
+        None => (data, DXF_DEFAULT_MATERIALS.to_string()),
+    };
+    check_import(dxf::parse(
+        "fuzz.dxf",
+        drawing,
+        "fuzz.materials.toml",
+        Some(&materials),
+        &ImportOptions::default(),
+    ));
+}

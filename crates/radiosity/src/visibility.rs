@@ -119,7 +119,7 @@ impl PolygonBvh {
         // coordinates, at most 32 from its centre, by 3.8e-6 units at most: well inside
         // the pad, at least 1.6e-4 units).
         let pad = (1e-5 * scale * to_local) as f32;
-        let bounds: Vec<Bounds> = polygons
+        let mut bounds: Vec<Bounds> = polygons
             .iter()
             .map(|p| {
                 let pts: Vec<Vec3A> = p.as_ref().iter().map(|v| local(*v)).collect();
@@ -130,6 +130,7 @@ impl PolygonBvh {
                 ))
             })
             .collect();
+        spread_identical_boxes(&mut bounds);
         let mut corners = Vec::new();
         let mut edge_planes = Vec::new();
         let mut records = Vec::with_capacity(polygons.len());
@@ -415,6 +416,43 @@ impl PolygonBvh {
 /// on two ordinary boxes, found by the fuzzer).
 const LOCAL_DIAGONAL: f64 = 16.0;
 
+/// Makes boxes that are the same (bit for bit) different, each still holding its own:
+/// the k-th of n equal boxes grows by (n - 1 - k) steps below and k steps above (a step
+/// two units in the last place of its largest coordinate), so the n boxes are the same
+/// size and slide apart. obvhs's builder chains equal boxes into a tree deeper than its
+/// traversal stack (32): a few hundred copies of one polygon, or many small polygons far
+/// from the rest whose boxes round to the same `f32`s (found by the VRML and DXF fuzz
+/// targets), failed its debug validation with a panic and would be walked wrongly in a
+/// release build. Growing a box only adds candidates to test, never loses a hit.
+fn spread_identical_boxes(bounds: &mut [Bounds]) {
+    let key = |b: &Bounds| {
+        let (lo, hi) = (b.0.min, b.0.max);
+        [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z].map(f32::to_bits)
+    };
+    let mut groups: std::collections::HashMap<[u32; 6], (usize, usize)> =
+        std::collections::HashMap::new();
+    for b in bounds.iter() {
+        groups.entry(key(b)).or_insert((0, 0)).0 += 1;
+    }
+    if groups.len() == bounds.len() {
+        return;
+    }
+    for b in bounds.iter_mut() {
+        let Some((n, next)) = groups.get_mut(&key(b)) else {
+            continue;
+        };
+        if *n < 2 {
+            continue;
+        }
+        let k = *next;
+        *next += 1;
+        let reach = b.0.min.abs().max(b.0.max.abs()).max_element();
+        let step = 2.0 * f32::EPSILON * (reach + 1.0);
+        b.0.min -= Vec3A::splat((*n - 1 - k) as f32 * step);
+        b.0.max += Vec3A::splat(k as f32 * step);
+    }
+}
+
 /// The power of two that makes a scene of diagonal `scale` [`LOCAL_DIAGONAL`] to twice that
 /// of the hierarchy's units long (module documentation).
 fn local_unit(scale: f64) -> f64 {
@@ -444,6 +482,51 @@ fn to_f32(v: DVec3) -> Vec3A {
 mod tests {
     use super::*;
     use glam::dvec3;
+
+    #[test]
+    fn hundreds_of_polygons_with_one_box_pass_obvhs_validation() {
+        // 300 copies of a triangle (the DXF fuzz target's zero-spaced INSERT grid), and
+        // 300 different small triangles far from a large one, whose boxes round to the
+        // same f32s in the hierarchy's units (the VRML fuzz target's far-off Transform):
+        // obvhs chained equal boxes deeper than its traversal stack and its validation
+        // (debug assertions, as in this test) panicked. Every copy is still found.
+        let tri = vec![
+            dvec3(-1.0, 0.0, 0.0),
+            dvec3(-1.1, 0.0, 0.0),
+            dvec3(-1.0, 0.0, -1.0),
+        ];
+        let polygons = vec![tri; 300];
+        let ids: Vec<u32> = (0..300).collect();
+        let bvh = PolygonBvh::new(&polygons, &ids);
+        let mut found = Vec::new();
+        bvh.overlapping(
+            dvec3(-1.05, -0.1, -0.2),
+            dvec3(-1.04, 0.1, -0.1),
+            &mut found,
+        );
+        found.sort_unstable();
+        assert_eq!(found, (0..300).collect::<Vec<u32>>());
+        let mut polygons: Vec<Vec<DVec3>> = (0..300)
+            .map(|k| {
+                let d = k as f64 * 1e-14;
+                vec![
+                    dvec3(d, 0.0, 0.0),
+                    dvec3(d + 1e-12, 0.0, 0.0),
+                    dvec3(d, 1e-12, 0.0),
+                ]
+            })
+            .collect();
+        polygons.push(vec![
+            dvec3(0.0, 1e17, 0.0),
+            dvec3(1e17, 1e17, 0.0),
+            dvec3(0.0, 1e17, 1e17),
+        ]);
+        let ids: Vec<u32> = (0..301).collect();
+        let bvh = PolygonBvh::new(&polygons, &ids);
+        let mut found = Vec::new();
+        bvh.overlapping(dvec3(-1.0, -1.0, -1.0), dvec3(1.0, 1.0, 1.0), &mut found);
+        assert_eq!(found.len(), 300);
+    }
 
     #[test]
     fn hierarchy_of_two_ordinary_boxes_passes_obvhs_validation() {

@@ -104,3 +104,70 @@ fn import_warnings_are_printed_even_when_quiet() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `solve` of the Cornell box as DXF (with its materials file) and as VRML writes the scene
+/// file's per-element CSV (the surfaces are the scene file's bit for bit; VRML names have
+/// `_` for spaces), and as glTF runs and says how it read the file.
+#[test]
+fn solve_reads_dxf_vrml_and_gltf_as_the_scene_file() {
+    let dir = scratch_dir("import-dxf-vrml-gltf");
+    let run = |scene: &str, out: &str| {
+        let args = [
+            "solve",
+            scene,
+            "-o",
+            out,
+            "--max-area",
+            "20000",
+            "--steps",
+            "1",
+            "--adapt-rounds",
+            "0",
+        ];
+        radiosity(&args, &dir)
+    };
+    let from_scene = run(&example("cornell_box.scene"), "scene.csv");
+    assert!(from_scene.status.success(), "{}", stderr(&from_scene));
+    let scene_csv = std::fs::read_to_string(dir.join("scene.csv")).unwrap();
+    let from_dxf = run(&data("cornell_box.dxf"), "dxf.csv");
+    assert!(from_dxf.status.success(), "{}", stderr(&from_dxf));
+    assert!(
+        stderr(&from_dxf).contains("read as DXF; unit: millimetres (the DXF's $INSUNITS 4"),
+        "{}",
+        stderr(&from_dxf)
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("dxf.csv")).unwrap(),
+        scene_csv
+    );
+    let from_vrml = run(&data("cornell_box.wrl"), "wrl.csv");
+    assert!(from_vrml.status.success(), "{}", stderr(&from_vrml));
+    assert!(stderr(&from_vrml).contains("read as VRML97; unit: metres (VRML97's unit)"));
+    // The same numbers; VRML's names have `_` where the scene file's have spaces.
+    assert_eq!(
+        std::fs::read_to_string(dir.join("wrl.csv"))
+            .unwrap()
+            .replace(' ', "_"),
+        scene_csv.replace(' ', "_")
+    );
+    let from_gltf = run(&data("cornell_box.gltf"), "gltf.csv");
+    assert!(from_gltf.status.success(), "{}", stderr(&from_gltf));
+    assert!(stderr(&from_gltf).contains("read as glTF; unit: metres (glTF's unit)"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A DXF without its materials file: the error names the file expected and the layers.
+#[test]
+fn dxf_without_materials_lists_its_layers() {
+    let dir = scratch_dir("import-dxf-materials");
+    std::fs::copy(data("cornell_box.dxf"), dir.join("box.dxf")).unwrap();
+    let out = radiosity(&["check", "box.dxf"], &dir);
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(
+        e.starts_with("box.materials.toml: error: the materials file of box.dxf is missing"),
+        "{e}"
+    );
+    assert!(e.contains("\"Back wall\", \"Ceiling back\""), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -7,9 +7,9 @@
 //! | --- | --- | --- |
 //! | `.scene` | the paper's Appendix A format | [`crate::io::scene_file`] |
 //! | `.obj` | Wavefront OBJ with its MTL materials | [`obj`] |
-//! | `.gltf`, `.glb` | glTF 2.0 | not yet: [`ImportError::NotSupportedYet`] |
-//! | `.dxf` | AutoCAD DXF | not yet: [`ImportError::NotSupportedYet`] |
-//! | `.wrl` | VRML97 | not yet: [`ImportError::NotSupportedYet`] |
+//! | `.gltf`, `.glb` | glTF 2.0 | [`gltf`] |
+//! | `.dxf` | AutoCAD DXF (ASCII) with a `.materials.toml` side file | [`dxf`] |
+//! | `.wrl` | VRML97 | [`vrml`] |
 //!
 //! Every importer other than the scene file's reads its file into a [`FaceSoup`] (named
 //! objects, faces as lists of indices into one vertex array, a material per face) and
@@ -52,8 +52,13 @@
 //! [`FaceSoup`], calls [`FaceSoup::to_scene`], and adds its own warnings. Counts read from
 //! a binary file are checked with [`check_count`] before anything is allocated for them.
 
+pub mod dxf;
 mod face_soup;
+pub mod gltf;
+mod merge;
 pub mod obj;
+mod tessellate;
+pub mod vrml;
 
 use std::fmt;
 use std::path::Path;
@@ -373,9 +378,9 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
     match format {
         Format::Scene => read_scene_scaled(path, options.scale),
         Format::Obj => obj::read(path, options),
-        Format::Gltf | Format::Glb | Format::Dxf | Format::Vrml => {
-            Err(ImportError::NotSupportedYet { file, format })
-        }
+        Format::Gltf | Format::Glb => gltf::read(path, options),
+        Format::Vrml => vrml::read(path, options),
+        Format::Dxf => dxf::read(path, options),
     }
 }
 

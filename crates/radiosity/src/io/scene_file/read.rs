@@ -148,18 +148,46 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneErro
 /// mesher handles (the covered part is left out); a duplicate leaves nothing of the lower
 /// one and is a mistake. The scene reader refuses duplicates; the importers
 /// ([`crate::io::import`]) drop the upper one with a warning.
+///
+/// Exact copies (the same corners in the same cyclic order, bit for bit) are paired with
+/// the first of them by hashing, and only that first one goes into the hierarchy: a few
+/// hundred identical boxes make obvhs build a tree deeper than its traversal stack (32),
+/// which its debug validation refuses with a panic and its release traversal walks wrongly
+/// (the DXF fuzz target's crash: an INSERT grid of 256 cells spaced 0).
 pub(crate) fn duplicate_surfaces(surfaces: &[Surface]) -> Vec<(usize, usize)> {
     if surfaces.len() < 2 {
         return Vec::new();
     }
+    let mut pairs = Vec::new();
+    let mut first_of: std::collections::HashMap<Vec<[u64; 3]>, usize> =
+        std::collections::HashMap::new();
+    let mut kept = Vec::with_capacity(surfaces.len());
+    for (i, s) in surfaces.iter().enumerate() {
+        let bits: Vec<[u64; 3]> = s
+            .vertices
+            .iter()
+            .map(|v| v.to_array().map(f64::to_bits))
+            .collect();
+        // The cycle from its smallest corner, so that a copy starting elsewhere matches.
+        let start = (0..bits.len()).min_by_key(|&k| bits[k]).unwrap_or(0);
+        let key: Vec<[u64; 3]> = (0..bits.len())
+            .map(|k| bits[(start + k) % bits.len()])
+            .collect();
+        match first_of.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => pairs.push((i, *e.get())),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(i);
+                kept.push(i);
+            }
+        }
+    }
     let scene = Scene {
-        surfaces: surfaces.to_vec(),
+        surfaces: kept.iter().map(|&i| surfaces[i].clone()).collect(),
         camera: None,
     };
     let bvh = crate::visibility::PolygonBvh::over_surfaces(&scene);
-    let mut pairs = Vec::new();
     for o in crate::scene::lying_on(&scene, &bvh) {
-        let (lower, upper) = (o.lower as usize, o.upper as usize);
+        let (lower, upper) = (kept[o.lower as usize], kept[o.upper as usize]);
         let area = |s: usize| geometry::polygon_area(&surfaces[s].vertices);
         // Covering the whole of the lower surface and no larger than it, to 1e-6 (six
         // significant digits, as scene files are often written).

@@ -922,6 +922,23 @@ fn a_surface_given_twice_is_refused_naming_both_lines() {
     assert_eq!(errors(&rug), vec![]);
 }
 
+// Regression (the DXF fuzz target's crash, in the shared duplicate check): 256 copies of one
+// patch made obvhs build a hierarchy deeper than its traversal stack, which its debug
+// validation refused with a panic. Each copy is now refused at its line, naming the first.
+#[test]
+fn hundreds_of_copies_of_a_patch_are_refused_without_a_panic() {
+    let mut text = VALID.replace("SCENEEND\n", "");
+    for k in 0..256 {
+        text += &patch(&format!("Copy{k}"), "Rg 0.5", "VERTEX2 1 1 0");
+    }
+    text += "SCENEEND\n";
+    let e = errors(&text);
+    assert_eq!(e.len(), 256, "{:#?}", &e[..3]);
+    assert!(e
+        .iter()
+        .all(|x| x.2.contains("lies exactly on surface \"Floor\" (line 13)")));
+}
+
 #[test]
 fn non_convex_patch_is_triangulated() {
     // A dart: (0,0) (1,0) (0.2,0.2) (0,1), area 0.2 by the shoelace formula, reflex at

@@ -1,0 +1,810 @@
+//! glTF 2.0 (`.gltf` with external or embedded buffers, and `.glb`), read with the `gltf`
+//! crate's document model; the buffers, accessors and images are read here, with every
+//! offset, stride and count checked against the bytes there are before anything is
+//! allocated for them.
+//!
+//! What is read:
+//!
+//! * the default scene (or the first, or, in a file without scenes, every node that is no
+//!   other node's child), its node hierarchy's transforms applied (`matrix` or
+//!   translation-rotation-scale); a node whose transform mirrors (negative determinant)
+//!   has its triangles' winding turned, as the specification says;
+//! * each mesh primitive's `POSITION`s (`f32`) and indices (`u8`, `u16`, `u32`, or none):
+//!   triangles as they are, triangle strips and fans converted to triangles (with a
+//!   warning), points and lines left out (with a warning: they have no area);
+//!   edge-adjacent triangles of one primitive that lie in one plane and make a convex
+//!   polygon are joined into it (module `merge`), so that a quad exported as two
+//!   triangles meshes as the quad;
+//! * the material: reflectance is `baseColorFactor` (RGB, alpha ignored) times the mean of
+//!   the base-colour texture when there is one (PNG or JPEG; decoded from sRGB to linear
+//!   and averaged over its texels, not weighted by how the surface's UVs use it; a texture
+//!   that cannot be read is left out with a warning); a reflectance of 1 or more (glTF's
+//!   default white) is taken as [`MAX_REFLECTANCE`] with a warning, since the scene
+//!   format needs it below 1. Emission is `emissiveFactor` times
+//!   `KHR_materials_emissive_strength` (1 without it), taken as the exitance in the
+//!   scene's emission units, as OBJ's `Ke` is.
+//!
+//! Each node with a mesh is one object: its surfaces are named after the node (or its
+//! mesh, or `node N`). Unit: metres, glTF's unit, times [`super::ImportOptions::scale`].
+//!
+//! Ignored: cameras and lights (`KHR_lights_punctual`), normals, UVs beyond the texture
+//! mean, vertex colours, the emissive texture, metallic-roughness, alpha and
+//! `doubleSided` (every surface is one-sided: it reflects on its front only), morph
+//! targets and skins, animations. Sparse accessors and quantized positions
+//! (`KHR_mesh_quantization`) are refused with an error.
+
+use std::collections::HashMap;
+use std::io::Read;
+use std::path::Path;
+
+use base64::Engine as _;
+use glam::{DMat4, DVec3};
+use gltf::mesh::Mode;
+
+use super::merge::join_coplanar;
+use super::{
+    check_count, default_settings, scaled_unit, FaceSoup, Format, ImportError, ImportOptions,
+    ImportWarning, Imported, SoupFace, SoupMaterial,
+};
+use crate::io::scene_file::SceneFile;
+use crate::light::Rgb;
+
+/// The reflectance a colour of 1 or more becomes (glTF's default material is white, 1).
+pub const MAX_REFLECTANCE: f64 = 0.99;
+
+/// The most triangles the scene may have once every node's mesh is placed (meshes used by
+/// several nodes count once per node): a file that asks for more is refused before it
+/// is expanded.
+pub const MAX_TRIANGLES: usize = 2_000_000;
+
+/// Reads the glTF or binary glTF file at `path`; buffers and images it names by URI are
+/// read relative to the file's folder.
+pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
+        file: file.clone(),
+        message: e.to_string(),
+    })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    parse(&file, &bytes, Some(dir), options)
+}
+
+/// Reads glTF or binary glTF from `bytes` (named `file` in messages). URIs other than
+/// `data:` ones are read from `dir`; with `dir` `None` they are refused.
+pub fn parse(
+    file: &str,
+    bytes: &[u8],
+    dir: Option<&Path>,
+    options: &ImportOptions,
+) -> Result<Imported, ImportError> {
+    let mut reader = Reader {
+        file: file.to_string(),
+        dir,
+        warnings: Vec::new(),
+        buffers: Vec::new(),
+    };
+    let (soup, format) = reader.soup(bytes)?;
+    let (scene, mut warnings) = soup.to_scene(options.scale)?;
+    let mut all = std::mem::take(&mut reader.warnings);
+    all.append(&mut warnings);
+    let settings = options.settings.unwrap_or_else(|| default_settings(&scene));
+    Ok(Imported {
+        file: SceneFile { settings, scene },
+        warnings: all,
+        unit: scaled_unit("metres (glTF's unit)", options.scale),
+        format,
+    })
+}
+
+struct Reader<'a> {
+    file: String,
+    dir: Option<&'a Path>,
+    warnings: Vec<ImportWarning>,
+    /// Every buffer's bytes, in the document's order.
+    buffers: Vec<Vec<u8>>,
+}
+
+/// What counts warn about, summed over the file.
+#[derive(Default)]
+struct Counts {
+    converted: usize,
+    no_area: usize,
+    leftover_indices: usize,
+}
+
+impl Reader<'_> {
+    fn error(&self, message: String) -> ImportError {
+        ImportError::Syntax {
+            file: self.file.clone(),
+            line: 0,
+            message,
+        }
+    }
+
+    fn warn(&mut self, message: String) {
+        self.warnings.push(ImportWarning {
+            file: self.file.clone(),
+            line: 0,
+            message,
+        });
+    }
+
+    fn soup(&mut self, bytes: &[u8]) -> Result<(FaceSoup, Format), ImportError> {
+        let format = if bytes.starts_with(b"glTF") {
+            self.check_glb_header(bytes)?;
+            Format::Glb
+        } else {
+            Format::Gltf
+        };
+        let invalid = |e: gltf::Error| self.error(format!("not a valid glTF 2.0 file: {e}"));
+        // Read, then validated in two steps: the `gltf` crate's own validation indexes the
+        // accessor list with a primitive's POSITION index unchecked (gltf-json 1.4.1,
+        // mesh.rs:151), so that index is checked here first (the fuzz target's first crash).
+        let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+        let blob = raw.blob;
+        let json = raw.document.into_json();
+        self.check_position_indices(&json)?;
+        let document = gltf::Document::from_json(json).map_err(invalid)?;
+        let doc = &document;
+        for buffer in doc.buffers() {
+            let data = self.buffer(&buffer, blob.as_deref())?;
+            self.buffers.push(data);
+        }
+        let mut soup = FaceSoup {
+            file: self.file.clone(),
+            ..FaceSoup::default()
+        };
+        let materials: Vec<SoupMaterial> = doc
+            .materials()
+            .map(|m| self.material(doc, &m))
+            .collect::<Result<_, _>>()?;
+        soup.materials = materials;
+        // The default material (for primitives without one) goes last, added when used.
+        let default_material = soup.materials.len() as u32;
+        let mut default_used = false;
+
+        let roots = self.roots(doc)?;
+        let planned = planned_triangles(doc, &roots);
+        if planned > MAX_TRIANGLES {
+            return Err(self.error(format!(
+                "the scene would have {planned} triangles once every node's mesh is placed, \
+                 more than the {MAX_TRIANGLES} this reader takes; split it or simplify it"
+            )));
+        }
+        let mut counts = Counts::default();
+        let mut triangles_total = 0usize;
+        // Depth-first over the tree, each node with its parent's global transform.
+        let mut stack: Vec<(gltf::Node, DMat4)> = roots
+            .into_iter()
+            .rev()
+            .map(|n| (n, DMat4::IDENTITY))
+            .collect();
+        let mut visited = vec![false; doc.nodes().len()];
+        while let Some((node, parent)) = stack.pop() {
+            if std::mem::replace(&mut visited[node.index()], true) {
+                return Err(self.error(format!(
+                    "node {} is reached twice in the scene's hierarchy (a node may have one \
+                     parent and appear once; the children form a cycle or share a node)",
+                    describe_node(&node)
+                )));
+            }
+            let local =
+                DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+            let global = parent * local;
+            if let Some(mesh) = node.mesh() {
+                let object = soup.objects.len() as u32;
+                soup.objects.push(object_name(&node, &mesh));
+                for prim in mesh.primitives() {
+                    let material = match prim.material().index() {
+                        Some(i) => i as u32,
+                        None => {
+                            default_used = true;
+                            default_material
+                        }
+                    };
+                    let n = self.primitive(
+                        &prim,
+                        &node,
+                        &global,
+                        object,
+                        material,
+                        &mut soup,
+                        &mut counts,
+                        triangles_total,
+                    )?;
+                    triangles_total += n;
+                }
+            }
+            for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+                stack.push((child, global));
+            }
+        }
+        if default_used {
+            soup.materials.push(self.default_material());
+        }
+        if counts.converted > 0 {
+            self.warn(format!(
+                "{} triangle strip or fan primitive{} converted to triangles",
+                counts.converted,
+                plural(counts.converted)
+            ));
+        }
+        if counts.no_area > 0 {
+            self.warn(format!(
+                "{} point or line primitive{} left out (they have no area to light)",
+                counts.no_area,
+                plural(counts.no_area)
+            ));
+        }
+        if counts.leftover_indices > 0 {
+            self.warn(format!(
+                "{} trailing index{} that make no whole triangle left out",
+                counts.leftover_indices,
+                if counts.leftover_indices == 1 {
+                    ""
+                } else {
+                    "es"
+                }
+            ));
+        }
+        Ok((soup, format))
+    }
+
+    /// Every primitive's POSITION names an accessor the file has (checked before the
+    /// `gltf` crate's validation, which would index out of bounds).
+    fn check_position_indices(&self, json: &gltf::json::Root) -> Result<(), ImportError> {
+        let accessors = json.accessors.len();
+        for (m, mesh) in json.meshes.iter().enumerate() {
+            for (p, prim) in mesh.primitives.iter().enumerate() {
+                let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+                if let Some(index) = prim.attributes.get(&position) {
+                    if index.value() >= accessors {
+                        return Err(self.error(format!(
+                            "mesh {m} primitive {p}: POSITION names accessor {}, but the file \
+                             has {accessors} accessors",
+                            index.value()
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The GLB header's length must be one the file can hold: the `gltf` crate subtracts
+    /// the header's size from it without a check.
+    fn check_glb_header(&self, bytes: &[u8]) -> Result<(), ImportError> {
+        let Some(len) = bytes.get(8..12) else {
+            return Err(self.error(format!(
+                "binary glTF truncated: {} bytes, less than the 12 of its header",
+                bytes.len()
+            )));
+        };
+        let length = u32::from_le_bytes([len[0], len[1], len[2], len[3]]) as usize;
+        if length < 20 || length > bytes.len() {
+            return Err(self.error(format!(
+                "binary glTF header gives the length {length}, but the file has {} bytes (and \
+                 the header and JSON chunk header need 20): truncated or corrupt",
+                bytes.len()
+            )));
+        }
+        Ok(())
+    }
+
+    /// The nodes the scene starts from.
+    fn roots<'d>(&self, doc: &'d gltf::Document) -> Result<Vec<gltf::Node<'d>>, ImportError> {
+        if let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) {
+            return Ok(scene.nodes().collect());
+        }
+        let mut is_child = vec![false; doc.nodes().len()];
+        for node in doc.nodes() {
+            for child in node.children() {
+                is_child[child.index()] = true;
+            }
+        }
+        let roots: Vec<_> = doc.nodes().filter(|n| !is_child[n.index()]).collect();
+        if roots.is_empty() && doc.nodes().len() > 0 {
+            return Err(self.error(
+                "every node is another node's child: the node hierarchy has a cycle".into(),
+            ));
+        }
+        Ok(roots)
+    }
+
+    /// A buffer's bytes: the GLB's binary chunk, a `data:` URI, or a file beside this one.
+    fn buffer(&self, buffer: &gltf::Buffer, blob: Option<&[u8]>) -> Result<Vec<u8>, ImportError> {
+        let what = format!("buffer {}", buffer.index());
+        let length = buffer.length();
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob
+                .ok_or_else(|| {
+                    self.error(format!(
+                        "{what} is the binary chunk, but the file has none (a .gltf file's \
+                         buffers need a \"uri\")"
+                    ))
+                })?
+                .to_vec(),
+            gltf::buffer::Source::Uri(uri) => self.uri_bytes(&what, uri, length)?,
+        };
+        if data.len() < length {
+            return Err(self.error(format!(
+                "{what} should hold {length} bytes (its byteLength) but has {}: truncated",
+                data.len()
+            )));
+        }
+        Ok(data)
+    }
+
+    /// The bytes a URI names: a base64 `data:` URI, or a file relative to this one's folder
+    /// (of which at most `limit` bytes are read).
+    fn uri_bytes(&self, what: &str, uri: &str, limit: usize) -> Result<Vec<u8>, ImportError> {
+        if let Some(rest) = uri.strip_prefix("data:") {
+            let Some((_, payload)) = rest.split_once(";base64,") else {
+                return Err(self.error(format!(
+                    "{what}: a data URI must be base64 (\"data:...;base64,...\")"
+                )));
+            };
+            return base64::engine::general_purpose::STANDARD
+                .decode(payload.trim())
+                .map_err(|e| self.error(format!("{what}: its data URI is not valid base64: {e}")));
+        }
+        let Some(dir) = self.dir else {
+            return Err(self.error(format!(
+                "{what} names the external file \"{uri}\", which cannot be read here"
+            )));
+        };
+        let path = dir.join(percent_decode(uri));
+        let opened = std::fs::File::open(&path).map_err(|e| ImportError::Io {
+            file: path.display().to_string(),
+            message: format!("{e} ({what} of {})", self.file),
+        })?;
+        let mut data = Vec::new();
+        opened
+            .take(limit as u64)
+            .read_to_end(&mut data)
+            .map_err(|e| ImportError::Io {
+                file: path.display().to_string(),
+                message: format!("{e} ({what} of {})", self.file),
+            })?;
+        Ok(data)
+    }
+
+    fn default_material(&mut self) -> SoupMaterial {
+        self.warn(format!(
+            "primitives without a material get glTF's default, white, whose reflectance 1 is \
+             taken as {MAX_REFLECTANCE}"
+        ));
+        SoupMaterial {
+            name: "(default material)".into(),
+            reflectance: Rgb([MAX_REFLECTANCE; 3]),
+            emission: Rgb([0.0; 3]),
+            defined_at: None,
+        }
+    }
+
+    fn material(
+        &mut self,
+        doc: &gltf::Document,
+        m: &gltf::Material,
+    ) -> Result<SoupMaterial, ImportError> {
+        let name = m.name().map_or_else(
+            || format!("material {}", m.index().unwrap_or(0)),
+            str::to_string,
+        );
+        let pbr = m.pbr_metallic_roughness();
+        let factor = pbr.base_color_factor();
+        let mut reflectance = [0.0; 3];
+        for (r, f) in reflectance.iter_mut().zip(factor) {
+            *r = f64::from(f);
+        }
+        if let Some(info) = pbr.base_color_texture() {
+            match self.texture_mean(doc, &info.texture()) {
+                Ok(mean) => {
+                    for (r, t) in reflectance.iter_mut().zip(mean) {
+                        *r *= t;
+                    }
+                }
+                Err(why) => self.warn(format!(
+                    "material \"{name}\": its base-colour texture is left out ({why}); the \
+                     reflectance is its baseColorFactor alone"
+                )),
+            }
+        }
+        if reflectance.iter().any(|&r| r >= 1.0) {
+            self.warn(format!(
+                "material \"{name}\": a base colour of 1 or more is taken as reflectance \
+                 {MAX_REFLECTANCE} (a surface cannot reflect all the light it receives)"
+            ));
+            for r in &mut reflectance {
+                *r = r.min(MAX_REFLECTANCE);
+            }
+        }
+        let strength = f64::from(m.emissive_strength().unwrap_or(1.0));
+        let emission = m.emissive_factor().map(|e| f64::from(e) * strength);
+        Ok(SoupMaterial {
+            name,
+            reflectance: Rgb(reflectance),
+            emission: Rgb(emission),
+            defined_at: None,
+        })
+    }
+
+    /// The mean linear colour of a texture's image, or why it cannot be had. The image is
+    /// looked at in the JSON: the `gltf` crate's `Image::source` panics on an image with
+    /// neither a URI nor a buffer view and a MIME type.
+    fn texture_mean(
+        &self,
+        doc: &gltf::Document,
+        texture: &gltf::Texture,
+    ) -> Result<[f64; 3], String> {
+        let index = texture.source().index();
+        let what = format!("image {index}");
+        let json = &doc.as_json().images[index];
+        let bytes = if let Some(view) = &json.buffer_view {
+            let view = doc
+                .views()
+                .nth(view.value())
+                .ok_or_else(|| format!("{what}: no buffer view {}", view.value()))?;
+            self.view_bytes(&view).map_err(|e| e.to_string())?.to_vec()
+        } else if let Some(uri) = &json.uri {
+            // An image is never larger than the file format's 4 GiB; a local file is the
+            // user's own.
+            self.uri_bytes(&what, uri, u32::MAX as usize)
+                .map_err(|e| e.to_string())?
+        } else {
+            return Err(format!("{what} has neither a uri nor a bufferView"));
+        };
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(16_384);
+        limits.max_image_height = Some(16_384);
+        limits.max_alloc = Some(1 << 30);
+        reader.limits(limits);
+        let decoded = reader
+            .with_guessed_format()
+            .map_err(|e| format!("{what}: {e}"))?
+            .decode()
+            .map_err(|e| format!("{what}: {e}"))?
+            .into_rgb8();
+        let n = u64::from(decoded.width()) * u64::from(decoded.height());
+        if n == 0 {
+            return Err(format!("{what} has no pixels"));
+        }
+        let mut sum = [0.0f64; 3];
+        for p in decoded.pixels() {
+            for (s, &c) in sum.iter_mut().zip(&p.0) {
+                *s += srgb_to_linear(f64::from(c) / 255.0);
+            }
+        }
+        Ok(sum.map(|s| s / n as f64))
+    }
+
+    /// A buffer view's bytes.
+    fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8], ImportError> {
+        let data = &self.buffers[view.buffer().index()];
+        let end = view.offset().checked_add(view.length());
+        match end {
+            Some(end) if end <= data.len() => Ok(&data[view.offset()..end]),
+            _ => Err(self.error(format!(
+                "buffer view {} runs from byte {} for {} bytes, past the end of buffer {} ({} \
+                 bytes)",
+                view.index(),
+                view.offset(),
+                view.length(),
+                view.buffer().index(),
+                data.len()
+            ))),
+        }
+    }
+
+    /// An accessor's elements as raw bytes each `size` long, checked to fit its view.
+    fn accessor_elements(
+        &self,
+        accessor: &gltf::Accessor,
+        size: usize,
+        what: &str,
+    ) -> Result<Vec<&[u8]>, ImportError> {
+        let index = accessor.index();
+        if accessor.sparse().is_some() {
+            return Err(self.error(format!(
+                "accessor {index} ({what}) is sparse, which this reader does not support"
+            )));
+        }
+        let Some(view) = accessor.view() else {
+            return Err(self.error(format!(
+                "accessor {index} ({what}) has no buffer view (its values would all be zero)"
+            )));
+        };
+        let bytes = self.view_bytes(&view)?;
+        let stride = view.stride().unwrap_or(size).max(size);
+        let count = accessor.count();
+        let offset = accessor.offset();
+        check_count(
+            &self.file,
+            0,
+            &format!("accessor {index} ({what})"),
+            count as u64,
+            stride as u64,
+            (bytes.len().saturating_sub(offset) + stride - size) as u64,
+        )?;
+        let mut out = Vec::with_capacity(count);
+        for k in 0..count {
+            let start = offset + k * stride;
+            let Some(e) = bytes.get(start..start + size) else {
+                return Err(self.error(format!(
+                    "accessor {index} ({what}): element {k} runs past the end of buffer view {}",
+                    view.index()
+                )));
+            };
+            out.push(e);
+        }
+        Ok(out)
+    }
+
+    /// One primitive's triangles into the soup; returns how many.
+    #[allow(clippy::too_many_arguments)]
+    fn primitive(
+        &self,
+        prim: &gltf::Primitive,
+        node: &gltf::Node,
+        global: &DMat4,
+        object: u32,
+        material: u32,
+        soup: &mut FaceSoup,
+        counts: &mut Counts,
+        triangles_so_far: usize,
+    ) -> Result<usize, ImportError> {
+        let mode = prim.mode();
+        if matches!(
+            mode,
+            Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip
+        ) {
+            counts.no_area += 1;
+            return Ok(0);
+        }
+        let place = format!("node {} primitive {}", describe_node(node), prim.index());
+        let Some(positions) = prim.get(&gltf::Semantic::Positions) else {
+            return Err(self.error(format!("{place} has no POSITION attribute")));
+        };
+        if positions.data_type() != gltf::accessor::DataType::F32
+            || positions.dimensions() != gltf::accessor::Dimensions::Vec3
+        {
+            return Err(self.error(format!(
+                "{place}: POSITION (accessor {}) must be VEC3 of 32-bit floats, found {:?} of \
+                 {:?} (quantized positions are not supported)",
+                positions.index(),
+                positions.dimensions(),
+                positions.data_type()
+            )));
+        }
+        let raw = self.accessor_elements(&positions, 12, "POSITION")?;
+        let vertex_count = raw.len();
+        let indices: Vec<u32> = match prim.indices() {
+            None => (0..vertex_count as u32).collect(),
+            Some(acc) => {
+                if acc.dimensions() != gltf::accessor::Dimensions::Scalar {
+                    return Err(self.error(format!(
+                        "{place}: indices (accessor {}) must be SCALAR",
+                        acc.index()
+                    )));
+                }
+                let (size, read): (usize, fn(&[u8]) -> u32) = match acc.data_type() {
+                    gltf::accessor::DataType::U8 => (1, |b| u32::from(b[0])),
+                    gltf::accessor::DataType::U16 => {
+                        (2, |b| u32::from(u16::from_le_bytes([b[0], b[1]])))
+                    }
+                    gltf::accessor::DataType::U32 => {
+                        (4, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                    }
+                    other => {
+                        return Err(self.error(format!(
+                            "{place}: indices (accessor {}) must be unsigned bytes, shorts or \
+                             ints, found {other:?}",
+                            acc.index()
+                        )))
+                    }
+                };
+                let elements = self.accessor_elements(&acc, size, "indices")?;
+                let mut out = Vec::with_capacity(elements.len());
+                for (k, e) in elements.into_iter().enumerate() {
+                    let i = read(e);
+                    if i as usize >= vertex_count {
+                        return Err(ImportError::BadIndex {
+                            file: self.file.clone(),
+                            line: 0,
+                            element: format!("{place}, index {k}"),
+                            index: i64::from(i),
+                            count: vertex_count,
+                        });
+                    }
+                    out.push(i);
+                }
+                out
+            }
+        };
+        let mut triangles: Vec<[u32; 3]> = match mode {
+            Mode::Triangles => {
+                counts.leftover_indices += indices.len() % 3;
+                indices
+                    .chunks_exact(3)
+                    .map(|t| [t[0], t[1], t[2]])
+                    .collect()
+            }
+            Mode::TriangleStrip => {
+                counts.converted += 1;
+                (0..indices.len().saturating_sub(2))
+                    .map(|i| {
+                        if i % 2 == 0 {
+                            [indices[i], indices[i + 1], indices[i + 2]]
+                        } else {
+                            [indices[i + 1], indices[i], indices[i + 2]]
+                        }
+                    })
+                    .collect()
+            }
+            Mode::TriangleFan => {
+                counts.converted += 1;
+                (1..indices.len().saturating_sub(1))
+                    .map(|i| [indices[i], indices[i + 1], indices[0]])
+                    .collect()
+            }
+            _ => Vec::new(),
+        };
+        if triangles_so_far.saturating_add(triangles.len()) > MAX_TRIANGLES {
+            return Err(self.error(format!(
+                "{place}: the scene would have more than {MAX_TRIANGLES} triangles once every \
+                 node's mesh is placed; split it or simplify it"
+            )));
+        }
+        // The points the triangles use, placed; the same point given twice (a vertex
+        // repeated per face for its normals or UVs) made one so that the triangles can be
+        // joined. Unused points are not kept (a mesh placed by many nodes costs its
+        // triangles, which are bounded, not its vertex list).
+        let mut unique: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut remap = vec![u32::MAX; vertex_count];
+        let base = soup.vertices.len() as u32;
+        let mut points: Vec<DVec3> = Vec::new();
+        let mirrored = global.determinant() < 0.0;
+        for t in &mut triangles {
+            for i in t.iter_mut() {
+                let k = *i as usize;
+                if remap[k] == u32::MAX {
+                    let e = raw[k];
+                    let p = DVec3::new(f32_at(e, 0), f32_at(e, 4), f32_at(e, 8));
+                    let placed = global.transform_point3(p);
+                    if !placed.is_finite() {
+                        return Err(ImportError::NotFinite {
+                            file: self.file.clone(),
+                            line: 0,
+                            element: format!(
+                                "{place}, POSITION {k} ({p}) placed by the node's transform"
+                            ),
+                            value: placed
+                                .to_array()
+                                .into_iter()
+                                .find(|x| !x.is_finite())
+                                .unwrap_or(f64::NAN),
+                        });
+                    }
+                    let key = placed.to_array().map(f64::to_bits);
+                    remap[k] = *unique.entry(key).or_insert_with(|| {
+                        points.push(placed);
+                        (points.len() - 1) as u32
+                    });
+                }
+                *i = remap[k];
+            }
+            if mirrored {
+                t.swap(1, 2);
+            }
+        }
+        let n = triangles.len();
+        for poly in join_coplanar(&points, &triangles) {
+            soup.faces.push(SoupFace {
+                object,
+                material,
+                first: soup.indices.len(),
+                count: poly.len() as u32,
+                line: 0,
+            });
+            soup.indices.extend(poly.iter().map(|&i| base + i));
+        }
+        soup.vertices.extend(points);
+        Ok(n)
+    }
+}
+
+/// How many triangles the nodes under `roots` ask for, from their accessors' counts,
+/// before anything is read (each node counted once; cycles are the walk's to report).
+fn planned_triangles(doc: &gltf::Document, roots: &[gltf::Node]) -> usize {
+    let mut seen = vec![false; doc.nodes().len()];
+    let mut stack: Vec<gltf::Node> = roots.to_vec();
+    let mut total = 0usize;
+    while let Some(node) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            continue;
+        }
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let count = match (prim.indices(), prim.get(&gltf::Semantic::Positions)) {
+                    (Some(i), _) => i.count(),
+                    (None, Some(p)) => p.count(),
+                    (None, None) => 0,
+                };
+                total = total.saturating_add(match prim.mode() {
+                    Mode::Triangles => count / 3,
+                    Mode::TriangleStrip | Mode::TriangleFan => count.saturating_sub(2),
+                    _ => 0,
+                });
+            }
+        }
+        stack.extend(node.children());
+    }
+    total
+}
+
+fn f32_at(bytes: &[u8], at: usize) -> f64 {
+    f64::from(f32::from_le_bytes([
+        bytes[at],
+        bytes[at + 1],
+        bytes[at + 2],
+        bytes[at + 3],
+    ]))
+}
+
+fn describe_node(node: &gltf::Node) -> String {
+    match node.name() {
+        Some(name) => format!("{} (\"{name}\")", node.index()),
+        None => node.index().to_string(),
+    }
+}
+
+fn object_name(node: &gltf::Node, mesh: &gltf::Mesh) -> String {
+    node.name()
+        .or_else(|| mesh.name())
+        .map_or_else(|| format!("node {}", node.index()), str::to_string)
+}
+
+fn plural(n: usize) -> &'static str {
+    if n == 1 {
+        ""
+    } else {
+        "s"
+    }
+}
+
+/// The sRGB transfer function undone: a texel's stored value to linear.
+fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// `%XX` escapes in a relative URI decoded (glTF's URIs are percent-encoded).
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            if let Some(v) = bytes
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok())
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+            {
+                out.push(v);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(bytes[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+#[cfg(test)]
+#[path = "gltf_tests.rs"]
+mod tests;

@@ -1,0 +1,750 @@
+//! The glTF reader: the Cornell box as glTF (embedded, external and binary buffers) against
+//! the scene file, transforms, materials, primitive modes, and hostile files.
+
+use std::path::PathBuf;
+
+use base64::Engine as _;
+use glam::{dvec3, DVec3};
+use serde_json::{json, Value};
+
+use super::*;
+use crate::io::import::read_any_scene;
+use crate::progress::NoProgress;
+use crate::scene::Scene;
+use crate::{pipeline, Overrides, Prepared, SolveRequest, Solver};
+
+/// A glTF document under construction: one buffer, a view and an accessor per array.
+#[derive(Default)]
+pub(crate) struct Builder {
+    pub bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        self.views.push(json!({
+            "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len(), "target": target
+        }));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
+    /// A VEC3 float accessor (with the min and max glTF requires of positions).
+    pub fn positions(&mut self, p: &[[f32; 3]]) -> usize {
+        let bytes: Vec<u8> = p.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        let view = self.view(&bytes, 34962);
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for q in p {
+            for k in 0..3 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": 5126, "count": p.len(), "type": "VEC3",
+            "min": lo, "max": hi
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// A SCALAR unsigned-int accessor.
+    pub fn indices(&mut self, i: &[u32]) -> usize {
+        let bytes: Vec<u8> = i.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let view = self.view(&bytes, 34963);
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": 5125, "count": i.len(), "type": "SCALAR"
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// A buffer view holding `bytes` (an image).
+    pub fn raw_view(&mut self, bytes: &[u8]) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        self.views.push(json!({
+            "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()
+        }));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
+    /// The document: `rest` (meshes, nodes, materials, scenes, ...) with the asset, the
+    /// buffer (`uri`: a data URI when `Some("")`, that file name when `Some(name)`, the
+    /// GLB chunk when `None`), views and accessors.
+    pub fn json(&self, mut rest: Value, uri: Option<&str>) -> Value {
+        let mut buffer = json!({ "byteLength": self.bin.len() });
+        match uri {
+            Some("") => {
+                buffer["uri"] = Value::String(format!(
+                    "data:application/octet-stream;base64,{}",
+                    base64::engine::general_purpose::STANDARD.encode(&self.bin)
+                ))
+            }
+            Some(name) => buffer["uri"] = Value::String(name.to_string()),
+            None => {}
+        }
+        rest["asset"] = json!({ "version": "2.0", "generator": "radiosity tests" });
+        rest["buffers"] = json!([buffer]);
+        rest["bufferViews"] = Value::Array(self.views.clone());
+        rest["accessors"] = Value::Array(self.accessors.clone());
+        rest
+    }
+
+    /// The binary glTF of `rest` with the buffer as its BIN chunk.
+    pub fn glb(&self, rest: Value) -> Vec<u8> {
+        let mut json = serde_json::to_vec(&self.json(rest, None)).unwrap();
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        let mut bin = self.bin.clone();
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let total = 12 + 8 + json.len() + 8 + bin.len();
+        let mut out = Vec::new();
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        out
+    }
+}
+
+/// The glTF of a scene: one node, mesh and material per surface (named after it), each
+/// polygon as the fan of triangles from its first corner; emission as `emissiveFactor`
+/// (scaled to at most 1) times `KHR_materials_emissive_strength`.
+pub(crate) fn scene_to_gltf(scene: &Scene) -> (Builder, Value) {
+    let mut b = Builder::default();
+    let (mut meshes, mut nodes, mut materials) = (vec![], vec![], vec![]);
+    for (i, s) in scene.surfaces.iter().enumerate() {
+        let p: Vec<[f32; 3]> = s
+            .vertices
+            .iter()
+            .map(|v| [v.x as f32, v.y as f32, v.z as f32])
+            .collect();
+        let fan: Vec<u32> = (1..s.vertices.len() as u32 - 1)
+            .flat_map(|k| [0, k, k + 1])
+            .collect();
+        let pos = b.positions(&p);
+        let ind = b.indices(&fan);
+        meshes.push(json!({
+            "name": s.name,
+            "primitives": [{ "attributes": { "POSITION": pos }, "indices": ind, "material": i }]
+        }));
+        nodes.push(json!({ "name": s.name, "mesh": i }));
+        let r = s.reflectance.0;
+        let e = s.emission.0;
+        let strength = e.iter().copied().fold(0.0, f64::max);
+        let mut m = json!({
+            "name": s.name,
+            "pbrMetallicRoughness": {
+                "baseColorFactor": [r[0], r[1], r[2], 1.0], "metallicFactor": 0.0
+            }
+        });
+        if strength > 0.0 {
+            m["emissiveFactor"] = json!(e.map(|x| x / strength));
+            m["extensions"] =
+                json!({ "KHR_materials_emissive_strength": { "emissiveStrength": strength } });
+        }
+        materials.push(m);
+    }
+    let n = nodes.len();
+    let rest = json!({
+        "extensionsUsed": ["KHR_materials_emissive_strength"],
+        "scene": 0,
+        "scenes": [{ "name": "Cornell box", "nodes": (0..n).collect::<Vec<_>>() }],
+        "nodes": nodes, "meshes": meshes, "materials": materials
+    });
+    (b, rest)
+}
+
+fn repo_file(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(name)
+}
+
+fn cornell_scene() -> Scene {
+    crate::io::scene_file::read_scene(&repo_file("examples/cornell_box.scene"))
+        .unwrap()
+        .scene
+}
+
+/// The committed `tests/data/cornell_box.gltf`, as [`scene_to_gltf`] writes it.
+fn cornell_gltf_text() -> String {
+    let (b, rest) = scene_to_gltf(&cornell_scene());
+    serde_json::to_string_pretty(&b.json(rest, Some(""))).unwrap() + "\n"
+}
+
+/// Rewrites `tests/data/cornell_box.gltf` (run with `--ignored` after changing the box).
+#[test]
+#[ignore]
+fn write_cornell_box_gltf() {
+    std::fs::write(
+        repo_file("tests/data/cornell_box.gltf"),
+        cornell_gltf_text(),
+    )
+    .unwrap();
+}
+
+#[test]
+fn committed_cornell_box_gltf_is_the_scene_files_box() {
+    let committed = std::fs::read_to_string(repo_file("tests/data/cornell_box.gltf")).unwrap();
+    assert!(
+        committed == cornell_gltf_text(),
+        "tests/data/cornell_box.gltf is not what scene_to_gltf makes of \
+         examples/cornell_box.scene; rewrite it with the ignored test write_cornell_box_gltf"
+    );
+}
+
+/// The surfaces of `got` are those of `want`: same names, order and colours, corners
+/// within single precision's rounding. The corners went through `f32`: 548.8 becomes
+/// 548.79998779..., 1.2e-5 off, and flattening moves them by as little again; 1e-4 mm
+/// is 2e-7 of the box.
+fn assert_same_surfaces(got: &Scene, want: &Scene) {
+    assert_eq!(got.surfaces.len(), want.surfaces.len());
+    for (g, w) in got.surfaces.iter().zip(&want.surfaces) {
+        assert_eq!(g.name, w.name);
+        assert_eq!(g.vertices.len(), w.vertices.len(), "{}", w.name);
+        for (a, b) in g.vertices.iter().zip(&w.vertices) {
+            assert!(
+                (*a - *b).abs().max_element() < 1e-4,
+                "{}: {a} vs {b}",
+                w.name
+            );
+        }
+        // Colours went through f32 too (and emission through a quotient and a product
+        // of f32s): relative 1e-6 is eight times f32's rounding.
+        for k in 0..3 {
+            let (r, s) = (g.reflectance.0[k], w.reflectance.0[k]);
+            assert!(
+                (r - s).abs() <= 1e-6 * s.abs().max(1e-3),
+                "{}: {r} vs {s}",
+                w.name
+            );
+            let (e, f) = (g.emission.0[k], w.emission.0[k]);
+            assert!(
+                (e - f).abs() <= 1e-6 * f.abs().max(1e-3),
+                "{}: {e} vs {f}",
+                w.name
+            );
+        }
+    }
+}
+
+/// The element radiosities of a coarse solve.
+fn solve(scene: Scene) -> Vec<[f64; 3]> {
+    let coarse = Overrides {
+        max_patch_area: Some(20_000.0),
+        integral_steps: Some(1),
+    };
+    let settings = coarse.apply(crate::scene::cornell_box().settings);
+    let prepared = Prepared::new(scene, settings, &NoProgress).unwrap();
+    let request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
+    let solution = pipeline::solve(
+        &prepared,
+        &request,
+        &mut crate::solve::keep_going,
+        &NoProgress,
+    )
+    .unwrap();
+    solution.element_rgb().to_vec()
+}
+
+#[test]
+fn cornell_box_gltf_solves_as_the_scene_file() {
+    let imported = read_any_scene(
+        &repo_file("tests/data/cornell_box.gltf"),
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
+    assert_eq!(imported.format, Format::Gltf);
+    assert_eq!(imported.unit, "metres (glTF's unit)");
+    let want = cornell_scene();
+    assert_same_surfaces(&imported.file.scene, &want);
+    let a = solve(imported.file.scene);
+    let b = solve(want);
+    assert_eq!(a.len(), b.len());
+    let top = b.iter().flatten().copied().fold(0.0, f64::max);
+    // The geometry differs by f32 rounding (2e-8 of the box); form factors and so the
+    // radiosities move by about as much relatively. 1e-5 of the brightest element is a
+    // thousand times that and far below anything visible.
+    for (x, y) in a.iter().zip(&b) {
+        for k in 0..3 {
+            assert!((x[k] - y[k]).abs() <= 1e-5 * top, "{x:?} vs {y:?}");
+        }
+    }
+}
+
+#[test]
+fn glb_and_external_buffer_read_as_the_embedded_gltf() {
+    let want = cornell_scene();
+    let (b, rest) = scene_to_gltf(&want);
+    let glb = parse(
+        "box.glb",
+        &b.glb(rest.clone()),
+        None,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(glb.format, Format::Glb);
+    assert_same_surfaces(&glb.file.scene, &want);
+
+    let dir = tempfile::tempdir().unwrap();
+    let gltf_path = dir.path().join("box.gltf");
+    std::fs::write(
+        &gltf_path,
+        serde_json::to_vec(&b.json(rest, Some("box%20data.bin"))).unwrap(),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("box data.bin"), &b.bin).unwrap();
+    let external = read_any_scene(&gltf_path, &ImportOptions::default()).unwrap();
+    assert_same_surfaces(&external.file.scene, &want);
+    // The scale multiplies every coordinate and says so in the unit.
+    let scaled = read_any_scene(
+        &gltf_path,
+        &ImportOptions {
+            scale: 0.001,
+            settings: None,
+        },
+    )
+    .unwrap();
+    assert_eq!(scaled.unit, "metres (glTF's unit) x 0.001");
+    let (lo, hi) = scaled.file.scene.bounds();
+    assert!((hi.x - lo.x - 0.556).abs() < 1e-6, "{lo} {hi}");
+
+    // Without the folder the external buffer cannot be had: an error, not a panic.
+    let text = std::fs::read(&gltf_path).unwrap();
+    let err = parse("box.gltf", &text, None, &ImportOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("box%20data.bin"), "{err}");
+}
+
+/// One unit square in the xy plane (normal +z) as two triangles, used by `nodes`.
+fn square_doc(nodes: Value, materials: Value, mode: Option<u32>) -> Value {
+    let mut b = Builder::default();
+    let pos = b.positions(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ]);
+    let mut prim = json!({ "attributes": { "POSITION": pos } });
+    match mode {
+        // Strip 0 1 3 2: triangles 0 1 3 and (odd, turned) 1 2 3.
+        Some(5) => {
+            prim["indices"] = json!(b.indices(&[0, 1, 3, 2]));
+            prim["mode"] = json!(5);
+        }
+        // Fan about 0: triangles 0 1 2 and 0 2 3, as glTF orders them (1 2 0, 2 3 0).
+        Some(6) => {
+            prim["indices"] = json!(b.indices(&[0, 1, 2, 3]));
+            prim["mode"] = json!(6);
+        }
+        Some(m) => {
+            prim["indices"] = json!(b.indices(&[0, 1, 2, 3]));
+            prim["mode"] = json!(m);
+        }
+        None => prim["indices"] = json!(b.indices(&[0, 1, 2, 0, 2, 3])),
+    }
+    if materials.as_array().is_some_and(|m| !m.is_empty()) {
+        prim["material"] = json!(0);
+    }
+    let n = nodes.as_array().unwrap().len();
+    let roots: Vec<usize> = (0..n)
+        .filter(|i| {
+            !nodes.as_array().unwrap().iter().any(|m| {
+                m["children"]
+                    .as_array()
+                    .is_some_and(|c| c.contains(&json!(i)))
+            })
+        })
+        .collect();
+    let mut rest = json!({
+        "scenes": [{ "nodes": roots }], "nodes": nodes,
+        "meshes": [{ "primitives": [prim] }],
+        "extensionsUsed": ["KHR_materials_emissive_strength"]
+    });
+    if materials.as_array().is_some_and(|m| !m.is_empty()) {
+        rest["materials"] = materials;
+    }
+    b.json(rest, Some(""))
+}
+
+fn read_doc(doc: &Value) -> Result<Imported, ImportError> {
+    parse(
+        "t.gltf",
+        &serde_json::to_vec(doc).unwrap(),
+        None,
+        &ImportOptions::default(),
+    )
+}
+
+fn grey() -> Value {
+    json!([{ "name": "grey", "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1] } }])
+}
+
+#[test]
+fn node_transforms_compose_parent_first() {
+    // Parent: translate (10, 0, 0). Child: rotate 90 degrees about z, scale 2, translate
+    // (0, 1, 0). The square's corner (1, 0, 0) goes: scale -> (2, 0, 0), rotate -> (0, 2,
+    // 0), child translation -> (0, 3, 0), parent -> (10, 3, 0).
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let nodes = json!([
+        { "name": "parent", "translation": [10, 0, 0], "children": [1] },
+        { "name": "child", "mesh": 0, "translation": [0, 1, 0], "rotation": [0, 0, s, s],
+          "scale": [2, 2, 2] }
+    ]);
+    let got = read_doc(&square_doc(nodes, grey(), None)).unwrap();
+    let s = &got.file.scene.surfaces;
+    assert_eq!(s.len(), 1, "the two triangles join into the square");
+    assert_eq!(s[0].name, "child");
+    let want = [
+        dvec3(10.0, 1.0, 0.0),
+        dvec3(10.0, 3.0, 0.0),
+        dvec3(8.0, 3.0, 0.0),
+        dvec3(8.0, 1.0, 0.0),
+    ];
+    for (a, b) in s[0].vertices.iter().zip(want) {
+        // f32 rotation quaternion (0.70710677): 1e-6 of the coordinates.
+        assert!((*a - b).length() < 1e-5, "{a} vs {b}");
+    }
+    assert_eq!(s[0].reflectance, Rgb([0.5; 3]));
+}
+
+#[test]
+fn a_mirroring_node_keeps_the_front_as_the_author_saw_it() {
+    // A column-major matrix mirroring x. glTF says a negative determinant turns the
+    // winding, so the square still faces +z.
+    let nodes = json!([{ "mesh": 0,
+        "matrix": [-1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1] }]);
+    let got = read_doc(&square_doc(nodes, grey(), None)).unwrap();
+    let v = &got.file.scene.surfaces[0].vertices;
+    let normal = crate::geometry::polygon_normal(v).unwrap();
+    assert!((normal - DVec3::Z).length() < 1e-12, "{normal}");
+    assert!(v.iter().all(|p| p.x <= 0.0));
+    assert_eq!(got.file.scene.surfaces[0].name, "node 0");
+}
+
+#[test]
+fn strips_and_fans_become_triangles_with_a_warning() {
+    for mode in [5, 6] {
+        let nodes = json!([{ "mesh": 0 }]);
+        let got = read_doc(&square_doc(nodes, grey(), Some(mode))).unwrap();
+        let s = &got.file.scene.surfaces;
+        assert_eq!(s.len(), 1, "mode {mode}: {s:?}");
+        assert!((crate::geometry::polygon_area(&s[0].vertices) - 1.0).abs() < 1e-12);
+        let n = crate::geometry::polygon_normal(&s[0].vertices).unwrap();
+        assert!((n - DVec3::Z).length() < 1e-12, "mode {mode}: {n}");
+        assert!(
+            got.warnings
+                .iter()
+                .any(|w| w.message == "1 triangle strip or fan primitive converted to triangles"),
+            "{:?}",
+            got.warnings
+        );
+    }
+}
+
+#[test]
+fn lines_are_left_out_with_a_warning_and_leave_no_surface() {
+    let nodes = json!([{ "mesh": 0 }]);
+    let err = read_doc(&square_doc(nodes, grey(), Some(1))).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "t.gltf: error: no usable faces: the file has 0 faces"
+    );
+}
+
+#[test]
+fn emissive_strength_multiplies_the_emissive_factor() {
+    let materials = json!([{
+        "pbrMetallicRoughness": { "baseColorFactor": [0.2, 0.3, 0.4, 1] },
+        "emissiveFactor": [1.0, 0.5, 0.25],
+        "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4.0 } }
+    }]);
+    let got = read_doc(&square_doc(json!([{ "mesh": 0 }]), materials, None)).unwrap();
+    let s = &got.file.scene.surfaces[0];
+    assert_eq!(s.emission, Rgb([4.0, 2.0, 1.0]));
+    // 0.2 as f32, widened: compare to that.
+    assert_eq!(s.reflectance.0[0], f64::from(0.2f32));
+}
+
+#[test]
+fn white_and_missing_materials_are_taken_below_one_with_a_warning() {
+    let got = read_doc(&square_doc(json!([{ "mesh": 0 }]), json!([]), None)).unwrap();
+    assert_eq!(
+        got.file.scene.surfaces[0].reflectance,
+        Rgb([MAX_REFLECTANCE; 3])
+    );
+    assert!(
+        got.warnings[0].message.contains("default, white"),
+        "{:?}",
+        got.warnings
+    );
+}
+
+#[test]
+fn base_colour_texture_mean_multiplies_the_factor() {
+    // A 2 x 1 PNG: pure red and pure blue, sRGB 255 = linear 1. Mean (0.5, 0, 0.5), times
+    // the factor 0.8: (0.4, 0, 0.4).
+    let mut png = Vec::new();
+    image::RgbImage::from_raw(2, 1, vec![255, 0, 0, 0, 0, 255])
+        .unwrap()
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let mut doc = square_doc(
+        json!([{ "mesh": 0 }]),
+        json!([{ "pbrMetallicRoughness": {
+            "baseColorFactor": [0.8, 0.8, 0.8, 1], "baseColorTexture": { "index": 0 } } }]),
+        None,
+    );
+    doc["images"] = json!([{ "uri": format!("data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&png)) }]);
+    doc["textures"] = json!([{ "source": 0 }]);
+    let got = read_doc(&doc).unwrap();
+    let r = got.file.scene.surfaces[0].reflectance.0;
+    let f = f64::from(0.8f32);
+    assert_eq!(r, [0.5 * f, 0.0, 0.5 * f]);
+    assert!(got.warnings.is_empty(), "{:?}", got.warnings);
+
+    // The same image in a buffer view (as a .glb holds it), with and without its MIME
+    // type (which glTF requires; the format is told from the bytes).
+    let mut b = Builder::default();
+    let pos = b.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]);
+    let view = b.raw_view(&png);
+    for image in [
+        json!({ "bufferView": view, "mimeType": "image/png" }),
+        json!({ "bufferView": view }),
+    ] {
+        let doc = b.json(
+            json!({ "scenes": [{ "nodes": [0] }], "nodes": [{ "mesh": 0 }],
+                    "meshes": [{ "primitives": [{ "attributes": { "POSITION": pos }, "material": 0 }] }],
+                    "materials": [{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }],
+                    "images": [image], "textures": [{ "source": 0 }] }),
+            Some(""),
+        );
+        let got = read_doc(&doc).unwrap();
+        assert_eq!(got.file.scene.surfaces[0].reflectance, Rgb([0.5, 0.0, 0.5]));
+    }
+
+    // An image that is no image: the factor alone, with a warning.
+    doc["images"] = json!([{ "uri": "data:image/png;base64,AAAA" }]);
+    let got = read_doc(&doc).unwrap();
+    assert_eq!(got.file.scene.surfaces[0].reflectance, Rgb([f; 3]));
+    assert!(
+        got.warnings[0].message.contains("texture is left out"),
+        "{:?}",
+        got.warnings
+    );
+    // An image with neither a URI nor a view (the gltf crate would panic on it).
+    doc["images"] = json!([{ "name": "nothing" }]);
+    let got = read_doc(&doc).unwrap();
+    assert!(
+        got.warnings[0].message.contains("neither a uri"),
+        "{:?}",
+        got.warnings
+    );
+}
+
+// ---- Bad and hostile files: an error naming the file and the element, never a panic.
+
+fn error_of(bytes: &[u8]) -> String {
+    parse("bad.gltf", bytes, None, &ImportOptions::default())
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn truncated_glb_header_is_refused() {
+    let (b, rest) = scene_to_gltf(&cornell_scene());
+    let glb = b.glb(rest);
+    let e = error_of(&glb[..10]);
+    assert!(
+        e.starts_with("bad.gltf: error: binary glTF truncated: 10 bytes"),
+        "{e}"
+    );
+    // A length field below the header's own size (the gltf crate underflows on it).
+    let mut short = glb.clone();
+    short[8..12].copy_from_slice(&4u32.to_le_bytes());
+    let e = error_of(&short);
+    assert!(e.contains("header gives the length 4"), "{e}");
+    // Cut in the middle of the binary chunk.
+    let e = error_of(&glb[..glb.len() / 2]);
+    assert!(e.contains("header gives the length"), "{e}");
+}
+
+#[test]
+fn truncated_json_is_refused_with_its_position() {
+    let text = cornell_gltf_text();
+    let e = error_of(&text.as_bytes()[..200]);
+    assert!(
+        e.starts_with("bad.gltf: error: not a valid glTF 2.0 file: "),
+        "{e}"
+    );
+}
+
+#[test]
+fn index_out_of_range_is_refused_naming_the_primitive() {
+    let mut b = Builder::default();
+    let pos = b.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]);
+    let ind = b.indices(&[0, 1, 7]);
+    let doc = b.json(
+        json!({ "scenes": [{ "nodes": [0] }], "nodes": [{ "name": "n", "mesh": 0 }],
+                "meshes": [{ "primitives": [{ "attributes": { "POSITION": pos }, "indices": ind }] }] }),
+        Some(""),
+    );
+    assert_eq!(
+        read_doc(&doc).unwrap_err().to_string(),
+        "t.gltf: error: node 0 (\"n\") primitive 0, index 2: vertex index 7 is out of range \
+         (the file has 3 vertices)"
+    );
+}
+
+#[test]
+fn huge_counts_are_refused_before_allocating() {
+    let mut b = Builder::default();
+    let pos = b.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]);
+    let mut doc = b.json(
+        json!({ "scenes": [{ "nodes": [0] }], "nodes": [{ "mesh": 0 }],
+                "meshes": [{ "primitives": [{ "attributes": { "POSITION": pos } }] }] }),
+        Some(""),
+    );
+    // A count the plan refuses outright (1.3e9 triangles) ...
+    doc["accessors"][0]["count"] = json!(4_000_000_000u64);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(e.contains("would have 1333333333 triangles"), "{e}");
+    // ... and one it allows that the buffer cannot hold (36 bytes for 1.8 million).
+    doc["accessors"][0]["count"] = json!(1_800_000u64);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(
+        e.starts_with("t.gltf: error: accessor 0 (POSITION) says 1800000 items, more than"),
+        "{e}"
+    );
+    // A view past its buffer's end.
+    doc["accessors"][0]["count"] = json!(3);
+    doc["bufferViews"][0]["byteLength"] = json!(1u64 << 40);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(
+        e.contains("buffer view 0 runs from byte 0 for 1099511627776 bytes"),
+        "{e}"
+    );
+    // A buffer shorter than its byteLength.
+    doc["buffers"][0]["byteLength"] = json!(1u64 << 40);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(
+        e.contains("buffer 0 should hold 1099511627776 bytes"),
+        "{e}"
+    );
+}
+
+#[test]
+fn nan_positions_are_refused_naming_the_vertex() {
+    let mut b = Builder::default();
+    let pos = b.positions(&[[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [1.0, 1.0, 0.0]]);
+    let mut doc = b.json(
+        json!({ "scenes": [{ "nodes": [0] }], "nodes": [{ "mesh": 0 }],
+                "meshes": [{ "primitives": [{ "attributes": { "POSITION": pos } }] }] }),
+        Some(""),
+    );
+    // serde_json writes the NaN bound as null; the bounds are not what is tested.
+    doc["accessors"][0]["min"] = json!([0, 0, 0]);
+    doc["accessors"][0]["max"] = json!([1, 1, 0]);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(
+        e.starts_with("t.gltf: error: node 0 primitive 0, POSITION 1 (["),
+        "{e}"
+    );
+    assert!(e.ends_with("is not a finite number"), "{e}");
+}
+
+#[test]
+fn node_cycles_and_shared_children_are_refused() {
+    let cycle = json!([{ "mesh": 0, "children": [1] }, { "mesh": 0, "children": [0] }]);
+    let mut doc = square_doc(cycle, grey(), None);
+    doc["scenes"] = json!([{ "nodes": [0] }]);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    // The gltf crate's validation or the walk: either names the problem.
+    assert!(e.starts_with("t.gltf: error: "), "{e}");
+    assert!(e.contains("node") || e.contains("cycle"), "{e}");
+    // A node reached twice (two parents).
+    let shared = json!([{ "children": [2] }, { "children": [2] }, { "name": "x", "mesh": 0 }]);
+    let mut doc = square_doc(shared, grey(), None);
+    doc["scenes"] = json!([{ "nodes": [0, 1] }]);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(e.contains("node 2 (\"x\") is reached twice"), "{e}");
+    // No scene, every node a child: a cycle with no root.
+    let mut doc = square_doc(
+        json!([{ "mesh": 0, "children": [1] }, { "children": [0] }]),
+        grey(),
+        None,
+    );
+    doc.as_object_mut().unwrap().remove("scenes");
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(e.contains("cycle"), "{e}");
+}
+
+#[test]
+fn bad_base64_and_wrong_types_are_refused() {
+    let mut doc = square_doc(json!([{ "mesh": 0 }]), grey(), None);
+    doc["buffers"][0]["uri"] = json!("data:application/octet-stream;base64,@@@@");
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(
+        e.contains("buffer 0: its data URI is not valid base64"),
+        "{e}"
+    );
+    let mut doc = square_doc(json!([{ "mesh": 0 }]), grey(), None);
+    doc["accessors"][0]["componentType"] = json!(5123);
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(
+        e.contains("POSITION (accessor 0) must be VEC3 of 32-bit floats"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_mesh_placed_by_too_many_nodes_is_refused_before_it_is_read() {
+    // 1000 triangles (no indices: 3000 positions), placed by 2001 nodes: 2,001,000
+    // triangles, over the 2,000,000 allowed, from a 36 kB buffer.
+    let mut b = Builder::default();
+    let p: Vec<[f32; 3]> = (0..3000).map(|k| [k as f32, (k % 3) as f32, 0.0]).collect();
+    let pos = b.positions(&p);
+    let nodes: Vec<Value> = (0..2001).map(|_| json!({ "mesh": 0 })).collect();
+    let doc = b.json(
+        json!({ "scenes": [{ "nodes": (0..2001).collect::<Vec<_>>() }], "nodes": nodes,
+                "meshes": [{ "primitives": [{ "attributes": { "POSITION": pos } }] }] }),
+        Some(""),
+    );
+    assert_eq!(
+        read_doc(&doc).unwrap_err().to_string(),
+        format!(
+            "t.gltf: error: the scene would have 2001000 triangles once every node's mesh is \
+             placed, more than the {MAX_TRIANGLES} this reader takes; split it or simplify it"
+        )
+    );
+}
+
+#[test]
+fn a_position_accessor_the_file_lacks_is_refused_not_a_panic() {
+    // The gltf crate's validation indexes the accessors with it unchecked: the glTF fuzz
+    // target's first crash (corpus/gltf/position_accessor_missing.gltf).
+    let mut doc = square_doc(json!([{ "mesh": 0 }]), grey(), None);
+    doc.as_object_mut().unwrap().remove("accessors");
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "t.gltf: error: mesh 0 primitive 0: POSITION names accessor 0, but the file has 0 \
+         accessors"
+    );
+}
