@@ -317,6 +317,9 @@ impl ViewerApp {
     fn save_scene(&mut self) {
         let path = PathBuf::from(self.save_path.trim());
         let settings = self.options.settings;
+        // Saving over the file opened is what an editor does: released as an input (every
+        // output of the command line is refused over one).
+        radiosity::io::release_input(&path);
         self.status =
             match radiosity::scene::write_scene_file(&self.modeller.scene, settings, &path) {
                 Ok(()) => {

@@ -326,3 +326,42 @@ fn a_scene_far_from_the_origin_is_warned_about() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn an_objs_material_file_is_never_written_over() {
+    // QA found `solve room.obj -o room.mtl`, `--report room.mtl`, `formfactors ... -o
+    // room.mtl` and an OBJ export named after the input's own MTL replacing the MTL that
+    // the OBJ reads (exit 0): every output is now refused over any file read as an input.
+    let dir = scratch_dir("mtl-input");
+    let obj = "mtllib room.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 0 1 0\nv 1 1 0\n\
+               usemtl wall\nf 4 3 2 1\nusemtl light\nf 5 6 2 1\n";
+    let mtl = "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl light\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
+    std::fs::write(dir.join("room.obj"), obj).unwrap();
+    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
+    for args in [
+        vec!["solve", "room.obj", "-o", "room.mtl"],
+        vec!["solve", "room.obj", "-o", "out.csv", "--report", "room.mtl"],
+        vec!["formfactors", "room.obj", "-o", "room.mtl"],
+        vec!["export", "room.obj", "-o", "room.obj"],
+        vec!["export", "room.obj", "-o", "./room.obj"],
+    ] {
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = stderr(&out);
+        // The scene file itself has the command line's own message; every other input
+        // the library's.
+        assert!(
+            err.contains("an output never replaces an input") || err.contains("destroy the input"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(std::fs::read_to_string(dir.join("room.mtl")).unwrap(), mtl, "{args:?}");
+        assert_eq!(std::fs::read_to_string(dir.join("room.obj")).unwrap(), obj, "{args:?}");
+    }
+    // An export named so that its own MTL is the input's (`mat.obj` writes `mat.mtl`).
+    std::fs::write(dir.join("other.obj"), obj.replace("room.mtl", "mat.mtl")).unwrap();
+    std::fs::write(dir.join("mat.mtl"), mtl).unwrap();
+    let out = radiosity(&["export", "other.obj", "-o", "mat.obj"], &dir);
+    assert!(!out.status.success(), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(dir.join("mat.mtl")).unwrap(), mtl);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -338,6 +338,7 @@ fn read_with_memory(
 ) -> Result<FormFactorMatrix, FormFactorFileError> {
     let p = || path.to_path_buf();
     let io_err = |source| FormFactorFileError::Io { path: p(), source };
+    crate::io::note_input(path);
     let file = std::fs::File::open(path).map_err(io_err)?;
     let actual = file.metadata().map_err(io_err)?.len();
     let mut r = io::BufReader::with_capacity(1 << 20, file);

@@ -16,12 +16,14 @@
 //! * [`png`]: rendered images as PNG files.
 //! * [`exr`]: linear images (radiance, no exposure, clamping or gamma) as OpenEXR files.
 //! * [`write_atomically`]: how every writer here replaces a file, so that a reader sees the
-//!   old file or the whole new one, never half of one.
+//!   old file or the whole new one, never half of one; it never replaces a file that a
+//!   reader here has read ([`inputs`]).
 //!
 //! Importers and exporters of other formats (OBJ, glTF, ...) belong here too, one module
 //! each beside [`scene_file`], converting to and from the scene model of [`crate::scene`].
 
 mod atomic_write;
+pub mod inputs;
 pub mod export;
 pub mod exr;
 pub mod form_factor_file;
@@ -33,3 +35,4 @@ pub mod solution;
 pub mod surface_report;
 
 pub use atomic_write::{is_same_file, write_atomically};
+pub use inputs::{input_at, note_input, release_input};

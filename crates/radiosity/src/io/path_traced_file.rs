@@ -284,6 +284,7 @@ pub fn read_path_traced(
     scene: &Scene,
 ) -> Result<SavedView, PathTracedFileError> {
     let file = || path.to_path_buf();
+    crate::io::note_input(path);
     let reader = std::fs::File::open(path)
         .map(io::BufReader::new)
         .map_err(|source| PathTracedFileError::Io {

@@ -89,12 +89,14 @@ pub fn materials_path(dxf: &Path) -> PathBuf {
 /// Reads the DXF file at `path` with its materials file ([`materials_path`]).
 pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportError> {
     let file = path.display().to_string();
+    crate::io::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
         file: file.clone(),
         message: e.to_string(),
     })?;
     let side = materials_path(path);
     let side_name = side.display().to_string();
+    crate::io::note_input(&side);
     let materials = match std::fs::read(&side) {
         Ok(b) => Some(String::from_utf8(b).map_err(|_| ImportError::Syntax {
             file: side_name.clone(),

@@ -61,6 +61,7 @@ pub const MAX_TRIANGLES: usize = 2_000_000;
 /// read relative to the file's folder.
 pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportError> {
     let file = path.display().to_string();
+    crate::io::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
         file: file.clone(),
         message: e.to_string(),
@@ -354,6 +355,7 @@ impl Reader<'_> {
             )));
         };
         let path = dir.join(percent_decode(uri));
+        crate::io::note_input(&path);
         let opened = std::fs::File::open(&path).map_err(|e| ImportError::Io {
             file: path.display().to_string(),
             message: format!("{e} ({what} of {})", self.file),

@@ -62,6 +62,7 @@ pub type MtlLoader<'a> = dyn FnMut(&str) -> Result<(String, String), String> + '
 /// Reads the OBJ file at `path` and the MTL files it names.
 pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportError> {
     let file = path.display().to_string();
+    crate::io::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
         file: file.clone(),
         message: e.to_string(),
@@ -70,6 +71,7 @@ pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportErro
     let folder = path.parent().unwrap_or(Path::new(""));
     let mut loader = |name: &str| {
         let p = folder.join(name);
+        crate::io::note_input(&p);
         std::fs::read(&p)
             .map(|b| {
                 (

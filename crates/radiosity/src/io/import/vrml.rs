@@ -73,6 +73,7 @@ pub const MAX_VISITS: usize = 1_000_000;
 /// Reads the VRML97 file at `path`.
 pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportError> {
     let file = path.display().to_string();
+    crate::io::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
         file: file.clone(),
         message: e.to_string(),

@@ -89,6 +89,7 @@ impl SceneError {
 /// A file that cannot be read, or is not UTF-8, gives a [`SceneError`] naming the file.
 pub fn read_scene(path: &Path) -> Result<SceneFile, SceneError> {
     let name = path.display().to_string();
+    crate::io::note_input(path);
     let bytes = std::fs::read(path)
         .map_err(|e| SceneError::whole_file(&name, format!("cannot read the scene file: {e}")))?;
     let text = String::from_utf8(bytes).map_err(|e| {
