@@ -75,6 +75,8 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // No output of this run may replace a file it read (an OBJ's MTL as much as the scene).
+    radiosity::io::protect_inputs();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {

@@ -4,8 +4,8 @@ use std::io::{self, Write};
 use std::path::Path;
 
 /// Writes `path` by calling `write` on a temporary file beside it, then renaming it into place;
-/// refused (`AlreadyExists`) when `path` is a file this process has read as an input
-/// ([`super::inputs`]).
+/// refused (`AlreadyExists`) when `path` is a file this process has read as an input, once
+/// the process protects its inputs ([`super::inputs`]).
 ///
 /// The temporary file is [`tempfile`]'s, made in the directory of `path` (a rename within
 /// one directory is atomic on POSIX file systems), so `path` either keeps its old content or
@@ -27,21 +27,7 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut io::BufWriter<std::fs::File>) -> io::Result<()>,
 ) -> io::Result<()> {
-    if let Some(input) = super::inputs::input_at(path) {
-        let spelled = if input == path {
-            String::new()
-        } else {
-            format!(" (read as {})", input.display())
-        };
-        return Err(io::Error::new(
-            io::ErrorKind::AlreadyExists,
-            format!(
-                "{} is an input of this run{spelled}: an output never replaces an input; \
-                 give the output another name",
-                path.display(),
-            ),
-        ));
-    }
+    super::inputs::refuse_output(path)?;
     if let Ok(meta) = std::fs::metadata(path) {
         if !meta.is_file() {
             let mut out = io::BufWriter::new(std::fs::OpenOptions::new().write(true).open(path)?);
