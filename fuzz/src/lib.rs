@@ -31,13 +31,14 @@ pub const SOLVE_ELEMENTS: usize = 16;
 /// ... with `INTEGRAL_STEPS` lowered to at most this.
 pub const SOLVE_STEPS: u32 = 3;
 
-
 /// Sets up what every target shares: one rayon thread (fuzzing takes one core; a second
 /// thread would only add noise to coverage).
 fn init() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(1).build_global();
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build_global();
     });
 }
 
@@ -88,7 +89,9 @@ pub fn scene_file(data: &[u8]) {
     if write_scene(&file.scene, file.settings, &mut written).is_ok() {
         let written = String::from_utf8(written).expect("the writer writes UTF-8");
         if let Err(e) = parse_scene(&written, "written.scene") {
-            panic!("a parsed scene, written back, does not parse again: {e}\n--- written:\n{written}");
+            panic!(
+                "a parsed scene, written back, does not parse again: {e}\n--- written:\n{written}"
+            );
         }
     }
 
@@ -114,7 +117,10 @@ pub fn scene_file(data: &[u8]) {
     prepared.method = FormFactorMethod::AreaIntegral {
         steps: settings.integral_steps.min(SOLVE_STEPS),
     };
-    if prepared.check_memory(Some(&Solver::DEFAULT_GAUSS_SEIDEL)).is_err() {
+    if prepared
+        .check_memory(Some(&Solver::DEFAULT_GAUSS_SEIDEL))
+        .is_err()
+    {
         return;
     }
     let request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
@@ -123,7 +129,6 @@ pub fn scene_file(data: &[u8]) {
         let _ = shade::vertex_radiosity(&solution.mesh, b);
     }
 }
-
 
 /// The scene every form-factor input is read against: two facing unit squares, one
 /// element each, and a floor of two (four elements in all), with its fingerprint and method.
@@ -265,8 +270,7 @@ pub fn obj(data: &[u8]) {
         Some(m) => Ok((format!("fuzz/{name}"), m.to_string())),
         None => Err("no material file in this input".to_string()),
     };
-    let imported = match obj::parse(obj_text, "fuzz.obj", &ImportOptions::default(), &mut loader)
-    {
+    let imported = match obj::parse(obj_text, "fuzz.obj", &ImportOptions::default(), &mut loader) {
         Ok(imported) => imported,
         Err(error) => {
             assert!(!error.to_string().is_empty(), "an error without a message");
@@ -277,10 +281,16 @@ pub fn obj(data: &[u8]) {
         assert!(!w.to_string().is_empty());
     }
     let file = imported.file;
-    assert!(!file.scene.surfaces.is_empty(), "an imported scene without surfaces");
+    assert!(
+        !file.scene.surfaces.is_empty(),
+        "an imported scene without surfaces"
+    );
     for s in &file.scene.surfaces {
         if let Err(e) = geometry::validate_polygon(&s.vertices) {
-            panic!("surface {:?} is not a usable polygon: {e}: {:?}", s.name, s.vertices);
+            panic!(
+                "surface {:?} is not a usable polygon: {e}: {:?}",
+                s.name, s.vertices
+            );
         }
         assert!(s.reflectance.0.iter().all(|r| (0.0..1.0).contains(r)));
         assert!(s.emission.0.iter().all(|e| *e >= 0.0 && e.is_finite()));
@@ -313,10 +323,16 @@ fn check_import(
         assert!(!w.to_string().is_empty());
     }
     let file = imported.file;
-    assert!(!file.scene.surfaces.is_empty(), "an imported scene without surfaces");
+    assert!(
+        !file.scene.surfaces.is_empty(),
+        "an imported scene without surfaces"
+    );
     for s in &file.scene.surfaces {
         if let Err(e) = geometry::validate_polygon(&s.vertices) {
-            panic!("surface {:?} is not a usable polygon: {e}: {:?}", s.name, s.vertices);
+            panic!(
+                "surface {:?} is not a usable polygon: {e}: {:?}",
+                s.name, s.vertices
+            );
         }
         assert!(s.reflectance.0.iter().all(|r| (0.0..1.0).contains(r)));
         assert!(s.emission.0.iter().all(|e| *e >= 0.0 && e.is_finite()));
@@ -337,7 +353,12 @@ fn check_import(
 pub fn gltf(data: &[u8]) {
     use radiosity::io::import::{gltf, ImportOptions};
     init();
-    check_import(gltf::parse("fuzz.gltf", data, None, &ImportOptions::default()));
+    check_import(gltf::parse(
+        "fuzz.gltf",
+        data,
+        None,
+        &ImportOptions::default(),
+    ));
 }
 
 /// The VRML97 reader (`io::import::vrml::parse`) on arbitrary bytes, then [`check_import`].

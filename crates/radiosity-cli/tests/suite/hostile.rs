@@ -304,8 +304,14 @@ fn a_scene_far_from_the_origin_is_warned_about() {
         let v = |x: f64, y: f64, z: f64| format!("v {} {} {}\n", x + shift, y, z + shift);
         let mut s = String::new();
         for (x, y, z) in [
-            (0., 0., 0.), (1., 0., 0.), (1., 1., 0.), (0., 1., 0.),
-            (0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.),
+            (0., 0., 0.),
+            (1., 0., 0.),
+            (1., 1., 0.),
+            (0., 1., 0.),
+            (0., 0., 1.),
+            (1., 0., 1.),
+            (1., 1., 1.),
+            (0., 1., 1.),
         ] {
             s += &v(x, y, z);
         }
@@ -354,8 +360,16 @@ fn an_objs_material_file_is_never_written_over() {
             err.contains("an output never replaces an input") || err.contains("destroy the input"),
             "{args:?}: {err}"
         );
-        assert_eq!(std::fs::read_to_string(dir.join("room.mtl")).unwrap(), mtl, "{args:?}");
-        assert_eq!(std::fs::read_to_string(dir.join("room.obj")).unwrap(), obj, "{args:?}");
+        assert_eq!(
+            std::fs::read_to_string(dir.join("room.mtl")).unwrap(),
+            mtl,
+            "{args:?}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("room.obj")).unwrap(),
+            obj,
+            "{args:?}"
+        );
     }
     // An export named so that its own MTL is the input's (`mat.obj` writes `mat.mtl`).
     std::fs::write(dir.join("other.obj"), obj.replace("room.mtl", "mat.mtl")).unwrap();

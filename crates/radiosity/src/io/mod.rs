@@ -23,11 +23,11 @@
 //! each beside [`scene_file`], converting to and from the scene model of [`crate::scene`].
 
 mod atomic_write;
-pub mod inputs;
 pub mod export;
 pub mod exr;
 pub mod form_factor_file;
 pub mod import;
+pub mod inputs;
 pub mod path_traced_file;
 pub mod png;
 pub mod scene_file;
