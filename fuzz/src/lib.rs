@@ -270,39 +270,12 @@ pub fn obj(data: &[u8]) {
         Some(m) => Ok((format!("fuzz/{name}"), m.to_string())),
         None => Err("no material file in this input".to_string()),
     };
-    let imported = match obj::parse(obj_text, "fuzz.obj", &ImportOptions::default(), &mut loader) {
-        Ok(imported) => imported,
-        Err(error) => {
-            assert!(!error.to_string().is_empty(), "an error without a message");
-            return;
-        }
-    };
-    for w in &imported.warnings {
-        assert!(!w.to_string().is_empty());
-    }
-    let file = imported.file;
-    assert!(
-        !file.scene.surfaces.is_empty(),
-        "an imported scene without surfaces"
-    );
-    for s in &file.scene.surfaces {
-        if let Err(e) = geometry::validate_polygon(&s.vertices) {
-            panic!(
-                "surface {:?} is not a usable polygon: {e}: {:?}",
-                s.name, s.vertices
-            );
-        }
-        assert!(s.reflectance.0.iter().all(|r| (0.0..1.0).contains(r)));
-        assert!(s.emission.0.iter().all(|e| *e >= 0.0 && e.is_finite()));
-    }
-    assert!(file.settings.max_patch_area > 0.0 && file.settings.max_patch_area.is_finite());
-    let mut written = Vec::new();
-    if write_scene(&file.scene, file.settings, &mut written).is_ok() {
-        let written = String::from_utf8(written).expect("the writer writes UTF-8");
-        if let Err(e) = parse_scene(&written, "written.scene") {
-            panic!("an imported scene, written, does not parse: {e}\n--- written:\n{written}");
-        }
-    }
+    check_import(obj::parse(
+        obj_text,
+        "fuzz.obj",
+        &ImportOptions::default(),
+        &mut loader,
+    ));
 }
 
 /// What every importer's target checks of a read: an error must format; a scene read must

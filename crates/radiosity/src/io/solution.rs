@@ -93,6 +93,22 @@ fn csv_fields(r: &ElementRecord) -> [String; 9] {
     ]
 }
 
+/// An `InvalidInput` error unless `element_b` has one entry per element of `mesh` (what
+/// the solution and the surface report check before writing anything).
+pub(crate) fn one_per_element(mesh: &Mesh, element_b: &[[f64; 3]]) -> io::Result<()> {
+    if element_b.len() == mesh.len() {
+        return Ok(());
+    }
+    Err(io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!(
+            "{} radiosities for {} elements",
+            element_b.len(),
+            mesh.len()
+        ),
+    ))
+}
+
 /// Writes the solution to `path`: CSV with the header line [`HEADER`] and one row per
 /// element (numbers in Rust's `Display` form, the shortest that reads back exactly, never
 /// with an exponent: 1.5e-7 is written `0.00000015`; lines end in `\n`), or, when the file name ends in `.json` (any case), a JSON array of
@@ -107,16 +123,7 @@ pub fn write_solution(
     mesh: &Mesh,
     element_b: &[[f64; 3]],
 ) -> io::Result<()> {
-    if element_b.len() != mesh.len() {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(
-                "{} radiosities for {} elements",
-                element_b.len(),
-                mesh.len()
-            ),
-        ));
-    }
+    one_per_element(mesh, element_b)?;
     let rows = records(scene, mesh, element_b);
     let json = path
         .extension()

@@ -110,16 +110,7 @@ pub fn write_surface_report(
     mesh: &Mesh,
     element_b: &[[f64; 3]],
 ) -> io::Result<()> {
-    if element_b.len() != mesh.len() {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(
-                "{} radiosities for {} elements",
-                element_b.len(),
-                mesh.len()
-            ),
-        ));
-    }
+    crate::io::solution::one_per_element(mesh, element_b)?;
     let rows = surface_records(scene, mesh, element_b);
     let three = |v: Option<[f64; 3]>| {
         v.map_or([String::new(), String::new(), String::new()], |v| {

@@ -153,7 +153,6 @@ impl Solver<'_> {
                     return Estimate::Nothing;
                 }
                 let g = mean_cos_over_r2(np.polygon(), mp, nq.centre) / std::f64::consts::PI;
-                let g = g * self.cluster_link_factor(np, nq, d, g);
                 (g, self.cluster_oracle(np, nq, d, r))
             }
             (true, false) => {
@@ -164,14 +163,12 @@ impl Solver<'_> {
                 }
                 let g =
                     nq.area * mean_cos_over_r2(nq.polygon(), mq, np.centre) / std::f64::consts::PI;
-                let g = g * self.cluster_link_factor(np, nq, d, g);
                 (g, self.cluster_oracle(np, nq, d, r))
             }
-            (true, true) => {
-                let g = 1.0 / (std::f64::consts::PI * r * r);
-                let g = g * self.cluster_link_factor(np, nq, d, g);
-                (g, self.cluster_oracle(np, nq, d, r))
-            }
+            (true, true) => (
+                1.0 / (std::f64::consts::PI * r * r),
+                self.cluster_oracle(np, nq, d, r),
+            ),
         };
         if g <= 0.0 && oracle <= 0.0 {
             return Estimate::Nothing;
@@ -192,6 +189,15 @@ impl Solver<'_> {
             // were dropped). The children's links decide, with their own rays.
             return Estimate::Refine;
         }
+        // A cluster link that is kept: its coupling weighed by where the clusters' members
+        // are (the `cluster_geometry` module; the oracle does not use it, so it is not
+        // computed for the pairs refined above). The factor is positive: the tests above
+        // decide as they would with it.
+        let g = if cluster_link {
+            g * self.cluster_link_factor(np, nq, d, g)
+        } else {
+            g
+        };
         let (fraction, rays, facing) = self.visibility(p, q, scratch);
         if fraction == 0.0 && facing >= 8 && !cluster_link {
             return Estimate::Nothing;
