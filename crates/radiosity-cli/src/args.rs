@@ -127,10 +127,16 @@ pub struct SolveOptions {
     #[arg(long, value_name = "AREA")]
     pub min_area: Option<f64>,
     /// Hierarchical: leave out the final gather (each leaf then takes its ancestors'
-    /// irradiance pushed down, as before the gather was added). It is left out anyway
-    /// above 250,000 elements, where it costs several times the solve.
+    /// irradiance pushed down, as before the gather was added): faster, and visibly
+    /// wrong where coarse links meet (bright concave corners, darker walls between).
     #[arg(long)]
     pub no_final_gather: bool,
+    /// Hierarchical: the most points the final gather gathers at; above it, the gather
+    /// runs at coarser patches and the leaves under each take its light plus what finer
+    /// links bring. Its time is about proportional to this (the million-element building:
+    /// about a minute of CPU at the default).
+    #[arg(long, value_name = "N", default_value_t = radiosity::solve::GATHER_POINTS_DEFAULT)]
+    pub gather_points: usize,
     /// Dense solvers: rounds of adaptive subdivision after the first solve (each splits
     /// the elements whose luminance steps against a neighbour's, then solves again; 2 is a
     /// good start for furnished rooms); 0, the default, solves the mesh once. Not with

@@ -344,6 +344,11 @@ fn solver(
             if !(min_area > 0.0 && min_area.is_finite()) {
                 bail!("--min-area must be a positive number, got {min_area}");
             }
+            if options.gather_points == 0 {
+                bail!(
+                    "--gather-points must be at least 1 (--no-final-gather leaves the gather out)"
+                );
+            }
             let tolerance = options
                 .tolerance
                 .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
@@ -355,11 +360,8 @@ fn solver(
                 min_area,
                 tolerance,
                 max_memory_bytes: None,
-                // The gather costs more than the hierarchy itself on large meshes (the
-                // million-element building: past 5.8 min of CPU against 82 s without it),
-                // so it is on by default up to FINAL_GATHER_MAX_ELEMENTS only.
-                final_gather: !options.no_final_gather
-                    && n <= radiosity::solve::FINAL_GATHER_MAX_ELEMENTS,
+                final_gather: !options.no_final_gather,
+                gather_points: options.gather_points,
             })
         }
     })

@@ -474,6 +474,7 @@ mod tests {
             tolerance: 1e-6,
             max_memory_bytes: None,
             final_gather: true,
+            gather_points: radiosity::solve::GATHER_POINTS_DEFAULT,
         };
         let scene = cornell_box().scene;
         let (edits, updates, _) = spawn(

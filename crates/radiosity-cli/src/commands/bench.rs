@@ -117,6 +117,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         epsilon: args.epsilon,
         min_area: args.min_area,
         no_final_gather: false,
+        gather_points: radiosity::solve::GATHER_POINTS_DEFAULT,
         adapt_rounds: None,
         adapt_contrast: radiosity::mesh::DEFAULT_CONTRAST,
         adapt_max_elements: None,

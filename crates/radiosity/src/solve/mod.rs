@@ -37,7 +37,7 @@ pub use energy::{energy_balance, escaped_by_surface, EnergyBalance};
 pub use error::SolveError;
 pub use hierarchical::{
     solve_hierarchical, HierarchicalReport, HierarchicalSettings, HierarchicalSolution,
-    DEFAULT_HIERARCHICAL_TOLERANCE,
+    DEFAULT_HIERARCHICAL_TOLERANCE, GATHER_POINTS_DEFAULT,
 };
 pub use progressive::{
     solve_progressive, ProgressiveReport, ProgressiveState, DEFAULT_PROGRESSIVE_TOLERANCE,
@@ -46,7 +46,7 @@ pub use radiosity::{keep_going, Observer, Radiosity, SolveReport, Step};
 pub use residual::relative_residual;
 pub use solver::{
     choose, AutoChoice, AutoReason, DenseSolver, GaussSeidelSettings, ProgressiveSettings, Solver,
-    SolverKind, UnknownSolver, AUTO_DENSE_MAX_ELEMENTS, FINAL_GATHER_MAX_ELEMENTS,
+    SolverKind, UnknownSolver, AUTO_DENSE_MAX_ELEMENTS,
 };
 
 use std::time::Instant;

@@ -52,13 +52,6 @@ impl Default for ProgressiveSettings {
     }
 }
 
-/// The most elements for which the command line turns hierarchical radiosity's final
-/// gather on by default: on the million-element building the gather ran past 5.8 min of
-/// CPU where the hierarchy alone takes about a minute, the target there; the
-/// Cornell box at 193,000 elements takes 9 s with it and comes within 2.5 % pixel RMS of
-/// the path tracer (10 % without).
-pub const FINAL_GATHER_MAX_ELEMENTS: usize = 250_000;
-
 impl HierarchicalSettings {
     /// The default refinement threshold epsilon: fast, and with the final gather about
     /// 1.6 % RMS element by element on the Cornell box at 2,046 elements (8.9 % without it;
@@ -68,7 +61,7 @@ impl HierarchicalSettings {
     /// The defaults for a scene meshed at `max_patch_area`: epsilon
     /// [`HierarchicalSettings::DEFAULT_EPSILON`], minimum area `max_patch_area / 16`,
     /// tolerance [`super::DEFAULT_HIERARCHICAL_TOLERANCE`], memory limit 80 % of what is
-    /// available, the final gather on.
+    /// available, the final gather on at up to [`super::GATHER_POINTS_DEFAULT`] points.
     pub fn defaults_for(max_patch_area: f64) -> HierarchicalSettings {
         HierarchicalSettings {
             epsilon: HierarchicalSettings::DEFAULT_EPSILON,
@@ -76,6 +69,7 @@ impl HierarchicalSettings {
             tolerance: super::DEFAULT_HIERARCHICAL_TOLERANCE,
             max_memory_bytes: None,
             final_gather: true,
+            gather_points: super::GATHER_POINTS_DEFAULT,
         }
     }
 }

@@ -132,6 +132,7 @@ fn two_meshes_and_two_solvers_of_one_scene_differ_by_their_discretisation() {
             tolerance: 1e-6,
             max_memory_bytes: None,
             final_gather: true,
+            gather_points: radiosity::solve::GATHER_POINTS_DEFAULT,
         })),
         &mut keep_going,
         &NoProgress,

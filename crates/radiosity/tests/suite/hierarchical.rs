@@ -36,6 +36,7 @@ fn settings(epsilon: f64, min_area: f64, final_gather: bool) -> HierarchicalSett
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: None,
         final_gather,
+        gather_points: radiosity::solve::GATHER_POINTS_DEFAULT,
     }
 }
 
@@ -268,6 +269,62 @@ fn closed_room_of_coplanar_wall_pieces_is_a_furnace_at_the_defaults() {
 }
 
 #[test]
+fn a_final_gather_at_coarse_points_keeps_the_furnace() {
+    // The furnace of the test above (B = E / (1 - rho) = 2 everywhere, nothing escapes)
+    // with the final gather held to a quarter as many points as leaves: it then gathers at
+    // patches of several leaves, and each leaf adds what the links below its point bring.
+    // A link counted twice or left out between the point and the leaf would show at once
+    // in the account by its share of the light. Measured: escaped -0.63 % (counted
+    // twice; at every leaf +0.06 %): a coarse point's form factors to middle-distance
+    // sources are means over four points of a patch up to four leaves across, accurate to
+    // O((R / r)^2) (`patch_form_factor`), so the account is held to 1 % here, twice the
+    // issue's 0.5 % for the defaults (which gather at every leaf below 250,000 of them);
+    // 10 % per surface as above.
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../bench/scenes/room_split_walls.scene"
+    );
+    let mut file = radiosity::scene::read_scene(std::path::Path::new(path)).unwrap();
+    for s in &mut file.scene.surfaces {
+        s.emission = Light([1.0; 3]);
+        s.reflectance = Light([0.5; 3]);
+    }
+    let max_area = file.settings.max_patch_area;
+    let defaults = HierarchicalSettings::defaults_for(max_area);
+    let every_leaf = solve_with(&file.scene, max_area, &defaults);
+    assert_eq!(every_leaf.report.gather_points, every_leaf.report.leaves);
+    let quarter = every_leaf.report.leaves / 4;
+    let s = solve_with(
+        &file.scene,
+        max_area,
+        &HierarchicalSettings {
+            gather_points: quarter,
+            ..defaults
+        },
+    );
+    assert!(
+        s.report.gather_points <= quarter && s.report.gather_points > 0,
+        "{} points for {} leaves, at most {quarter} asked",
+        s.report.gather_points,
+        s.report.leaves
+    );
+    let b = s.report.balance;
+    for k in 0..3 {
+        let escaped = b.escaped[k] / b.emitted[k];
+        assert!(escaped.abs() < 0.01, "escaped {escaped:e} of the emitted");
+    }
+    for (i, mean) in per_surface(&s.mesh, &s.radiosity).iter().enumerate() {
+        let error = mean[0] / 2.0 - 1.0;
+        assert!(
+            error.abs() < 0.10,
+            "{}: mean B {} against 2 ({error:+.3})",
+            file.scene.surfaces[i].name,
+            mean[0]
+        );
+    }
+}
+
+#[test]
 fn cornell_box_agrees_with_the_dense_solve() {
     const EPS: f64 = 0.01;
     let (scene, max_area) = cornell();
@@ -407,6 +464,7 @@ fn refuses_bad_settings() {
             tolerance,
             max_memory_bytes: None,
             final_gather: true,
+            gather_points: radiosity::solve::GATHER_POINTS_DEFAULT,
         };
         assert!(solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).is_err());
     }
@@ -424,6 +482,7 @@ fn refuses_to_outgrow_its_memory_limit() {
         tolerance: DEFAULT_HIERARCHICAL_TOLERANCE,
         max_memory_bytes: Some(4 << 20),
         final_gather: true,
+        gather_points: radiosity::solve::GATHER_POINTS_DEFAULT,
     };
     let err = solve_hierarchical(&scene, max_area, &bvh, &settings, &NoProgress).unwrap_err();
     let text = err.to_string();

@@ -27,6 +27,16 @@
 //! passes left at 1.3 % and the iteration at 0.33 %. Where the terms do not fit in the
 //! memory left, two passes are made, recomputing the terms. The energy account is taken
 //! from the gathered H.
+//!
+//! Where the leaves are more than [`super::HierarchicalSettings::gather_points`], the
+//! gather runs at coarser points: the largest patches of area at most A_g, the smallest A_g
+//! that keeps them within the budget (leaves along contacts stay points of their own, as
+//! their visibility is their own). A leaf's irradiance is then its point's gathered one
+//! plus what the links held between the point and the leaf bring, pushed down as a sweep
+//! does. Measured on building_small (7,922 leaves) against the path tracer: at every leaf
+//! 4.94 % pixel RMS, at 5,849 points 5.68 %, at 3,569 points 6.76 %, without the gather
+//! 11.67 %; on the million-element building at 236,916 points 7.35 % against 11.09 %
+//! without (BENCHMARKS.md).
 
 use std::collections::HashMap;
 
@@ -250,6 +260,8 @@ impl Solver<'_> {
     pub(super) fn final_gather(&mut self) -> HashMap<u32, [f64; 3]> {
         self.split_leaves_to_cells();
         let (parent, leaves) = self.parents_and_leaves();
+        let points = self.gather_points(&leaves, self.settings.gather_points);
+        self.gathered_at = points.len();
         let from_clusters = self.irradiance_from_clusters();
         let emitted: [f64; 3] = std::array::from_fn(|k| {
             leaves
@@ -264,7 +276,7 @@ impl Solver<'_> {
         let budget = self.memory_limit.saturating_sub(self.memory_bytes());
         let mut kept: Vec<LeafTerms> = Vec::new();
         let mut bytes = 0u64;
-        for chunk in leaves.chunks(TERM_CHUNK) {
+        for chunk in points.chunks(TERM_CHUNK) {
             let terms = self.leaf_terms(chunk, &parent);
             bytes += terms.iter().map(LeafTerms::bytes).sum::<u64>();
             kept.extend(terms);
@@ -273,7 +285,7 @@ impl Solver<'_> {
                 break;
             }
         }
-        let cached = kept.len() == leaves.len();
+        let cached = kept.len() == points.len();
         let passes = if cached {
             MAX_GATHER_PASSES
         } else {
@@ -291,15 +303,20 @@ impl Solver<'_> {
                 }
                 from_clusters = self.irradiance_from_clusters();
             }
-            h = if cached {
+            let at_points = if cached {
                 self.evaluate(&kept, &from_clusters)
             } else {
-                let mut all = Vec::with_capacity(leaves.len());
-                for chunk in leaves.chunks(TERM_CHUNK) {
+                let mut all = Vec::with_capacity(points.len());
+                for chunk in points.chunks(TERM_CHUNK) {
                     let terms = self.leaf_terms(chunk, &parent);
                     all.extend(self.evaluate(&terms, &from_clusters));
                 }
                 all
+            };
+            h = if points.len() == leaves.len() {
+                at_points
+            } else {
+                self.push_below_points(&points, &at_points, leaves.len())
             };
             let mut change = [0.0; 3];
             for (&l, hl) in leaves.iter().zip(&h) {
@@ -343,6 +360,148 @@ impl Solver<'_> {
                 std::array::from_fn(|k| self.emission[s][k] + self.rho[s][k] * hl[k]);
             h_of.insert(l, hl);
         }
+    }
+
+    /// The patches the final gather gathers at: every leaf where there are at most `max`;
+    /// else, in each quadtree, the largest patches of area at most some A_g (the smallest
+    /// that keeps their count at most `max`, found by bisection on A_g), except that a
+    /// patch with a leaf along a contact under it is not taken whole (such leaves gather
+    /// with visibility of their own, as without the coarse points). In the order of
+    /// `leaves`: the leaves under each point follow one another.
+    fn gather_points(&self, leaves: &[u32], max: usize) -> Vec<u32> {
+        let open = leaves
+            .iter()
+            .filter(|&&l| !self.nodes[l as usize].straddles)
+            .count();
+        if open <= max {
+            return leaves.to_vec();
+        }
+        // Whether a straddling leaf lies under each node (patches only).
+        let mut straddling = vec![false; self.nodes.len()];
+        fn mark(s: &Solver, n: u32, out: &mut [bool]) -> bool {
+            let node = &s.nodes[n as usize];
+            let mut any = node.child_count == 0 && node.straddles && !node.buried;
+            for &c in node.children() {
+                any |= mark(s, c, out);
+            }
+            out[n as usize] = any;
+            any
+        }
+        for r in 0..self.root_count as u32 {
+            mark(self, r, &mut straddling);
+        }
+        let pick = |area_max: f64, out: &mut Vec<u32>| {
+            let mut stack: Vec<u32> = (0..self.root_count as u32).rev().collect();
+            while let Some(n) = stack.pop() {
+                let node = &self.nodes[n as usize];
+                if node.buried {
+                    continue;
+                }
+                if node.child_count == 0 || (node.area <= area_max && !straddling[n as usize]) {
+                    out.push(n);
+                } else {
+                    stack.extend(node.children().iter().rev());
+                }
+            }
+        };
+        let mut hi = 0.0f64;
+        for r in 0..self.root_count {
+            hi = hi.max(self.nodes[r].area);
+        }
+        let mut out = Vec::new();
+        // Bisection on log area: forty halvings of the ratio reach far below any leaf.
+        let mut lo_log = (leaves
+            .iter()
+            .map(|&l| self.nodes[l as usize].area)
+            .fold(f64::INFINITY, f64::min))
+        .max(f64::MIN_POSITIVE)
+        .ln();
+        let mut hi_log = hi.max(f64::MIN_POSITIVE).ln();
+        // The coarsest choice (every quadtree whole where it can be) is the fallback.
+        let mut best = hi;
+        for _ in 0..40 {
+            let mid = 0.5 * (lo_log + hi_log);
+            out.clear();
+            pick(mid.exp(), &mut out);
+            let open = out
+                .iter()
+                .filter(|&&n| !self.nodes[n as usize].straddles)
+                .count();
+            if open > max {
+                lo_log = mid;
+            } else {
+                hi_log = mid;
+                best = mid.exp();
+            }
+        }
+        out.clear();
+        pick(best, &mut out);
+        out
+    }
+
+    /// Each leaf's irradiance from the irradiance gathered at the points above it: the
+    /// point's, plus what the links of the patches between the point and the leaf bring,
+    /// pushed down as a sweep does (spread over each patch's open area). `count` leaves,
+    /// in the order `gather_points` gave.
+    fn push_below_points(
+        &self,
+        points: &[u32],
+        at_points: &[[f64; 3]],
+        count: usize,
+    ) -> Vec<[f64; 3]> {
+        let per_point: Vec<Vec<[f64; 3]>> = points
+            .par_iter()
+            .zip(at_points)
+            .map(|(&g, &h_g)| {
+                let mut out = Vec::new();
+                let mut stack = vec![(g, h_g)];
+                while let Some((n, h)) = stack.pop() {
+                    let node = &self.nodes[n as usize];
+                    if node.buried {
+                        continue;
+                    }
+                    if node.child_count == 0 {
+                        out.push(h);
+                        continue;
+                    }
+                    for &c in node.children().iter().rev() {
+                        let child = &self.nodes[c as usize];
+                        let links = self.links_irradiance(child);
+                        let open = if child.open_area > 0.0 && child.open_area < child.area {
+                            child.area / child.open_area
+                        } else {
+                            1.0
+                        };
+                        stack.push((c, std::array::from_fn(|k| h[k] + links[k] * open)));
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut h = Vec::with_capacity(count);
+        for v in per_point {
+            h.extend(v);
+        }
+        h
+    }
+
+    /// The irradiance node `n`'s own links bring from the radiosity and bins the nodes
+    /// hold now (what a sweep gathers at `n`).
+    fn links_irradiance(&self, n: &super::tree::Node) -> [f64; 3] {
+        let mut g = [0.0; 3];
+        for l in &n.links {
+            let c = self.cluster_of[l.source as usize];
+            let x = if c != NONE {
+                let d = DVec3::new(l.dir[0] as f64, l.dir[1] as f64, l.dir[2] as f64);
+                cluster_emission(&self.clusters[c as usize].power, d)
+            } else {
+                self.b[l.source as usize]
+            };
+            for k in 0..3 {
+                g[k] += l.g as f64 * x[k];
+            }
+        }
+        g
     }
 
     /// The gather terms of `leaves`, in parallel; their rays are counted in the report.

@@ -43,6 +43,8 @@ pub(super) struct Solver<'a> {
     pub(super) memory_limit: u64,
     /// The most [`Solver::memory_bytes`] plus a refinement frontier reached.
     pub(super) peak_memory: u64,
+    /// Points the final gather gathered at (0 before it or without it).
+    pub(super) gathered_at: usize,
 }
 
 /// Bytes each pair of a refinement frontier takes while it is estimated: the pair in the
