@@ -46,8 +46,8 @@ pub struct BuildingArgs {
     /// Seed of door positions, window widths, furniture placement and colours.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// The scene's MAX_PATCH_AREA (m^2): 1 gives about 40,000 elements for the default
-    /// building, 0.0125 about a million.
+    /// The scene's MAX_PATCH_AREA (m^2): 1 gives about 33,000 elements for the default
+    /// building, 0.0125 about 990,000 (the count is printed when the file is written).
     #[arg(long, default_value_t = 1.0, value_name = "AREA")]
     pub max_area: f64,
     /// The scene's INTEGRAL_STEPS.
@@ -115,7 +115,9 @@ pub struct SolveOptions {
     pub solver: SolverArg,
     /// Where the solver stops. Gauss-Seidel: the relative residual (default 1e-9).
     /// Progressive: the unshot power as a fraction of the emitted power, in every band (the
-    /// convergence value of Cohen et al. 1988; default 0.01 = 1 %).
+    /// convergence value of Cohen et al. 1988; default 0.01 = 1 %). Hierarchical: the power
+    /// still changing in a sweep as a fraction of the emitted power (default 1e-6). LU
+    /// solves directly and takes none.
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
     /// Hierarchical: the BF refinement threshold, relative to the mean radiosity (smaller is
@@ -146,7 +148,9 @@ pub struct SolveOptions {
     /// the first matrix's, or 4 million; given, only this limit holds).
     #[arg(long, value_name = "N")]
     pub adapt_max_elements: Option<usize>,
-    /// Progressive: give up after this many shots.
+    /// Progressive: stop after this many shots even if the unshot power is still above
+    /// --tolerance; the output then holds the light shot so far, and a note says how far it
+    /// got.
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     pub max_shots: usize,
     /// Read form factors from this file (written by `radiosity formfactors`) instead of
@@ -464,7 +468,7 @@ pub struct BenchArgs {
     #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
     pub solver: SolverArg,
     /// Where the solver stops (as for `render --tolerance`: 1e-9 residual for Gauss-Seidel,
-    /// 0.01 unshot for progressive).
+    /// 0.01 unshot for progressive, 1e-6 changing power for hierarchical).
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
     /// Image width and height in pixels.
@@ -479,6 +483,9 @@ pub struct BenchArgs {
     /// Hierarchical: the minimum node area (as for `render --min-area`).
     #[arg(long, value_name = "AREA")]
     pub min_area: Option<f64>,
+    /// Only the table: no note on what was timed (errors and warnings are still printed).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// Options of `radiosity view`.
@@ -508,10 +515,11 @@ pub struct ViewArgs {
     /// progressive refinement shows light sooner.
     #[arg(long)]
     pub dense: bool,
-    /// The solver: auto (the two options above decide), dense or gauss-seidel (Gauss-Seidel
-    /// on the cached matrix when it fits), lu, progressive, hierarchical (hierarchical
-    /// radiosity with clustering, --epsilon, --min-area; the window shows its leaves and an
-    /// edit re-runs it).
+    /// The solver: auto (the dense matrix up to 6,000 elements, or 20,000 with --dense,
+    /// progressive refinement beyond; --progressive always progressive), dense or
+    /// gauss-seidel (Gauss-Seidel on the cached matrix whenever it fits, else progressive),
+    /// lu (likewise, LU), progressive, hierarchical (hierarchical radiosity with clustering,
+    /// --epsilon, --min-area; the window shows its leaves and an edit re-runs it).
     #[arg(
         long,
         value_name = "SOLVER",
