@@ -450,9 +450,28 @@ fn where_escaped(scene: &radiosity::scene::Scene, by_surface: &[[f64; 3]], emitt
     }
 }
 
-/// Prints the accuracy table of `form_factor::accuracy` as Markdown.
-pub fn method_accuracy(max_area: f64) {
+/// Prints the accuracy table of `form_factor::accuracy` as Markdown, once every method is
+/// measured; meanwhile a line per method on stderr (unless `quiet`), as the whole takes
+/// about 20 s.
+pub fn method_accuracy(max_area: f64, quiet: bool) {
     use radiosity::form_factor::accuracy::{measure, standard_methods};
+    let methods = standard_methods();
+    let start = std::time::Instant::now();
+    let rows: Vec<_> = methods
+        .iter()
+        .enumerate()
+        .map(|(i, &method)| {
+            if !quiet {
+                errln!(
+                    "measuring {} of {}: {method} (after {:.0} s)",
+                    i + 1,
+                    methods.len(),
+                    start.elapsed().as_secs_f64()
+                );
+            }
+            measure(method, max_area)
+        })
+        .collect();
     outln!(
         "Elements of at most {max_area} (unit squares in {} elements); relative errors.",
         (1.0 / max_area).round()
@@ -462,8 +481,7 @@ pub fn method_accuracy(max_area: f64) {
         "| method | opposed squares | perpendicular squares | coaxial discs | element to rectangle | mean | closed box max abs(row sum - 1) | reciprocity | time (ms) | mean error x time |"
     );
     outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for method in standard_methods() {
-        let r = measure(method, max_area);
+    for r in rows {
         outln!(
             "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.1} | {:.2e} |",
             r.method,

@@ -233,3 +233,34 @@ fn check_explains_the_hemicube_rays_and_sampled_reciprocity() {
     assert!(!crate::fixtures::stdout(&out).contains("(expected:"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn compare_methods_refuses_a_scene_and_reports_progress() {
+    let dir = scratch_dir("compare-methods");
+    for (args, needle) in [
+        (
+            vec!["check", "room.scene", "--compare-methods"],
+            "not on a scene: drop room.scene",
+        ),
+        (
+            vec!["check", "--compare-methods", "--method", "hemicube"],
+            "drop --method and --steps",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    // One element per unit square: the cheapest table (the fixed-resolution hemicubes
+    // still take about a second), with a line per method on stderr.
+    let out = radiosity(&["check", "--compare-methods", "--max-area", "1"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let n = crate::fixtures::stdout(&out)
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| method"))
+        .count();
+    assert!(n >= 2, "{}", crate::fixtures::stdout(&out));
+    assert!(err.contains(&format!("measuring {n} of {n}: ")), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
