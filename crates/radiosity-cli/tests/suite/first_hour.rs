@@ -264,3 +264,24 @@ fn compare_methods_refuses_a_scene_and_reports_progress() {
     assert!(err.contains(&format!("measuring {n} of {n}: ")), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn compare_reports_the_dense_matrix_size_not_a_leftover_peak() {
+    let dir = scratch_dir("compare-matrix");
+    let out = radiosity(
+        &["compare", "--max-area", "20000", "--solver", "progressive", "-q"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = crate::fixtures::stdout(&out);
+    assert!(text.contains("| dense matrix (MiB) |"), "{text}");
+    let row = text.lines().find(|l| l.starts_with("| cornell |")).unwrap();
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    // | scene | elements | ... | dense time | dense matrix | ...: the f32 matrix of the
+    // elements' count, 4 n^2 bytes, whichever solver ran first.
+    let n: f64 = cells[2].parse().unwrap();
+    let mib: f64 = cells[9].parse().unwrap();
+    let expected = 4.0 * n * n / (1024.0 * 1024.0);
+    assert!((mib - expected).abs() <= 0.005, "{row}: expected {expected}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
