@@ -73,7 +73,7 @@ pub struct SceneArgs {
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,
     /// Override the scene's INTEGRAL_STEPS (points along each axis of each element, for
-    /// the area method).
+    /// the area, contour and analytic methods).
     #[arg(long, value_name = "K")]
     pub steps: Option<u32>,
     #[command(flatten)]
@@ -288,7 +288,8 @@ pub struct RenderArgs {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub solve: SolveOptions,
-    /// Output PNG (default: cornell.png for the built-in box, else the scene's name).
+    /// Output image: .png, or .exr for linear radiance (default: cornell.png for the
+    /// built-in box, else the scene's name with .png).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Shading.
@@ -548,7 +549,9 @@ pub struct ViewArgs {
     /// The shading the window starts with: smooth, flat or wireframe.
     #[arg(long, default_value = "smooth", value_name = "MODE", value_parser = parse_shading)]
     pub shading: Shading,
-    /// Select the first surface whose name starts with this (as a click on it would).
+    /// Select a surface (as a click on it would): the one named so, else the first whose
+    /// name starts with this that can be seen (not a face pressed against another, like the
+    /// base of furniture standing on the floor).
     #[arg(long, value_name = "NAME")]
     pub select: Option<String>,
     /// No window: measure frame time offscreen (Cornell box and a tiled scene of

@@ -47,12 +47,35 @@ fn rays_text(method: FormFactorMethod, stats: &FormFactorStats) -> String {
             stats.seconds
         );
     }
-    format!(
+    let mut text = format!(
         "{} visibility rays in {:.3} s ({:.1} M rays/s)",
         stats.rays,
         stats.seconds,
         stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
-    )
+    );
+    if let Some(per_ray) = candidates_per_ray(stats) {
+        text.push_str(&format!(
+            "; each ray is tested against the occluders whose boxes meet its pair's box, \
+             {per_ray:.1} on average{}",
+            if per_ray > MANY_CANDIDATES {
+                " (many: a cluttered scene's rays are that much slower)"
+            } else {
+                ""
+            }
+        ));
+    }
+    text
+}
+
+/// Above this many occluder candidates per ray the rays/s figure is said to be low because
+/// of them: the Cornell box's rays meet about 2 (its two blocks), the furnished rooms'
+/// tens.
+const MANY_CANDIDATES: f64 = 10.0;
+
+/// The mean number of occluder candidates listed per ray, where the method lists them.
+fn candidates_per_ray(stats: &FormFactorStats) -> Option<f64> {
+    (stats.rays > 0 && stats.candidates > 0)
+        .then(|| stats.candidates as f64 / stats.rays as f64)
 }
 
 /// The reciprocity error, and for the methods that estimate F_ij and F_ji apart, why it is
@@ -318,9 +341,13 @@ pub fn check(
             );
         } else if stats.rays > 0 {
             outln!(
-                "visibility rays   {} ({:.1} M rays/s)",
+                "visibility rays   {} ({:.1} M rays/s){}",
                 stats.rays,
-                stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+                stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
+                candidates_per_ray(stats).map_or(String::new(), |c| format!(
+                    "; {c:.1} occluder candidates tested per ray on average (the rate falls as \
+                     they grow)"
+                ))
             );
         }
     }

@@ -45,6 +45,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
                 let f = prepared.load_form_factors(path, &reporter)?;
                 let stats = radiosity::pipeline::FormFactorStats {
                     rays: 0,
+                    candidates: 0,
                     seconds: 0.0,
                     row_sums: f.row_sums(),
                     reciprocity: f.reciprocity(&prepared.areas()),

@@ -369,18 +369,30 @@ pub fn occluder_bvh(scene: &Scene) -> PolygonBvh {
     PolygonBvh::over_surfaces(scene)
 }
 
-/// Counts the rays cast, for rays-per-second figures.
+/// Counts the rays cast, for rays-per-second figures, and the occluder candidates they
+/// were tested against (where a method tests each ray against a list of candidates).
 #[derive(Debug, Default)]
-pub struct RayCounter(AtomicU64);
+pub struct RayCounter(AtomicU64, AtomicU64);
 
 impl RayCounter {
     /// Adds `n` rays.
     pub fn add(&self, n: u64) {
         self.0.fetch_add(n, Ordering::Relaxed);
     }
+    /// Adds `n` rays each tested against a list of `candidates` occluders.
+    pub fn add_tested(&self, n: u64, candidates: u64) {
+        self.0.fetch_add(n, Ordering::Relaxed);
+        self.1.fetch_add(n * candidates, Ordering::Relaxed);
+    }
     /// The rays counted so far.
     pub fn get(&self) -> u64 {
         self.0.load(Ordering::Relaxed)
+    }
+    /// Occluder candidates listed for the rays counted by [`RayCounter::add_tested`]: each
+    /// such ray is tested against its list until one blocks it, so this is the most
+    /// ray-polygon tests they made (the ray rate falls as it grows).
+    pub fn candidates(&self) -> u64 {
+        self.1.load(Ordering::Relaxed)
     }
 }
 
