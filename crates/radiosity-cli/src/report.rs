@@ -68,8 +68,8 @@ fn rays_text(method: FormFactorMethod, stats: &FormFactorStats) -> String {
 }
 
 /// Above this many occluder candidates per ray the rays/s figure is said to be low because
-/// of them: the Cornell box's rays meet about 2 (its two blocks), the furnished rooms'
-/// tens.
+/// of them: measured, the Cornell box's rays meet 4.4 on average, building_small's 47.1
+/// (its pairs across a room list the furniture between).
 const MANY_CANDIDATES: f64 = 10.0;
 
 /// The mean number of occluder candidates listed per ray, where the method lists them.
