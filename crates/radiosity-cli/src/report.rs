@@ -74,8 +74,7 @@ const MANY_CANDIDATES: f64 = 10.0;
 
 /// The mean number of occluder candidates listed per ray, where the method lists them.
 fn candidates_per_ray(stats: &FormFactorStats) -> Option<f64> {
-    (stats.rays > 0 && stats.candidates > 0)
-        .then(|| stats.candidates as f64 / stats.rays as f64)
+    (stats.rays > 0 && stats.candidates > 0).then(|| stats.candidates as f64 / stats.rays as f64)
 }
 
 /// The reciprocity error, and for the methods that estimate F_ij and F_ji apart, why it is

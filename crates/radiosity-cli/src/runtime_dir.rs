@@ -81,7 +81,8 @@ mod tests {
     #[test]
     fn private_runtime_dir_is_made_once_with_mode_0700() {
         use std::os::unix::fs::PermissionsExt;
-        let parent = std::env::temp_dir().join(format!("radiosity-xdg-test-{}", std::process::id()));
+        let parent =
+            std::env::temp_dir().join(format!("radiosity-xdg-test-{}", std::process::id()));
         std::fs::create_dir_all(&parent).unwrap();
         let dir = private_runtime_dir(&parent).unwrap();
         let mode = std::fs::metadata(&dir).unwrap().permissions().mode();

@@ -309,7 +309,10 @@ pub fn run_all(
         )
     };
     out += &row("Cornell box (MAX_PATCH_AREA 1000), default camera", &ft);
-    log(&format!("frame time: the Cornell box, {:.2} ms a frame", ft.mean_ms));
+    log(&format!(
+        "frame time: the Cornell box, {:.2} ms a frame",
+        ft.mean_ms
+    ));
     if big_triangles > 0 {
         log(&format!(
             "frame time: about {big_triangles} triangles of tiled Cornell boxes, {frames} frames"

@@ -120,7 +120,10 @@ pub fn select_by_name(scene: &Scene, mesh: &Mesh, prefix: &str) -> Option<usize>
         .filter(|(_, s)| s.name.starts_with(prefix))
         .map(|(i, _)| i)
         .collect();
-    if let Some(&exact) = candidates.iter().find(|&&i| scene.surfaces[i].name == prefix) {
+    if let Some(&exact) = candidates
+        .iter()
+        .find(|&&i| scene.surfaces[i].name == prefix)
+    {
         return Some(exact);
     }
     let first = *candidates.first()?;
@@ -363,12 +366,15 @@ mod tests {
 
     /// The furnished example room, meshed as the window meshes it.
     fn room() -> (Scene, Mesh) {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/room.scene");
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/room.scene");
         let options = radiosity::io::import::ImportOptions {
             scale: 1.0,
             settings: None,
         };
-        let file = radiosity::io::import::read_any_scene(&path, &options).unwrap().file;
+        let file = radiosity::io::import::read_any_scene(&path, &options)
+            .unwrap()
+            .file;
         let prepared = Prepared::new(file.scene, file.settings, &NoProgress).unwrap();
         (prepared.scene.clone(), (*prepared.mesh).clone())
     }

@@ -270,7 +270,14 @@ fn compare_methods_refuses_a_scene_and_reports_progress() {
 fn compare_reports_the_dense_matrix_size_not_a_leftover_peak() {
     let dir = scratch_dir("compare-matrix");
     let out = radiosity(
-        &["compare", "--max-area", "20000", "--solver", "progressive", "-q"],
+        &[
+            "compare",
+            "--max-area",
+            "20000",
+            "--solver",
+            "progressive",
+            "-q",
+        ],
         &dir,
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -283,6 +290,9 @@ fn compare_reports_the_dense_matrix_size_not_a_leftover_peak() {
     let n: f64 = cells[2].parse().unwrap();
     let mib: f64 = cells[9].parse().unwrap();
     let expected = 4.0 * n * n / (1024.0 * 1024.0);
-    assert!((mib - expected).abs() <= 0.005, "{row}: expected {expected}");
+    assert!(
+        (mib - expected).abs() <= 0.005,
+        "{row}: expected {expected}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
