@@ -46,8 +46,9 @@ pub struct BuildingArgs {
     /// Seed of door positions, window widths, furniture placement and colours.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// The scene's MAX_PATCH_AREA (m^2): 1 gives about 40,000 elements for the default
-    /// building, 0.0125 about a million.
+    /// The scene's MAX_PATCH_AREA (m^2): 1 gives about 51,500 elements for the default
+    /// building (33,400 on the grid, split along furniture contacts), 0.0125 about 990,000
+    /// on the grid (the count is printed when the file is written).
     #[arg(long, default_value_t = 1.0, value_name = "AREA")]
     pub max_area: f64,
     /// The scene's INTEGRAL_STEPS.
@@ -73,7 +74,7 @@ pub struct SceneArgs {
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,
     /// Override the scene's INTEGRAL_STEPS (points along each axis of each element, for
-    /// the area method).
+    /// the area, contour and analytic methods).
     #[arg(long, value_name = "K")]
     pub steps: Option<u32>,
     #[command(flatten)]
@@ -115,7 +116,9 @@ pub struct SolveOptions {
     pub solver: SolverArg,
     /// Where the solver stops. Gauss-Seidel: the relative residual (default 1e-9).
     /// Progressive: the unshot power as a fraction of the emitted power, in every band (the
-    /// convergence value of Cohen et al. 1988; default 0.01 = 1 %).
+    /// convergence value of Cohen et al. 1988; default 0.01 = 1 %). Hierarchical: the power
+    /// still changing in a sweep as a fraction of the emitted power (default 1e-6). LU
+    /// solves directly and takes none.
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
     /// Hierarchical: the BF refinement threshold, relative to the mean radiosity (smaller is
@@ -152,7 +155,9 @@ pub struct SolveOptions {
     /// the first matrix's, or 4 million; given, only this limit holds).
     #[arg(long, value_name = "N")]
     pub adapt_max_elements: Option<usize>,
-    /// Progressive: give up after this many shots.
+    /// Progressive: stop after this many shots even if the unshot power is still above
+    /// --tolerance; the output then holds the light shot so far, and a note says how far it
+    /// got.
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     pub max_shots: usize,
     /// Read form factors from this file (written by `radiosity formfactors`) instead of
@@ -290,7 +295,8 @@ pub struct RenderArgs {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub solve: SolveOptions,
-    /// Output PNG (default: cornell.png for the built-in box, else the scene's name).
+    /// Output image: .png, or .exr for linear radiance (default: cornell.png for the
+    /// built-in box, else the scene's name with .png).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Shading.
@@ -425,10 +431,11 @@ pub struct CheckArgs {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub solve: SolveOptions,
-    /// Instead of checking a scene, print the accuracy table: every form-factor method
-    /// against closed forms (opposed and perpendicular squares, coaxial discs, a small
-    /// element under a rectangle), its row-sum error in a closed box, its reciprocity
-    /// error and its time, as Markdown.
+    /// Instead of checking a scene (give none), print the accuracy table: every form-factor
+    /// method against closed forms (opposed and perpendicular squares, coaxial discs, a
+    /// small element under a rectangle), its row-sum error in a closed box, its reciprocity
+    /// error and its time, as Markdown. --max-area sets the elements' size (default 1/64
+    /// of the unit squares); about 20 s, a line per method on stderr meanwhile.
     #[arg(long)]
     pub compare_methods: bool,
 }
@@ -470,7 +477,7 @@ pub struct BenchArgs {
     #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
     pub solver: SolverArg,
     /// Where the solver stops (as for `render --tolerance`: 1e-9 residual for Gauss-Seidel,
-    /// 0.01 unshot for progressive).
+    /// 0.01 unshot for progressive, 1e-6 changing power for hierarchical).
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
     /// Image width and height in pixels.
@@ -485,6 +492,9 @@ pub struct BenchArgs {
     /// Hierarchical: the minimum node area (as for `render --min-area`).
     #[arg(long, value_name = "AREA")]
     pub min_area: Option<f64>,
+    /// Only the table: no note on what was timed (errors and warnings are still printed).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// Options of `radiosity view`.
@@ -514,10 +524,11 @@ pub struct ViewArgs {
     /// progressive refinement shows light sooner.
     #[arg(long)]
     pub dense: bool,
-    /// The solver: auto (the two options above decide), dense or gauss-seidel (Gauss-Seidel
-    /// on the cached matrix when it fits), lu, progressive, hierarchical (hierarchical
-    /// radiosity with clustering, --epsilon, --min-area; the window shows its leaves and an
-    /// edit re-runs it).
+    /// The solver: auto (the dense matrix up to 6,000 elements, or 20,000 with --dense,
+    /// progressive refinement beyond; --progressive always progressive), dense or
+    /// gauss-seidel (Gauss-Seidel on the cached matrix whenever it fits, else progressive),
+    /// lu (likewise, LU), progressive, hierarchical (hierarchical radiosity with clustering,
+    /// --epsilon, --min-area; the window shows its leaves and an edit re-runs it).
     #[arg(
         long,
         value_name = "SOLVER",
@@ -545,7 +556,9 @@ pub struct ViewArgs {
     /// The shading the window starts with: smooth, flat or wireframe.
     #[arg(long, default_value = "smooth", value_name = "MODE", value_parser = parse_shading)]
     pub shading: Shading,
-    /// Select the first surface whose name starts with this (as a click on it would).
+    /// Select a surface (as a click on it would): the one named so, else the first whose
+    /// name starts with this that can be seen (not a face pressed against another, like the
+    /// base of furniture standing on the floor).
     #[arg(long, value_name = "NAME")]
     pub select: Option<String>,
     /// No window: measure frame time offscreen (Cornell box and a tiled scene of

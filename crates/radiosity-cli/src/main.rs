@@ -13,6 +13,7 @@ mod errors;
 mod peak_memory;
 mod progress_bar;
 mod report;
+mod runtime_dir;
 mod setup;
 
 use std::process::ExitCode;
@@ -28,8 +29,8 @@ use errors::describe;
 
 /// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
 ///
-/// Every command takes an optional scene file in the paper's Appendix A format; without one
-/// it uses the built-in Cornell box.
+/// Every command but `generate` takes an optional scene file (the paper's Appendix A
+/// format, or OBJ with its MTL); without one it uses the built-in Cornell box.
 #[derive(Parser)]
 #[command(name = "radiosity", version)]
 struct Cli {
@@ -39,7 +40,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a scene and render it to a PNG image.
+    /// Solve a scene and render it to a PNG image (or linear radiance as OpenEXR).
     Render(RenderArgs),
     /// Compute the form-factor matrix and write it to a file (paper 2.8).
     Formfactors(FormFactorArgs),

@@ -4,6 +4,8 @@
 
 use std::path::Path;
 
+use radiosity::form_factor::{FormFactorMethod, ROW_SUM_OVER};
+use radiosity::mesh::Mesh;
 use radiosity::pathtrace::{FilmComparison, PathTraceSettings, PathTraced};
 use radiosity::pipeline::{AdaptReport, FormFactorStats, Prepared, Solution, SolutionReport};
 use radiosity::scene::{BuildingParams, Scene};
@@ -11,21 +13,170 @@ use radiosity::solve::{Solver, SolverKind};
 
 use crate::progress_bar::{format_duration, Reporter};
 
-/// Notes what computing the form factors found.
-pub fn form_factor_stats(prepared: &Prepared, stats: &FormFactorStats, reporter: &Reporter) {
+/// Notes what computing the form factors on `mesh` found, with what its figures mean.
+pub fn form_factor_stats(
+    prepared: &Prepared,
+    mesh: &Mesh,
+    stats: &FormFactorStats,
+    reporter: &Reporter,
+) {
     reporter.note(&format!(
-        "form factors ({}): {} visibility rays in {:.3} s ({:.1} M rays/s); row sums min {:.4} mean {:.4} max {:.4}; \
-         reciprocity error {:.1e} largest, {:.1e} of exchanged power",
+        "form factors ({}): {}; row sums min {:.4} mean {:.4} max {:.4}; {}",
         prepared.method(),
-        stats.rays,
-        stats.seconds,
-        stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
+        rays_text(prepared.method(), stats),
         stats.row_sums.min,
         stats.row_sums.mean,
         stats.row_sums.max,
-        stats.reciprocity.max_relative,
-        stats.reciprocity.total_relative
+        reciprocity_text(prepared.method(), stats),
     ));
+    if let Some(text) = zero_rows_text(&prepared.scene, mesh, stats) {
+        reporter.note(&text);
+    }
+    if let Some(text) = over_rows_text(&prepared.scene, mesh, prepared.method(), stats) {
+        reporter.note(&format!("warning: {text}"));
+    }
+}
+
+/// "103794791 visibility rays in 18.650 s (5.6 M rays/s)", or for the hemicube, which casts
+/// none, what it does instead.
+fn rays_text(method: FormFactorMethod, stats: &FormFactorStats) -> String {
+    if let FormFactorMethod::Hemicube { .. } = method {
+        return format!(
+            "{:.3} s, no visibility rays (the hemicube finds what is visible with a depth \
+             buffer)",
+            stats.seconds
+        );
+    }
+    let mut text = format!(
+        "{} visibility rays in {:.3} s ({:.1} M rays/s)",
+        stats.rays,
+        stats.seconds,
+        stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+    );
+    if let Some(per_ray) = candidates_per_ray(stats) {
+        text.push_str(&format!(
+            "; each ray is tested against the occluders whose boxes meet its pair's box, \
+             {per_ray:.1} on average{}",
+            if per_ray > MANY_CANDIDATES {
+                " (many: a cluttered scene's rays are that much slower)"
+            } else {
+                ""
+            }
+        ));
+    }
+    text
+}
+
+/// Above this many occluder candidates per ray the rays/s figure is said to be low because
+/// of them: measured, the Cornell box's rays meet 4.4 on average, building_small's 47.1
+/// (its pairs across a room list the furniture between).
+const MANY_CANDIDATES: f64 = 10.0;
+
+/// The mean number of occluder candidates listed per ray, where the method lists them.
+fn candidates_per_ray(stats: &FormFactorStats) -> Option<f64> {
+    (stats.rays > 0 && stats.candidates > 0).then(|| stats.candidates as f64 / stats.rays as f64)
+}
+
+/// The reciprocity error, and for the methods that estimate F_ij and F_ji apart, why it is
+/// large.
+fn reciprocity_text(method: FormFactorMethod, stats: &FormFactorStats) -> String {
+    let r = &stats.reciprocity;
+    let mut text = format!(
+        "reciprocity error {:.1e} largest, {:.1e} of exchanged power",
+        r.max_relative, r.total_relative
+    );
+    if let Some(why) = not_reciprocal(method) {
+        if r.max_relative > 1e-3 {
+            text.push_str(&format!(" ({why})"));
+        }
+    }
+    text
+}
+
+/// Why a method's A_i F_ij and A_j F_ji may differ: `None` for the methods that compute one
+/// number per pair.
+pub fn not_reciprocal(method: FormFactorMethod) -> Option<&'static str> {
+    match method {
+        FormFactorMethod::AreaIntegral { .. } | FormFactorMethod::Contour { .. } => None,
+        FormFactorMethod::Analytic { .. } => Some(
+            "expected: the analytic method integrates each row at its own receiver's points, \
+             so F_ij and F_ji come from different points and a partly hidden pair can be seen \
+             from one side only",
+        ),
+        FormFactorMethod::Hemicube { .. } => Some(
+            "expected: the hemicube samples each row from its element's centre, so a pair \
+             seen by a cell from one side may fall between cells, or be hidden, from the other",
+        ),
+        FormFactorMethod::MonteCarlo { .. } => Some(
+            "expected: Monte Carlo estimates each row with its own random rays, so a small \
+             or distant pair hit from one side may be missed from the other",
+        ),
+    }
+}
+
+/// The name of element `e` for a note: `element 12 of surface 3 "Floor"`.
+fn element_name(scene: &Scene, mesh: &Mesh, e: usize) -> String {
+    match mesh.elements.get(e) {
+        Some(el) => {
+            let s = el.surface as usize;
+            match scene.surfaces.get(s).map(|x| x.name.as_str()) {
+                Some(name) if !name.is_empty() => format!("element {e} of surface {s} {name:?}"),
+                _ => format!("element {e} of surface {s}"),
+            }
+        }
+        None => format!("element {e}"),
+    }
+}
+
+/// What rows summing to 0 mean, when there are any.
+fn zero_rows_text(scene: &Scene, mesh: &Mesh, stats: &FormFactorStats) -> Option<String> {
+    let rows = &stats.row_sums;
+    if rows.zero == 0 {
+        return None;
+    }
+    Some(format!(
+        "row sums: {} element(s) see no other element (row sum 0; the first is {}): faces \
+         pressed against another surface, such as the base of furniture standing on the floor \
+         or a side against a wall, or elements whose sample points lie under such furniture; \
+         no light reaches them, so they keep only their own emission, and they are hidden \
+         (or partly hidden) by what touches them",
+        rows.zero,
+        element_name(scene, mesh, rows.min_row),
+    ))
+}
+
+/// What rows summing above [`ROW_SUM_OVER`] mean, when there are any.
+fn over_rows_text(
+    scene: &Scene,
+    mesh: &Mesh,
+    method: FormFactorMethod,
+    stats: &FormFactorStats,
+) -> Option<String> {
+    let rows = &stats.row_sums;
+    if rows.over == 0 {
+        return None;
+    }
+    let cure = match method {
+        FormFactorMethod::AreaIntegral { steps }
+        | FormFactorMethod::Contour { steps }
+        | FormFactorMethod::Analytic { steps } => format!(
+            "more points (--steps {}) or a smaller --max-area reduce it",
+            (2 * steps).max(4)
+        ),
+        FormFactorMethod::Hemicube { .. } | FormFactorMethod::MonteCarlo { .. } => {
+            "--method contour --steps 4 reduces it".to_string()
+        }
+    };
+    Some(format!(
+        "{} element(s) have form-factor rows summing above {ROW_SUM_OVER} (the largest {:.4}, \
+         {}): they pass on more light than reaches them, so the solution holds light that \
+         was never emitted (`check` lists it as \"counted twice\"). It comes from pairs much \
+         closer than their elements are large (a wall a few cm behind furniture, surfaces \
+         meeting at an edge), whose visibility the {method} points cannot resolve; {cure}",
+        rows.over,
+        rows.max,
+        element_name(scene, mesh, rows.max_row),
+    ))
 }
 
 /// Notes where the emitted power went (the largest band's share): absorbed, and escaped
@@ -41,15 +192,27 @@ pub fn energy_note(solution: &Solution, reporter: &Reporter) {
         return;
     };
     let share = |x: f64| 100.0 * x / b.emitted[band];
+    let escaped = share(b.escaped[band]);
     let mut text = format!(
-        "energy: of the emitted power {:.2} % absorbed, {:.2} % escaped",
+        "energy: of the emitted power {:.2} % absorbed, {:.2} % escaped ({}; `check` says where)",
         share(b.absorbed[band]),
-        share(b.escaped[band])
+        escaped,
+        escaped_meaning(escaped)
     );
     if let SolutionReport::Progressive(_) = solution.report {
         text.push_str(" (the rest is still unshot)");
     }
     reporter.note(&text);
+}
+
+/// What an escaped share (percent of the emitted power) means, for the energy notes.
+fn escaped_meaning(percent: f64) -> &'static str {
+    if percent < 0.0 {
+        "negative: rows of form factors summing above 1 made light"
+    } else {
+        "light that reached no element: through openings, into gaps and contacts, or lost to \
+         the form factors' rows summing below 1"
+    }
 }
 
 /// Notes what adaptive subdivision did, round by round.
@@ -155,15 +318,35 @@ pub fn check(
             stats.row_sums.mean,
             stats.row_sums.max
         );
+        if let Some(text) = zero_rows_text(scene, &solution.mesh, stats) {
+            outln!("                  {text}");
+        }
+        if let Some(text) = over_rows_text(scene, &solution.mesh, prepared.method(), stats) {
+            outln!("                  warning: {text}");
+        }
         outln!(
             "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max; {:.3e} of all exchanged power",
             stats.reciprocity.max_relative, stats.reciprocity.total_relative
         );
-        if stats.rays > 0 {
+        if let (Some(why), true) = (
+            not_reciprocal(prepared.method()),
+            stats.reciprocity.max_relative > 1e-3,
+        ) {
+            outln!("                  ({why})");
+        }
+        if let FormFactorMethod::Hemicube { .. } = prepared.method() {
             outln!(
-                "visibility rays   {} ({:.1} M rays/s)",
+                "visibility rays   none: the hemicube finds what is visible with a depth buffer"
+            );
+        } else if stats.rays > 0 {
+            outln!(
+                "visibility rays   {} ({:.1} M rays/s){}",
                 stats.rays,
-                stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+                stats.rays as f64 / stats.seconds.max(1e-9) / 1e6,
+                candidates_per_ray(stats).map_or(String::new(), |c| format!(
+                    "; {c:.1} occluder candidates tested per ray on average (the rate falls as \
+                     they grow)"
+                ))
             );
         }
     }
@@ -213,13 +396,28 @@ pub fn check(
         }
     }
     let b = &solution.balance;
+    let share = |x: f64| {
+        if b.emitted[0] > 0.0 {
+            format!(" ({:.2} %)", 100.0 * x / b.emitted[0])
+        } else {
+            String::new()
+        }
+    };
     outln!(
-        "energy (R)        emitted {:.6e} = absorbed {:.6e} + escaped {:.6e} (relative error {:.1e})",
+        "energy (R)        emitted {:.6e} = absorbed {:.6e}{} + escaped {:.6e}{} (relative error {:.1e})",
         b.emitted[0],
         b.absorbed[0],
+        share(b.absorbed[0]),
         b.escaped[0],
+        share(b.escaped[0]),
         b.relative_error()
     );
+    if b.emitted[0] > 0.0 {
+        outln!(
+            "                  (escaped: {})",
+            escaped_meaning(100.0 * b.escaped[0] / b.emitted[0])
+        );
+    }
     if let (Some(by_surface), true) = (escaped_by_surface, b.emitted[0] > 0.0) {
         where_escaped(scene, by_surface, b.emitted[0]);
     }
@@ -278,9 +476,28 @@ fn where_escaped(scene: &radiosity::scene::Scene, by_surface: &[[f64; 3]], emitt
     }
 }
 
-/// Prints the accuracy table of `form_factor::accuracy` as Markdown.
-pub fn method_accuracy(max_area: f64) {
+/// Prints the accuracy table of `form_factor::accuracy` as Markdown, once every method is
+/// measured; meanwhile a line per method on stderr (unless `quiet`), as the whole takes
+/// about 20 s.
+pub fn method_accuracy(max_area: f64, quiet: bool) {
     use radiosity::form_factor::accuracy::{measure, standard_methods};
+    let methods = standard_methods();
+    let start = std::time::Instant::now();
+    let rows: Vec<_> = methods
+        .iter()
+        .enumerate()
+        .map(|(i, &method)| {
+            if !quiet {
+                errln!(
+                    "measuring {} of {}: {method} (after {:.0} s)",
+                    i + 1,
+                    methods.len(),
+                    start.elapsed().as_secs_f64()
+                );
+            }
+            measure(method, max_area)
+        })
+        .collect();
     outln!(
         "Elements of at most {max_area} (unit squares in {} elements); relative errors.",
         (1.0 / max_area).round()
@@ -290,8 +507,7 @@ pub fn method_accuracy(max_area: f64) {
         "| method | opposed squares | perpendicular squares | coaxial discs | element to rectangle | mean | closed box max abs(row sum - 1) | reciprocity | time (ms) | mean error x time |"
     );
     outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for method in standard_methods() {
-        let r = measure(method, max_area);
+    for r in rows {
         outln!(
             "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.1} | {:.2e} |",
             r.method,
@@ -329,7 +545,11 @@ pub struct CompareRow<'a> {
 /// The dense reference of a `compare` row.
 pub struct Reference {
     pub seconds: f64,
-    pub peak: Peak,
+    /// Bytes of its f32 form-factor matrix (4 n^2), what the dense solve holds beyond the
+    /// prepared scene: computed, not measured, because a resident peak measured after the
+    /// first solve depends on what that solve left in the allocator (23 to 256 MiB for
+    /// one reference between runs).
+    pub matrix_bytes: u64,
     /// The solver's radiosity against the reference's.
     pub difference: radiosity::compare::Comparison,
 }
@@ -347,14 +567,21 @@ pub fn compare(row: &CompareRow) {
     let (time, peak, rms, max, mean) = match &row.reference {
         Some(r) => (
             format!("{:.2}", r.seconds),
-            mib(&r.peak),
+            {
+                let m = r.matrix_bytes as f64 / (1024.0 * 1024.0);
+                if m < 10.0 {
+                    format!("{m:.2}")
+                } else {
+                    format!("{m:.0}")
+                }
+            },
             format!("{:.2}", 100.0 * r.difference.rms),
             format!("{:.1}", 100.0 * r.difference.max),
             format!("{:+.2}", 100.0 * r.difference.bias),
         ),
         None => (dash(), dash(), dash(), dash(), dash()),
     };
-    outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense reference | dense time (s) | dense peak (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
+    outln!("| scene | elements | solver | its elements | time (s) | peak (MiB) | dense reference | dense time (s) | dense matrix (MiB) | RMS diff (%) | max diff (%) | mean diff (%) |");
     outln!("| --- | ---: | --- | ---: | ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: |");
     outln!(
         "| {} | {} | {} | {} | {:.2} | {} | {} | {time} | {peak} | {rms} | {max} | {mean} |",
@@ -377,21 +604,24 @@ fn mib(peak: &Peak) -> String {
     }
 }
 
-/// Prints the note (stderr) and the header of the `bench` table.
-pub fn bench_header(repeat: usize, size: u32, supersample: u32, solver: SolverKind) {
+/// Prints the note (stderr, unless `quiet`) and the header of the `bench` table.
+pub fn bench_header(repeat: usize, size: u32, supersample: u32, solver: SolverKind, quiet: bool) {
     let solver_name = match solver {
         SolverKind::Auto => {
-            "auto (dense Gauss-Seidel up to 20,000 elements when it fits, else progressive)"
+            "auto (dense Gauss-Seidel up to 20,000 elements when the matrix fits in half the \
+             memory, else hierarchical)"
         }
         SolverKind::Lu => "LU",
         SolverKind::GaussSeidel => "Gauss-Seidel",
         SolverKind::Progressive => "progressive (form factors computed within the solve)",
         SolverKind::Hierarchical => "hierarchical (links computed within the solve)",
     };
-    errln!(
-        "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
-        repeat, size, supersample
-    );
+    if !quiet {
+        errln!(
+            "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
+            repeat, size, supersample
+        );
+    }
     outln!(
         "| scene | max area | elements | k | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
     );
@@ -448,10 +678,12 @@ fn ms(seconds: f64) -> String {
 pub fn building(output: &Path, params: &BuildingParams, built: &Scene, elements: &str) {
     let (lo, hi) = built.bounds();
     let size = hi - lo;
+    let rooms = params.floors * params.rooms_x * params.rooms_z;
     outln!(
-        "{}: {} rooms, {} surfaces, {:.0} m^2, {:.1} x {:.1} x {:.1} m; MAX_PATCH_AREA {}: {}",
+        "{}: {} room{}, {} surfaces, {:.0} m^2, {:.1} x {:.1} x {:.1} m; MAX_PATCH_AREA {}: {}",
         output.display(),
-        params.floors * params.rooms_x * params.rooms_z,
+        rooms,
+        if rooms == 1 { "" } else { "s" },
         built.surfaces.len(),
         built.total_area(),
         size.x,

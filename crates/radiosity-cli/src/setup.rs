@@ -309,7 +309,15 @@ fn solver(
     };
     Ok(match choice {
         SolverKind::Auto => unreachable!("auto is resolved above"),
-        SolverKind::Lu => Solver::LU,
+        SolverKind::Lu => {
+            if options.tolerance.is_some() {
+                // Printed even with --quiet: the run does not do what the flags say.
+                errln!(
+                    "warning: --tolerance is ignored: the LU solver solves directly, to rounding"
+                );
+            }
+            Solver::LU
+        }
         SolverKind::GaussSeidel => Solver::Dense(radiosity::solve::DenseSolver::GaussSeidel(
             GaussSeidelSettings {
                 tolerance: options.tolerance.unwrap_or(1e-9),

@@ -146,13 +146,11 @@ impl ViewerApp {
                 texture,
             }
         });
-        // The window saves in the scene format: beside an imported model (room.obj), as
-        // room.scene, never over the model.
-        let save_path = options
-            .path
-            .as_ref()
-            .map(|p| p.with_extension("scene").display().to_string())
-            .unwrap_or_else(|| "cornell_box.scene".into());
+        // The window saves in the scene format, never by default over the file opened (a
+        // shipped example would be lost to one Ctrl+S): room-edited.scene here.
+        let save_path = crate::model::default_save_path(options.path.as_deref())
+            .display()
+            .to_string();
         let show_panel = options.screenshot.is_none() || options.panel;
         ViewerApp {
             modeller: Modeller::new(options.scene.clone()),
@@ -210,13 +208,9 @@ impl ViewerApp {
                     self.mesh = Some(mesh);
                     self.bvh = Some(bvh);
                     self.gpu_mesh_pending = true;
-                    if let Some(prefix) = &self.options.select {
-                        self.selected = self
-                            .modeller
-                            .scene
-                            .surfaces
-                            .iter()
-                            .position(|s| s.name.starts_with(prefix.as_str()));
+                    if let (Some(prefix), Some(mesh)) = (&self.options.select, &self.mesh) {
+                        self.selected =
+                            crate::model::select_by_name(&self.modeller.scene, mesh, prefix);
                         self.emission_edit = self.selected.map(|s| {
                             EmissionEdit::of(
                                 self.modeller.colours(s).emission,

@@ -272,7 +272,9 @@ pub fn edit_to_picture(gpu: &Headless, target: usize) -> Result<EditTiming, Stri
     })
 }
 
-/// Runs every measurement and returns BENCHMARKS.md's tables (Markdown).
+/// Runs every measurement and returns BENCHMARKS.md's tables (Markdown); `log` gets a line
+/// of progress as each measurement starts and ends (not the tables: the caller prints them
+/// once).
 pub fn run_all(
     edit_sizes: &[usize],
     big_triangles: usize,
@@ -282,6 +284,8 @@ pub fn run_all(
     let gpu = Headless::new().map_err(|e| e.to_string())?;
     let mut out = format!("adapter: {}\n\n", gpu.adapter);
     out += "| scene | triangles | image | frames | mean ms/frame | fastest ms |\n| --- | --- | --- | --- | --- | --- |\n";
+    log(&format!("adapter: {}", gpu.adapter));
+    log(&format!("frame time: the Cornell box, {frames} frames"));
     let (scene, mesh, b, scale) = solved_cornell(1000.0)?;
     let style = Style {
         exposure_scale: scale,
@@ -305,8 +309,14 @@ pub fn run_all(
         )
     };
     out += &row("Cornell box (MAX_PATCH_AREA 1000), default camera", &ft);
-    log(&out);
+    log(&format!(
+        "frame time: the Cornell box, {:.2} ms a frame",
+        ft.mean_ms
+    ));
     if big_triangles > 0 {
+        log(&format!(
+            "frame time: about {big_triangles} triangles of tiled Cornell boxes, {frames} frames"
+        ));
         let (_, fine, fb, fscale) = solved_cornell(cornell_max_area_for(10_000))?;
         let per_copy = geometry_vertices(&fine, &[]).len() / 3;
         let copies = big_triangles.div_ceil(per_copy);
@@ -324,11 +334,17 @@ pub fn run_all(
             ),
             &ft,
         );
-        log(&line);
+        log(&format!(
+            "frame time: {} triangles, {:.2} ms a frame",
+            ft.triangles, ft.mean_ms
+        ));
         out += &line;
     }
     out += "\n| elements | MAX_PATCH_AREA | form factors (once) | edit → first picture | edit → converged picture | warm sweeps | LU re-solve instead |\n| --- | --- | --- | --- | --- | --- | --- |\n";
     for &n in edit_sizes {
+        log(&format!(
+            "edit to picture: about {n} elements (the form factors first, once)"
+        ));
         let t = edit_to_picture(&gpu, n)?;
         let line = format!(
             "| {} | {:.1} | {:.1} s | {:.0} ms | {:.0} ms | {} | {} |\n",
@@ -340,7 +356,10 @@ pub fn run_all(
             t.sweeps,
             t.lu_ms.map_or("-".into(), |ms| format!("{ms:.0} ms"))
         );
-        log(&line);
+        log(&format!(
+            "edit to picture: {} elements, first picture {:.0} ms, converged {:.0} ms",
+            t.elements, t.first_picture_ms, t.converged_picture_ms
+        ));
         out += &line;
     }
     Ok(out)

@@ -55,8 +55,9 @@ pub struct ViewerOptions {
     /// Its file's settings: the scene is meshed with them (overrides applied) and saved
     /// with them (as they are).
     pub settings: MeshSettings,
-    /// Its file (where "save" writes; `None` for the built-in Cornell box, which is saved to
-    /// `cornell_box.scene`).
+    /// Its file (`None` for the built-in Cornell box); "save" writes beside the current
+    /// directory's `<stem>-edited.scene` unless another path is typed
+    /// ([`model::default_save_path`]).
     pub path: Option<PathBuf>,
     /// `--max-area` and `--steps`, applied to `settings` for meshing, never saved.
     pub overrides: Overrides,
@@ -71,8 +72,9 @@ pub struct ViewerOptions {
     pub panel: bool,
     /// Window size in points.
     pub size: [f32; 2],
-    /// Select the first surface whose name starts with this once the mesh is ready (for
-    /// screenshots of the modeller).
+    /// Select the surface named so, or the first that can be seen whose name starts with
+    /// this, once the mesh is ready ([`model::select_by_name`]; for screenshots of the
+    /// modeller).
     pub select: Option<String>,
     /// The shading the window starts with.
     pub shading: radiosity::render::Shading,

@@ -6,7 +6,12 @@
 //! after a small edit the old B is already close, so far fewer sweeps are needed than from
 //! B = E). BENCHMARKS.md compares it with refactoring the LU.
 
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use radiosity::mesh::Mesh;
 use radiosity::scene::{Rgb, Scene};
+use radiosity::visibility::PolygonBvh;
 
 /// The colours of one surface: what the modeller edits.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,6 +104,76 @@ impl Modeller {
     pub fn undo_len(&self) -> usize {
         self.undo.len()
     }
+}
+
+/// The surface `--select NAME` picks: of the surfaces whose name starts with `prefix`, one
+/// named exactly so, else the first in the file that can be seen, else the first. A surface
+/// can be seen when some element of `mesh` (the mesh as solved: buried pieces already left
+/// out) has its centre on no other surface: the base of a sofa standing on the floor, or a
+/// cupboard's side against a wall, is hidden by what it touches, and selecting it would
+/// show nothing. At most the first 64 candidates are tested.
+pub fn select_by_name(scene: &Scene, mesh: &Mesh, prefix: &str) -> Option<usize> {
+    let candidates: Vec<usize> = scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.name.starts_with(prefix))
+        .map(|(i, _)| i)
+        .collect();
+    if let Some(&exact) = candidates
+        .iter()
+        .find(|&&i| scene.surfaces[i].name == prefix)
+    {
+        return Some(exact);
+    }
+    let first = *candidates.first()?;
+    let visible = candidates
+        .iter()
+        .take(64)
+        .copied()
+        .find(|&s| surface_visible(scene, mesh, s));
+    Some(visible.unwrap_or(first))
+}
+
+/// True when some element of surface `s` in `mesh` has its centre on no other surface
+/// (see [`select_by_name`]).
+fn surface_visible(scene: &Scene, mesh: &Mesh, s: usize) -> bool {
+    let elements: Vec<_> = mesh
+        .elements
+        .iter()
+        .filter(|e| e.surface as usize == s)
+        .collect();
+    if elements.is_empty() {
+        return false;
+    }
+    let (polygons, ids): (Vec<&[DVec3]>, Vec<u32>) = scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| i != s)
+        .map(|(i, surface)| (surface.vertices.as_slice(), i as u32))
+        .unzip();
+    if polygons.is_empty() {
+        return true;
+    }
+    let others = PolygonBvh::new(&polygons, &ids);
+    // Touching means at no distance: a millionth of the scene's size covers f64 rounding
+    // of coordinates, and no face meant to be seen lies that close to another.
+    let tolerance = 1e-6 * others.scale().max(f64::MIN_POSITIVE);
+    elements
+        .iter()
+        .any(|e| others.polygon_at(e.centroid, tolerance).is_none())
+}
+
+/// Where the window's "save scene" (and Ctrl+S) writes unless the user types another
+/// path: never over the file opened (a shipped example would be overwritten by one key),
+/// but `<stem>-edited.scene` in the current directory; `cornell-edited.scene` for the
+/// built-in box. Typing the opened file's own path saves over it.
+pub fn default_save_path(opened: Option<&Path>) -> PathBuf {
+    let stem = opened
+        .and_then(Path::file_stem)
+        .map_or("cornell".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!("{stem}-edited.scene"))
 }
 
 #[cfg(test)]
@@ -286,6 +361,60 @@ mod tests {
         assert!(
             warm_sweeps <= cold_sweeps,
             "warm {warm_sweeps} vs cold {cold_sweeps}"
+        );
+    }
+
+    /// The furnished example room, meshed as the window meshes it.
+    fn room() -> (Scene, Mesh) {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/room.scene");
+        let options = radiosity::io::import::ImportOptions {
+            scale: 1.0,
+            settings: None,
+        };
+        let file = radiosity::io::import::read_any_scene(&path, &options)
+            .unwrap()
+            .file;
+        let prepared = Prepared::new(file.scene, file.settings, &NoProgress).unwrap();
+        (prepared.scene.clone(), (*prepared.mesh).clone())
+    }
+
+    #[test]
+    fn select_by_name_picks_a_surface_that_can_be_seen() {
+        let (scene, mesh) = room();
+        let name = |i: usize| scene.surfaces[i].name.clone();
+        let index = |n: &str| scene.surfaces.iter().position(|s| s.name == n).unwrap();
+        // The sofa's seat stands on the floor: its base lies on the floor's plane and is
+        // hidden; its top is open to the room.
+        assert!(!surface_visible(&scene, &mesh, index("Sofa seat.base")));
+        assert!(surface_visible(&scene, &mesh, index("Sofa seat.top")));
+        assert!(surface_visible(&scene, &mesh, index("Floor")));
+        let sofa = select_by_name(&scene, &mesh, "Sofa").unwrap();
+        assert!(name(sofa).starts_with("Sofa"), "{}", name(sofa));
+        assert!(surface_visible(&scene, &mesh, sofa), "{}", name(sofa));
+        assert!(!name(sofa).ends_with(".base"), "{}", name(sofa));
+        // An exact name is taken as asked, hidden or not; no match is none.
+        assert_eq!(
+            select_by_name(&scene, &mesh, "Sofa seat.base"),
+            Some(index("Sofa seat.base"))
+        );
+        assert_eq!(select_by_name(&scene, &mesh, "Piano"), None);
+    }
+
+    #[test]
+    fn default_save_path_is_never_the_opened_file() {
+        let opened = std::path::Path::new("examples/room.scene");
+        let save = default_save_path(Some(opened));
+        assert_eq!(save, std::path::PathBuf::from("room-edited.scene"));
+        assert_ne!(save, opened);
+        assert_eq!(
+            default_save_path(None),
+            std::path::PathBuf::from("cornell-edited.scene")
+        );
+        // An imported model is saved in the scene format, not over the model.
+        assert_eq!(
+            default_save_path(Some(std::path::Path::new("model.obj"))),
+            std::path::PathBuf::from("model-edited.scene")
         );
     }
 }

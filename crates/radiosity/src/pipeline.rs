@@ -153,6 +153,9 @@ pub struct Prepared {
 pub struct FormFactorStats {
     /// Visibility segments tested against candidate occluders.
     pub rays: u64,
+    /// Occluder candidates listed for those rays ([`RayCounter::candidates`]; 0 where a
+    /// method tests no lists: the hemicube, Monte Carlo's BVH traversal).
+    pub candidates: u64,
     /// Wall-clock seconds of the computation.
     pub seconds: f64,
     /// Row sums.
@@ -441,6 +444,7 @@ impl Prepared {
         let seconds = start.elapsed().as_secs_f64();
         let stats = FormFactorStats {
             rays: rays.get(),
+            candidates: rays.candidates(),
             seconds,
             row_sums: matrix.row_sums(),
             reciprocity: matrix.reciprocity(&self.areas()),
@@ -630,6 +634,7 @@ fn solve_adaptive(
     let mut light = prepared.light.clone();
     let (mut f, first) = prepared.form_factors(progress)?;
     let (mut rays, mut seconds) = (first.rays, first.seconds);
+    let mut candidates = first.candidates;
     let (mut radiosity, mut report) = solve::solve(&f, &light, dense, start, observer, progress)?;
     let mut adapted = AdaptReport {
         initial_elements: mesh.len(),
@@ -681,6 +686,7 @@ fn solve_adaptive(
         next_f.check_entries()?;
         seconds += clock.elapsed().as_secs_f64();
         rays += counter.get();
+        candidates += counter.candidates();
         let n = next.len() as u64;
         let fresh = kept.iter().filter(|k| k.is_none()).count() as u64;
         let kept_count = n - fresh;
@@ -704,6 +710,7 @@ fn solve_adaptive(
     let balance = energy_balance(&f, &areas, &light, radiosity.as_slice());
     let stats = FormFactorStats {
         rays,
+        candidates,
         seconds,
         row_sums: f.row_sums(),
         reciprocity: f.reciprocity(&areas),

@@ -40,13 +40,19 @@ pub fn run(args: BenchArgs) -> Result<()> {
     } else {
         args.max_area.iter().copied().map(Some).collect()
     };
-    report::bench_header(args.repeat, args.size, args.supersample, args.solver.0);
+    report::bench_header(
+        args.repeat,
+        args.size,
+        args.supersample,
+        args.solver.0,
+        args.quiet,
+    );
     for max_area in areas {
         let runs = (0..args.repeat)
             .map(|_| bench_run(&args, max_area))
             .collect::<Result<Vec<_>>>()?;
         let first = &runs[0];
-        if runs.iter().any(|r| r.rays != first.rays) {
+        if !args.quiet && runs.iter().any(|r| r.rays != first.rays) {
             errln!("note: the ray count differed between runs");
         }
         let stage = |k: usize| median(runs.iter().map(|r| r.stages[k]).collect());

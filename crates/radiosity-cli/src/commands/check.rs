@@ -1,7 +1,7 @@
 //! `radiosity check`: the statistics of a scene and its solution, or the accuracy table of
 //! the form-factor methods (`--compare-methods`).
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use radiosity::pipeline::{self as pipeline, FormFactors, SolveRequest};
 use radiosity::solve::{escaped_by_surface, keep_going};
 
@@ -13,7 +13,27 @@ use crate::setup::prepare_solve;
 
 pub fn run(args: CheckArgs) -> Result<()> {
     if args.compare_methods {
-        report::method_accuracy(args.scene.max_area.unwrap_or(1.0 / 64.0));
+        // The table measures every method on its own test geometry: flags that choose a
+        // scene or a method would silently do nothing.
+        if let Some(scene) = &args.scene.scene {
+            bail!(
+                "check --compare-methods measures every form-factor method on its own test \
+                 geometry (unit squares, coaxial discs, a closed box), not on a scene: drop \
+                 {} (or drop --compare-methods to check that scene)",
+                scene.display()
+            );
+        }
+        if args.scene.method.method.is_some() || args.scene.steps.is_some() {
+            bail!(
+                "check --compare-methods measures every method at its listed settings: drop \
+                 --method and --steps (--max-area sets the elements' size)"
+            );
+        }
+        let max_area = args.scene.max_area.unwrap_or(1.0 / 64.0);
+        if !(max_area > 0.0 && max_area <= 1.0) {
+            bail!("--max-area must be in (0, 1] for --compare-methods (unit squares are meshed at it), got {max_area}");
+        }
+        report::method_accuracy(max_area, args.scene.quiet);
         return Ok(());
     }
     // `check` always prints its report; --quiet only silences the progress bars.
@@ -25,6 +45,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
                 let f = prepared.load_form_factors(path, &reporter)?;
                 let stats = radiosity::pipeline::FormFactorStats {
                     rays: 0,
+                    candidates: 0,
                     seconds: 0.0,
                     row_sums: f.row_sums(),
                     reciprocity: f.reciprocity(&prepared.areas()),

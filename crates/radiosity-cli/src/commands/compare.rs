@@ -47,7 +47,6 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 hint(&e).unwrap_or_default()
             )),
             Ok(()) => {
-                let reset = reset_peak_memory();
                 let start = std::time::Instant::now();
                 let exact = pipeline::solve(
                     &prepared,
@@ -56,10 +55,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
                     &reporter,
                 )?;
                 let seconds = start.elapsed().as_secs_f64();
-                let peak = Peak {
-                    bytes: peak_memory_bytes(),
-                    reset,
-                };
+                let n = prepared.mesh.len() as u64;
                 let emission = prepared.light.emission();
                 let difference = radiosity::compare::compare(
                     &prepared.mesh,
@@ -70,7 +66,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 )?;
                 reference = Some(Reference {
                     seconds,
-                    peak,
+                    matrix_bytes: 4 * n * n,
                     difference,
                 });
             }

@@ -23,7 +23,7 @@ pub fn run(args: FormFactorArgs) -> Result<()> {
         prepared.method().occlusion()
     ));
     let (f, stats) = prepared.form_factors(&reporter)?;
-    report::form_factor_stats(&prepared, &stats, &reporter);
+    report::form_factor_stats(&prepared, &prepared.mesh, &stats, &reporter);
     prepared.save_form_factors(&output, &f, &reporter)?;
     reporter.note(&format!(
         "wrote {} ({} x {} form factors, method {})",

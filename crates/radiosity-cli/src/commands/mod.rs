@@ -12,19 +12,21 @@ pub mod render;
 pub mod solve;
 pub mod view;
 
+use std::ops::ControlFlow;
 use std::path::Path;
 
 use anyhow::Result;
 use image::RgbImage;
 use radiosity::mesh::{AdaptSettings, Mesh};
 use radiosity::pipeline::{
-    self as pipeline, FormFactorStats, FormFactors, Prepared, Solution, SolveRequest,
+    self as pipeline, FormFactorStats, FormFactors, Prepared, Solution, SolutionReport,
+    SolveRequest,
 };
 use radiosity::progress::{run_stage, Stage};
 use radiosity::render::tonemap::{lit_radiosity_top_mean, AUTO_EXPOSURE_TOP_AREA};
 use radiosity::render::{Camera, RenderSettings, Renderer};
 use radiosity::shade::{self, Exposure};
-use radiosity::solve::{Observer, Solver};
+use radiosity::solve::{Observer, Solver, Step};
 
 use crate::progress_bar::Reporter;
 use crate::report;
@@ -61,16 +63,49 @@ pub fn solve_scene(
         adapt,
         ..SolveRequest::new(solver)
     };
-    let solution = pipeline::solve(prepared, &request, observer, reporter)?;
+    // `--max-shots` caps progressive refinement: the run stops there with what it has shot
+    // (and says how far it got) instead of failing; a NaN or divergence is still an error.
+    let cap = match solver {
+        Solver::Progressive(s) => Some(s),
+        _ => None,
+    };
+    let mut capped = false;
+    let mut capping = |step: &Step| {
+        let flow = observer(step);
+        if let (Some(s), Step::Shot(state)) = (cap, step) {
+            if state.shot >= s.max_shots && state.unshot_fraction >= s.tolerance {
+                capped = true;
+                return ControlFlow::Break(());
+            }
+        }
+        flow
+    };
+    let solution = pipeline::solve(prepared, &request, &mut capping, reporter)?;
+    if let (true, Some(s), SolutionReport::Progressive(r)) = (capped, cap, &solution.report) {
+        reporter.note(&shot_cap_note(s.max_shots, s.tolerance, r.unshot_fraction));
+    }
     if let Some(a) = &solution.adapt {
         report::adapt(a, reporter);
     }
     if let Some(stats) = &solution.form_factors {
-        report::form_factor_stats(prepared, stats, reporter);
+        report::form_factor_stats(prepared, &solution.mesh, stats, reporter);
     }
     report::energy_note(&solution, reporter);
     let stats = solution.form_factors;
     Ok((solution, stats))
+}
+
+/// What a progressive run stopped by `--max-shots` says: how far it got against the
+/// tolerance, and what its output holds.
+pub fn shot_cap_note(max_shots: usize, tolerance: f64, unshot: f64) -> String {
+    format!(
+        "progressive refinement stopped at --max-shots {max_shots}: the unshot power is \
+         {:.1} % of the emitted power, not yet below the tolerance {:.1} %; the output holds \
+         the light shot so far (the unshot part is left out; --max-shots or --tolerance \
+         takes it further)",
+        100.0 * unshot,
+        100.0 * tolerance
+    )
 }
 
 /// Vertex radiosities (the shade stage), then the image with radiosities multiplied by

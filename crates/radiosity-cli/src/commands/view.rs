@@ -14,12 +14,16 @@ pub fn run(args: ViewArgs) -> Result<()> {
     if args.steps == Some(0) {
         bail!("--steps must be at least 1");
     }
+    // Before any thread starts: the window system's libraries complain at every probe
+    // where XDG_RUNTIME_DIR is missing (root under Xvfb).
+    crate::runtime_dir::ensure_runtime_dir();
     if args.bench {
+        // Progress on stderr, the tables once on stdout.
         let table = radiosity_viewer::bench::run_all(
             &args.bench_elements,
             args.bench_triangles,
             args.bench_frames,
-            &mut |line| errln!("{}", line.trim_end()),
+            &mut |line| errln!("view --bench: {}", line.trim_end()),
         )
         .map_err(anyhow::Error::msg)?;
         outln!("{table}");

@@ -5,6 +5,7 @@ mod fixtures;
 
 mod browser;
 mod commands;
+mod first_hour;
 mod formats_out;
 mod hostile;
 mod imports;

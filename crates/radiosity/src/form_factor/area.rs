@@ -336,7 +336,7 @@ impl<'a> AreaIntegrator<'a> {
                     .sum()
             }
         };
-        rays.add(cast);
+        rays.add_tested(cast, candidates.len() as u64);
         g
     }
 
@@ -443,6 +443,10 @@ impl<'a> AreaIntegrator<'a> {
             total += k;
             if !candidates.is_empty() {
                 *cast += 1;
+                // Every visible ray scans the whole list (tens of polygons per pair in a
+                // furnished building). Measured on building_small, neither the occluder
+                // hierarchy for long lists (17.8 -> 20.4 s of CPU) nor trying the last
+                // blocker first was faster.
                 if occ.segment_blocked_by(candidates, p, q) {
                     continue;
                 }

@@ -192,7 +192,21 @@ pub struct RowSums {
     pub mean: f64,
     /// Largest row sum.
     pub max: f64,
+    /// The row (element) of the smallest sum (the first of equals; 0 for an empty matrix).
+    pub min_row: usize,
+    /// The row (element) of the largest sum (the first of equals; 0 for an empty matrix).
+    pub max_row: usize,
+    /// Rows that sum to exactly 0: elements that see no other element (faces pressed
+    /// against another surface, or shut in).
+    pub zero: usize,
+    /// Rows that sum above [`ROW_SUM_OVER`]: elements that send out more light than leaves
+    /// them (over-counted near pairs).
+    pub over: usize,
 }
+
+/// The row sum above which a row counts as over-counted in [`RowSums::over`]: 1 % above
+/// the most a closed surround can give (f32 rounding of a row stays near 1e-6).
+pub const ROW_SUM_OVER: f64 = 1.01;
 
 impl FormFactorMatrix {
     /// An n x n matrix of zeros, refused with [`OutOfMemory`] if it would not fit.
@@ -246,10 +260,23 @@ impl FormFactorMatrix {
     /// Minimum, mean and maximum row sum.
     pub fn row_sums(&self) -> RowSums {
         let sums: Vec<f64> = (0..self.n).map(|i| self.row_sum(i)).collect();
+        let (mut min_row, mut max_row) = (0, 0);
+        for (i, &s) in sums.iter().enumerate() {
+            if s < sums[min_row] {
+                min_row = i;
+            }
+            if s > sums[max_row] {
+                max_row = i;
+            }
+        }
         RowSums {
             min: sums.iter().copied().fold(f64::INFINITY, f64::min),
             mean: sums.iter().sum::<f64>() / self.n.max(1) as f64,
             max: sums.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            min_row,
+            max_row,
+            zero: sums.iter().filter(|&&s| s == 0.0).count(),
+            over: sums.iter().filter(|&&s| s > ROW_SUM_OVER).count(),
         }
     }
 
@@ -342,18 +369,30 @@ pub fn occluder_bvh(scene: &Scene) -> PolygonBvh {
     PolygonBvh::over_surfaces(scene)
 }
 
-/// Counts the rays cast, for rays-per-second figures.
+/// Counts the rays cast, for rays-per-second figures, and the occluder candidates they
+/// were tested against (where a method tests each ray against a list of candidates).
 #[derive(Debug, Default)]
-pub struct RayCounter(AtomicU64);
+pub struct RayCounter(AtomicU64, AtomicU64);
 
 impl RayCounter {
     /// Adds `n` rays.
     pub fn add(&self, n: u64) {
         self.0.fetch_add(n, Ordering::Relaxed);
     }
+    /// Adds `n` rays each tested against a list of `candidates` occluders.
+    pub fn add_tested(&self, n: u64, candidates: u64) {
+        self.0.fetch_add(n, Ordering::Relaxed);
+        self.1.fetch_add(n * candidates, Ordering::Relaxed);
+    }
     /// The rays counted so far.
     pub fn get(&self) -> u64 {
         self.0.load(Ordering::Relaxed)
+    }
+    /// Occluder candidates listed for the rays counted by [`RayCounter::add_tested`]: each
+    /// such ray is tested against its list until one blocks it, so this is the most
+    /// ray-polygon tests they made (the ray rate falls as it grows).
+    pub fn candidates(&self) -> u64 {
+        self.1.load(Ordering::Relaxed)
     }
 }
 

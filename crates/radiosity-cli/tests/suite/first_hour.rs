@@ -1,0 +1,298 @@
+//! A new user's first hour (issue 16): every message, help text and default says what is
+//! true. Each test guards one case that once puzzled a user.
+
+use crate::fixtures::{radiosity, scratch_dir, stderr};
+
+#[test]
+fn progressive_max_shots_caps_the_run_and_still_writes_the_picture() {
+    let dir = scratch_dir("max-shots");
+    // The coarse Cornell box needs far more than 3 shots to bring the unshot power below
+    // 1 % (every shot leaves the reflected part of its power unshot, and the walls reflect
+    // about half), so 3 shots stop at the cap.
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--solver",
+            "progressive",
+            "--max-shots",
+            "3",
+            "--snapshots",
+            "snaps",
+            "--snapshot-every",
+            "1",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--supersample",
+            "1",
+            "-o",
+            "capped.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "a capped run is not a failure: {err}");
+    assert!(dir.join("capped.png").exists(), "{err}");
+    assert!(dir.join("snaps/shot-00003.png").exists(), "{err}");
+    assert!(!dir.join("snaps/shot-00004.png").exists(), "{err}");
+    assert!(
+        err.contains("stopped at --max-shots 3: the unshot power is")
+            && err.contains("not yet below the tolerance 1.0 %"),
+        "says how far it got: {err}"
+    );
+    // Reaching the tolerance first is no cap: nothing said.
+    let out = radiosity(
+        &[
+            "solve",
+            "--max-area",
+            "20000",
+            "--solver",
+            "progressive",
+            "--tolerance",
+            "0.5",
+            "--max-shots",
+            "100000",
+            "-o",
+            "b.csv",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("--max-shots"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The element count `generate building` prints for its file.
+fn printed_elements(out: &std::process::Output) -> usize {
+    let text = crate::fixtures::stdout(out);
+    let tail = text.rsplit(": ").next().unwrap_or("");
+    tail.split_whitespace()
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no element count in {text:?}"))
+}
+
+#[test]
+fn generate_help_states_the_element_count_it_makes() {
+    let dir = scratch_dir("generate-help");
+    let help = radiosity(&["generate", "building", "--help"], &dir);
+    let help = crate::fixtures::stdout(&help);
+    assert!(help.contains("1 gives about 51,500 elements"), "{help}");
+    // The default building at --max-area 1 (the default) makes what the help promises,
+    // within 5 % (the count moves a little with the seed's furniture), counted as the
+    // other commands mesh it (contact refinement included).
+    let out = radiosity(&["generate", "building", "-o", "b.scene"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let n = printed_elements(&out) as f64;
+    assert!((n - 51_500.0).abs() < 0.05 * 51_500.0, "{n}");
+    // One room is "1 room".
+    let out = radiosity(
+        &[
+            "generate",
+            "building",
+            "--floors",
+            "1",
+            "--rooms-x",
+            "1",
+            "--rooms-z",
+            "1",
+            "-o",
+            "one.scene",
+        ],
+        &dir,
+    );
+    let text = crate::fixtures::stdout(&out);
+    assert!(text.contains(": 1 room, "), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn help_texts_name_every_solver_and_default() {
+    let dir = scratch_dir("help-texts");
+    let view = crate::fixtures::stdout(&radiosity(&["view", "--help"], &dir));
+    for name in [
+        "auto",
+        "dense",
+        "gauss-seidel",
+        "lu",
+        "progressive",
+        "hierarchical",
+    ] {
+        assert!(view.contains(name), "view --help names {name}: {view}");
+    }
+    let render = crate::fixtures::stdout(&radiosity(&["render", "--help"], &dir));
+    // Each iterative solver's default tolerance, as setup uses it.
+    for default in [
+        "default 1e-9",
+        "default 0.01 = 1 %",
+        "Hierarchical: the power still changing",
+        "default 1e-6",
+    ] {
+        assert!(
+            render.contains(default),
+            "render --help gives {default}: {render}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bench_header_says_what_auto_picks_and_quiet_silences_it() {
+    let dir = scratch_dir("bench-quiet");
+    let args = [
+        "bench",
+        "--max-area",
+        "20000",
+        "--repeat",
+        "1",
+        "--size",
+        "8",
+    ];
+    let out = radiosity(&args, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // `auto` picks hierarchical radiosity past the dense limit (solve::choose), never
+    // progressive refinement.
+    let err = stderr(&out);
+    assert!(err.contains("else hierarchical)"), "{err}");
+    assert!(!err.contains("progressive"), "{err}");
+    let table = crate::fixtures::stdout(&out);
+    assert!(table.starts_with("| scene |"), "{table}");
+    let mut quiet = args.to_vec();
+    quiet.push("-q");
+    let out = radiosity(&quiet, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(out.stderr.is_empty(), "bench -q: {}", stderr(&out));
+    assert_eq!(
+        crate::fixtures::stdout(&out).lines().count(),
+        3,
+        "header, rule, one row"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn check_gives_the_reason_beside_odd_row_sums_and_the_escaped_share() {
+    let dir = scratch_dir("check-reasons");
+    // The furnished room: boxes stand on the floor, so their bases face it at no distance
+    // and see nothing (row sum 0); the cupboard stands 2 cm from the left wall, a pair far
+    // closer than its 0.5 m elements, which k = 2 over-counts (rows above 1).
+    let out = radiosity(&["check", &crate::fixtures::example("room.scene")], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = crate::fixtures::stdout(&out);
+    assert!(
+        text.contains("see no other element (row sum 0; the first is element")
+            && text.contains(".base\"): faces pressed against another surface"),
+        "{text}"
+    );
+    assert!(
+        text.contains("warning: ") && text.contains("rows summing above 1.01"),
+        "{text}"
+    );
+    // The escaped power as a share of the emitted, beside the absolute figure, and what it
+    // is.
+    assert!(text.contains(" %) + escaped "), "{text}");
+    assert!(
+        text.contains("(escaped: light that reached no element"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn check_explains_the_hemicube_rays_and_sampled_reciprocity() {
+    let dir = scratch_dir("check-methods");
+    let coarse = ["check", "--max-area", "20000"];
+    let mut hemicube = coarse.to_vec();
+    hemicube.extend(["--method", "hemicube", "--resolution", "16"]);
+    let out = radiosity(&hemicube, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = crate::fixtures::stdout(&out);
+    assert!(
+        text.contains(
+            "visibility rays   none: the hemicube finds what is visible with a depth buffer"
+        ),
+        "{text}"
+    );
+    assert!(!text.contains("0.0 M rays/s"), "{text}");
+    let mut montecarlo = coarse.to_vec();
+    montecarlo.extend(["--method", "montecarlo", "--samples", "64"]);
+    let out = radiosity(&montecarlo, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = crate::fixtures::stdout(&out);
+    assert!(
+        text.contains("(expected: Monte Carlo estimates each row with its own random rays"),
+        "{text}"
+    );
+    // The exact method computes one number per pair: no excuse printed.
+    let mut contour = coarse.to_vec();
+    contour.extend(["--method", "contour"]);
+    let out = radiosity(&contour, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!crate::fixtures::stdout(&out).contains("(expected:"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_methods_refuses_a_scene_and_reports_progress() {
+    let dir = scratch_dir("compare-methods");
+    for (args, needle) in [
+        (
+            vec!["check", "room.scene", "--compare-methods"],
+            "not on a scene: drop room.scene",
+        ),
+        (
+            vec!["check", "--compare-methods", "--method", "hemicube"],
+            "drop --method and --steps",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    // One element per unit square: the cheapest table (the fixed-resolution hemicubes
+    // still take about a second), with a line per method on stderr.
+    let out = radiosity(&["check", "--compare-methods", "--max-area", "1"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let n = crate::fixtures::stdout(&out)
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| method"))
+        .count();
+    assert!(n >= 2, "{}", crate::fixtures::stdout(&out));
+    assert!(err.contains(&format!("measuring {n} of {n}: ")), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_reports_the_dense_matrix_size_not_a_leftover_peak() {
+    let dir = scratch_dir("compare-matrix");
+    let out = radiosity(
+        &[
+            "compare",
+            "--max-area",
+            "20000",
+            "--solver",
+            "progressive",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = crate::fixtures::stdout(&out);
+    assert!(text.contains("| dense matrix (MiB) |"), "{text}");
+    let row = text.lines().find(|l| l.starts_with("| cornell |")).unwrap();
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    // | scene | elements | ... | dense time | dense matrix | ...: the f32 matrix of the
+    // elements' count, 4 n^2 bytes, whichever solver ran first.
+    let n: f64 = cells[2].parse().unwrap();
+    let mib: f64 = cells[9].parse().unwrap();
+    let expected = 4.0 * n * n / (1024.0 * 1024.0);
+    assert!(
+        (mib - expected).abs() <= 0.005,
+        "{row}: expected {expected}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
