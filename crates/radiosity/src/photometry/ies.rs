@@ -582,7 +582,7 @@ impl IesPhotometry {
             1.0
         };
         let scale = candela_multiplier * ballast_factor * ballast_lamp_factor;
-        if !(scale <= MAX_CANDELA) {
+        if scale > MAX_CANDELA {
             return Err(error(
                 line,
                 IesProblem::OutOfRange {
@@ -623,11 +623,11 @@ impl IesPhotometry {
 
         // Candela values
         let mut values = Vec::new();
-        for h in 0..horizontal_deg.len() {
-            for v in 0..vertical_deg.len() {
+        for &horizontal in &horizontal_deg {
+            for &vertical in &vertical_deg {
                 let (value, line) = numbers.number(&format!(
                     "the candela value at vertical angle {} and horizontal angle {}",
-                    vertical_deg[v], horizontal_deg[h]
+                    vertical, horizontal
                 ))?;
                 if value < 0.0 {
                     return Err(error(
@@ -635,21 +635,21 @@ impl IesPhotometry {
                         IesProblem::OutOfRange {
                             what: format!(
                                 "the candela value at vertical angle {} and horizontal angle {}",
-                                vertical_deg[v], horizontal_deg[h]
+                                vertical, horizontal
                             ),
                             value,
                             allowed: "intensities must be 0 or more".to_string(),
                         },
                     ));
                 }
-                if !(value * scale <= MAX_CANDELA) {
+                if value * scale > MAX_CANDELA {
                     return Err(error(
                         line,
                         IesProblem::OutOfRange {
                             what: format!(
                                 "the candela value at vertical angle {} and horizontal angle {}, \
                                  times the candela multiplier and ballast factors,",
-                                vertical_deg[v], horizontal_deg[h]
+                                vertical, horizontal
                             ),
                             value: value * scale,
                             allowed: format!("at most {MAX_CANDELA:e} cd is accepted"),
@@ -786,9 +786,11 @@ impl IesPhotometry {
             return 0.0;
         }
         let column = |h: usize| self.column_at(h, theta);
-        let raw = match self.horizontal_weights(phi) {
-            (h0, _, t) if t == 0.0 => column(h0),
-            (h0, h1, t) => column(h0) * (1.0 - t) + column(h1) * t,
+        let (h0, h1, t) = self.horizontal_weights(phi);
+        let raw = if t == 0.0 {
+            column(h0)
+        } else {
+            column(h0) * (1.0 - t) + column(h1) * t
         };
         raw * self.scale
     }
