@@ -471,7 +471,12 @@ impl IesPhotometry {
         let start = usize::from(version.is_some());
         for (index, raw) in lines.iter().enumerate().skip(start) {
             let line = if index == 0 { first } else { raw }.trim();
-            if line.len() >= 5 && line[..5].eq_ignore_ascii_case("TILT=") {
+            // `get`: the first five bytes may end inside a character (Latin-1 text read
+            // as UTF-8 code points); found by the fuzz target.
+            if line
+                .get(..5)
+                .is_some_and(|start| start.eq_ignore_ascii_case("TILT="))
+            {
                 tilt_line = Some(index);
                 break;
             }

@@ -322,11 +322,13 @@ fn write_scene(title: &str, max_patch_area: f64, patches: &[Patch], lights: &[Li
             Some(l) => s.push_str(&format!("LUMINANCE {l}\n")),
             None => s.push_str("Er 0\nEg 0\nEb 0\n"),
         }
+        // An opening has no reflectance: OPENING stands where Rr Rg Rb would.
         if p.opening {
             s.push_str("OPENING\n");
+        } else {
+            let r = p.reflectance;
+            s.push_str(&format!("Rr {r}\nRg {r}\nRb {r}\n"));
         }
-        let r = p.reflectance;
-        s.push_str(&format!("Rr {r}\nRg {r}\nRb {r}\n"));
         for (k, v) in p.vertices.iter().enumerate() {
             s.push_str(&format!("VERTEX{k} {} {} {}\n", v.x, v.y, v.z));
         }

@@ -373,3 +373,14 @@ fn messages_name_file_line_and_what_was_expected() {
          angle 0, found `x`"
     );
 }
+
+/// Regression (fuzz target `ies`, crash-0880ca90): a label line whose fifth byte falls inside
+/// a two-byte character panicked the `TILT=` check, which sliced the line at byte 5.
+#[test]
+fn tilt_check_on_a_line_with_a_multibyte_character_near_its_start() {
+    let text = "close\u{9f}form isotropic\nclo\u{9f}se\nTILT=NONE\n1 100 1 2 1 1 2 0 0 0\n1 1 5\n0 90\n0\n10 10\n";
+    let ies = IesPhotometry::parse(text, Path::new("multibyte.ies")).unwrap();
+    assert_eq!(ies.labels().len(), 2);
+    let (line, problem) = refused("clo\u{9f}se\n1 2 3\n");
+    assert_eq!((line, problem), (2, IesProblem::NoTilt));
+}
