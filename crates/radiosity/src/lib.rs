@@ -73,6 +73,7 @@ pub mod form_factor;
 pub mod geometry;
 pub mod io;
 pub mod light;
+pub mod luminaire;
 pub mod mesh;
 pub mod pathtrace;
 pub mod photometry;

@@ -128,7 +128,7 @@ fn floor_and_rug(lift: f64, rug_only: bool) -> radiosity::scene::Scene {
         name: name.into(),
         emission: Rgb::BLACK,
         reflectance: Rgb([0.5; 3]),
-        vertices,
+        vertices, photometry: Default::default(), 
     };
     let mut surfaces = vec![surface("floor", quad(0., 4., 0., 4., 0.))];
     if rug_only {
@@ -137,7 +137,7 @@ fn floor_and_rug(lift: f64, rug_only: bool) -> radiosity::scene::Scene {
     surfaces.push(surface("rug", quad(1., 3., 1., 2., lift)));
     Scene {
         surfaces,
-        camera: None,
+        camera: None, lights: Vec::new(), 
     }
 }
 
