@@ -373,3 +373,49 @@ pub fn dxf(data: &[u8]) {
         &ImportOptions::default(),
     ));
 }
+
+/// The IES LM-63 reader on arbitrary bytes: text through `IesPhotometry::parse`, bytes that
+/// are not UTF-8 through `IesPhotometry::read` (a file, read as Latin-1). Every error must
+/// format and name the file; an accepted table must give finite, non-negative intensities in
+/// every direction tried, a finite non-negative flux and tilt factors.
+pub fn ies(data: &[u8]) {
+    use radiosity::photometry::{IesError, IesPhotometry, ies::MAX_CANDELA};
+    init();
+    let result = match std::str::from_utf8(data) {
+        Ok(text) => IesPhotometry::parse(text, std::path::Path::new("fuzz.ies")),
+        Err(_) => {
+            let path = scratch_file("lamp.ies");
+            std::fs::write(&path, data).expect("writing the scratch file");
+            let result = IesPhotometry::read(&path);
+            let _ = std::fs::remove_file(&path);
+            result
+        }
+    };
+    let ies = match result {
+        Ok(ies) => ies,
+        Err(error) => {
+            let message = error.to_string();
+            assert!(message.contains("lamp.ies") || message.contains("fuzz.ies"), "{message}");
+            if let IesError::Invalid { line, .. } = error {
+                assert!(line >= 1, "{message}");
+            }
+            return;
+        }
+    };
+    for i in 0..64 {
+        let theta = f64::from(i) * 0.05 - 0.2;
+        let phi = f64::from(i) * 0.7 - 3.0;
+        let candela = ies.candela(theta, phi);
+        assert!(
+            candela.is_finite() && (0.0..=MAX_CANDELA * (1.0 + 1e-12)).contains(&candela),
+            "candela {candela} at theta {theta}, phi {phi}"
+        );
+        let tilt = ies.tilt_factor(theta);
+        assert!(tilt.is_finite() && tilt >= 0.0, "tilt factor {tilt}");
+    }
+    let flux = ies.table_lumens();
+    assert!(flux.is_finite() && flux >= 0.0, "table lumens {flux}");
+    if let Some(stated) = ies.stated_lumens() {
+        assert!(stated > 0.0, "stated lumens {stated}");
+    }
+}

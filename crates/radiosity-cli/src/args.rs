@@ -20,6 +20,28 @@ pub enum GenerateCommand {
     Building(BuildingArgs),
 }
 
+#[derive(Subcommand)]
+pub enum ValidateCommand {
+    /// The analytical cases of CIE 171:2006 for a diffuse program (5.2 point source, 5.3
+    /// area source, 5.6 and 5.7 diffuse reflection without and with an obstruction, 5.8
+    /// inter-reflection in a 4 m cube for reflectances 0 to 0.95, 5.9 and 5.11 openings under
+    /// a uniform sky): runs each scene, prints case, point, reference, computed and
+    /// difference in %, and fails if any is outside the targets (1 %; 0.5 % for the
+    /// cube's mean indirect illuminance).
+    Cie171(Cie171Args),
+}
+
+#[derive(Args)]
+pub struct Cie171Args {
+    /// Write each case's scene and points file (name,x,y,z,nx,ny,nz) into DIR and stop
+    /// (the repository keeps them under validation/).
+    #[arg(long, value_name = "DIR")]
+    pub write: Option<PathBuf>,
+    /// Run only the cases whose id starts with this, e.g. 5.8 or 5.11.
+    #[arg(long, value_name = "ID")]
+    pub case: Option<String>,
+}
+
 #[derive(Args)]
 pub struct BuildingArgs {
     /// Output scene file.

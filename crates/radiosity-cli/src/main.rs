@@ -22,7 +22,7 @@ use clap::{Parser, Subcommand};
 
 use args::{
     BenchArgs, CheckArgs, CompareArgs, ExportArgs, FormFactorArgs, GenerateCommand, PathTraceArgs,
-    RenderArgs, SolveArgs, ViewArgs,
+    RenderArgs, SolveArgs, ValidateCommand, ViewArgs,
 };
 use errors::describe;
 
@@ -71,6 +71,11 @@ enum Command {
         #[command(subcommand)]
         what: GenerateCommand,
     },
+    /// Run published validation cases and compare with their reference values.
+    Validate {
+        #[command(subcommand)]
+        what: ValidateCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -100,5 +105,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Generate {
             what: GenerateCommand::Building(args),
         } => commands::generate::building(args),
+        Command::Validate {
+            what: ValidateCommand::Cie171(args),
+        } => commands::validate::cie171(args),
     }
 }

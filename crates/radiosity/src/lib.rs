@@ -26,6 +26,8 @@
 //! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7), PNG
 //!   images.
 //! * [`pathtrace`]: an unbiased diffuse path tracer, the yardstick for radiosity images.
+//! * [`photometry`]: luminaire data: IES LM-63 candela tables.
+//! * [`validation`]: the CIE 171:2006 analytical cases with references from first principles.
 //! * [`progress`]: the one interface long work reports through.
 //! * [`io`]: every file read or written: the paper's Appendix A scene format, the
 //!   form-factor file (paper 2.8), the per-element solution as CSV or JSON, PNG images.
@@ -75,6 +77,7 @@ pub mod light;
 pub mod luminaire;
 pub mod mesh;
 pub mod pathtrace;
+pub mod photometry;
 pub mod pipeline;
 pub mod progress;
 pub mod render;
@@ -82,6 +85,7 @@ pub mod scene;
 pub mod shade;
 pub mod solve;
 mod splitmix;
+pub mod validation;
 pub mod visibility;
 
 #[cfg(test)]

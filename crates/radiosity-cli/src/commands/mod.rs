@@ -10,6 +10,7 @@ pub mod generate;
 pub mod pathtrace;
 pub mod render;
 pub mod solve;
+pub mod validate;
 pub mod view;
 
 use std::path::Path;

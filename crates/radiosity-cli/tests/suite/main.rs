@@ -9,4 +9,5 @@ mod formats_out;
 mod hostile;
 mod imports;
 mod pathtrace;
+mod validate;
 mod view;
