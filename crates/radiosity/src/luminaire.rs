@@ -34,20 +34,42 @@
 
 use std::f64::consts::PI;
 
+use std::sync::Arc;
+
 use glam::DVec3;
 
 use crate::light::Rgb;
+use crate::photometry::ies::IesPhotometry;
 
 /// The default `AIM`: straight down.
 pub const DEFAULT_AIM: DVec3 = DVec3::new(0.0, 0.0, -1.0);
 
 /// The shape of a luminaire's intensity distribution.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Distribution {
     /// The same intensity in every direction.
     Isotropic,
     /// I0 cos(theta) in front of the axis, 0 behind.
     Cosine,
+    /// A measured type C table.
+    Ies {
+        /// The path as written in the scene file (relative to the scene file's folder).
+        written: String,
+        /// The file's photometry, read when the scene was read.
+        photometry: Arc<IesPhotometry>,
+    },
+}
+
+/// Two IES distributions are the same when the scene names the same file (as written).
+impl PartialEq for Distribution {
+    fn eq(&self, other: &Distribution) -> bool {
+        match (self, other) {
+            (Distribution::Isotropic, Distribution::Isotropic)
+            | (Distribution::Cosine, Distribution::Cosine) => true,
+            (Distribution::Ies { written: a, .. }, Distribution::Ies { written: b, .. }) => a == b,
+            _ => false,
+        }
+    }
 }
 
 /// How much light a luminaire gives, as written.
@@ -102,6 +124,14 @@ impl Luminaire {
             return Err(LuminaireError::ZeroAim);
         }
         match (&self.distribution, self.output) {
+            (Distribution::Ies { .. }, Output::Intensity(_)) => {
+                Err(LuminaireError::IntensityWithIes)
+            }
+            (Distribution::Ies { photometry, .. }, Output::Flux(_))
+                if !(photometry.table_lumens() > 0.0) =>
+            {
+                Err(LuminaireError::DarkTable)
+            }
             (Distribution::Isotropic | Distribution::Cosine, Output::AsTabulated) => {
                 Err(LuminaireError::NoOutput)
             }
@@ -143,6 +173,10 @@ impl Luminaire {
             (_, Output::Intensity(i)) => i,
             (Distribution::Isotropic, Output::Flux(p)) => p / (4.0 * PI),
             (Distribution::Cosine, Output::Flux(p)) => p / PI,
+            (Distribution::Ies { photometry, .. }, Output::Flux(p)) => {
+                p / photometry.table_lumens()
+            }
+            (Distribution::Ies { .. }, Output::AsTabulated) => 1.0,
             (_, Output::AsTabulated) => 0.0,
         }
     }
@@ -150,11 +184,16 @@ impl Luminaire {
     /// The luminous intensity (cd, untinted) towards the unit direction `d` (from the
     /// light outwards).
     pub fn candela(&self, d: DVec3) -> f64 {
-        let (_u, _v, w) = self.frame();
+        let (u, v, w) = self.frame();
         let cos_theta = d.dot(w).clamp(-1.0, 1.0);
         let shape = match &self.distribution {
             Distribution::Isotropic => 1.0,
             Distribution::Cosine => cos_theta.max(0.0),
+            Distribution::Ies { photometry, .. } => {
+                let theta = cos_theta.acos();
+                let phi = d.dot(v).atan2(d.dot(u)).rem_euclid(2.0 * PI);
+                photometry.candela(theta, phi)
+            }
         };
         self.scale() * shape
     }
@@ -170,6 +209,7 @@ impl Luminaire {
         match &self.distribution {
             Distribution::Isotropic => 4.0 * PI * self.scale(),
             Distribution::Cosine => PI * self.scale(),
+            Distribution::Ies { photometry, .. } => photometry.table_lumens() * self.scale(),
         }
     }
 

@@ -3,7 +3,7 @@
 
 use std::f64::consts::PI;
 
-use glam::dvec3;
+use glam::{dvec3, DVec3};
 
 use super::super::write_scene;
 use super::*;
@@ -228,4 +228,47 @@ fn light_block_errors_name_the_line_and_what_was_expected() {
                 INTENSITY 5\nDISTRIBUTION COSINE\nLIGHTEND\nSCENEEND\n";
     let e = errors(text);
     assert!(e[0].2.contains("no patches"), "{e:?}");
+}
+
+#[test]
+fn an_ies_light_reads_its_file_relative_to_the_scene_and_round_trips() {
+    // The scene's name is a path in the repository's tests/data; the IES path is relative
+    // to its folder.
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/x.scene");
+    let text = with_light(
+        "LIGHTBEGIN\n#Iso\nPOSITION 0 0 2\nFLUX 1000\nDISTRIBUTION IES ies/isotropic_lm63_2002.ies\nLIGHTEND",
+    );
+    let file = parse_scene(&text, data).unwrap_or_else(|e| panic!("{e}"));
+    let l = &file.scene.lights[0];
+    let Distribution::Ies { written, .. } = &l.distribution else {
+        panic!("{:?}", l.distribution)
+    };
+    assert_eq!(written, "ies/isotropic_lm63_2002.ies");
+    // FLUX scales the table to 1000 lm: an isotropic table then gives 1000 / (4 pi) cd
+    // everywhere (to the table's interpolation, which is exact for a constant).
+    assert!((l.flux() - 1000.0).abs() < 1e-9, "{}", l.flux());
+    for d in [DVec3::Z, -DVec3::Z, dvec3(1.0, 1.0, 0.3).normalize()] {
+        assert!((l.candela(d) - 1000.0 / (4.0 * PI)).abs() < 1e-9, "{d}");
+    }
+    let mut out = Vec::new();
+    write_scene(&file.scene, file.settings, &mut out).unwrap();
+    let written_text = String::from_utf8(out).unwrap();
+    assert!(written_text.contains("DISTRIBUTION IES ies/isotropic_lm63_2002.ies\n"));
+    assert_eq!(parse_scene(&written_text, data).unwrap(), file);
+    // A missing file: the scene's line, the path as written, and the reason.
+    let text = with_light("LIGHTBEGIN\n#X\nPOSITION 0 0 2\nDISTRIBUTION IES no/such.ies\nLIGHTEND");
+    let e = parse_scene(&text, data).unwrap_err().errors;
+    assert_eq!((e[0].line, e[0].column), (21, 18), "{e:?}");
+    assert!(e[0].message.contains("IES file \"no/such.ies\""), "{e:?}");
+    assert!(e[0].message.contains("cannot read"), "{e:?}");
+    // INTENSITY with IES is refused (FLUX or the file's own values).
+    let text = with_light(
+        "LIGHTBEGIN\n#X\nPOSITION 0 0 2\nINTENSITY 3\nDISTRIBUTION IES ies/isotropic_lm63_2002.ies\nLIGHTEND",
+    );
+    let e = parse_scene(&text, data).unwrap_err().errors;
+    assert!(
+        e[0].message
+            .contains("takes FLUX (to scale the table) or neither"),
+        "{e:?}"
+    );
 }

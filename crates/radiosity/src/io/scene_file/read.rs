@@ -296,7 +296,6 @@ struct Parser<'a> {
     /// The `LIGHTBEGIN` blocks read so far.
     lights: Vec<Luminaire>,
     /// The folder that paths in the file (IES files) are relative to: the source name's.
-    #[allow(dead_code)]
     folder: std::path::PathBuf,
 }
 
@@ -1137,8 +1136,33 @@ impl<'a> Parser<'a> {
     /// `DISTRIBUTION IES file.ies`: the rest of the line (trimmed) is the path, relative to
     /// the scene file's folder.
     fn ies_distribution(&mut self, line: &Line<'a>, word: Token<'a>) -> Step<Distribution> {
-        let msg = "IES photometry files are not read yet; use ISOTROPIC or COSINE";
-        Err(self.error_at(word, line, msg))
+        // The rest of the line after the word IES: a path may hold spaces.
+        let start = line
+            .code
+            .char_indices()
+            .nth(word.column - 1)
+            .map_or(line.code.len(), |(b, _)| b + word.text.len());
+        let written = line.code.get(start..).unwrap_or("").trim().to_string();
+        if written.is_empty() {
+            let msg = "expected the IES file's path after \"IES\" (relative to the scene \
+                       file), found end of line";
+            return Err(self.error(line.number, line.end_column, msg));
+        }
+        let path = self.folder.join(&written);
+        match crate::photometry::ies::IesPhotometry::read(&path) {
+            Ok(photometry) => Ok(Distribution::Ies {
+                written,
+                photometry: std::sync::Arc::new(photometry),
+            }),
+            Err(e) => {
+                let column = line.tokens.get(2).map_or(word.column, |t| t.column);
+                let msg = format!(
+                    "the light's IES file \"{written}\" (relative to the scene file's folder) \
+                     cannot be used: {e}"
+                );
+                Err(self.error(line.number, column, msg))
+            }
+        }
     }
 
     // ----- boxes -----

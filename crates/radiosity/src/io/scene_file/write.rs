@@ -106,6 +106,7 @@ fn write_light(l: &Luminaire, out: &mut impl Write) -> io::Result<()> {
     match &l.distribution {
         Distribution::Isotropic => writeln!(out, "DISTRIBUTION ISOTROPIC")?,
         Distribution::Cosine => writeln!(out, "DISTRIBUTION COSINE")?,
+        Distribution::Ies { written, .. } => writeln!(out, "DISTRIBUTION IES {written}")?,
     }
     if l.colour != Rgb::splat(1.0) {
         let c = l.colour.0;
