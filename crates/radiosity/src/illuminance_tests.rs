@@ -128,3 +128,62 @@ fn a_grid_runs_from_corner_to_corner_at_the_spacing() {
     assert!(grid(DVec3::ZERO, DVec3::X, 0.0, DVec3::Z, 100).is_none());
     assert!(grid(DVec3::ZERO, dvec3(100.0, 100.0, 0.0), 0.01, DVec3::Z, 1000).is_none());
 }
+
+#[test]
+fn points_files_are_read_and_bad_lines_named() {
+    let pts = parse_points(
+        "name,x,y,z,nx,ny,nz\nA,1,2,3,0,0,1\n\nB, 0.5 ,0,0,0,1,0\n",
+        "p.csv",
+    )
+    .unwrap();
+    assert_eq!(pts.len(), 2);
+    assert_eq!(pts[1].position, dvec3(0.5, 0.0, 0.0));
+    assert_eq!(pts[1].normal, DVec3::Y);
+    let err = |t: &str| parse_points(t, "p.csv").unwrap_err().to_string();
+    assert_eq!(
+        err("name,x,y\n"),
+        "p.csv:1: error: expected the header \"name,x,y,z,nx,ny,nz\", found \"name,x,y\""
+    );
+    assert!(
+        err("name,x,y,z,nx,ny,nz\nA,1,2,3,0,0\n").starts_with("p.csv:2: error: expected 7 fields")
+    );
+    assert!(
+        err("name,x,y,z,nx,ny,nz\nA,1,q,3,0,0,1\n").contains("finite number for y, found \"q\"")
+    );
+    assert!(err("name,x,y,z,nx,ny,nz\nA,1,2,3,0,0,0\n").contains("the normal nx,ny,nz is 0,0,0"));
+    let mut out = Vec::new();
+    write_lux_csv(
+        &pts[..1],
+        &[Lux {
+            direct: 1.5,
+            indirect: 0.25,
+            total: 1.75,
+        }],
+        &mut out,
+    )
+    .unwrap();
+    assert_eq!(
+        String::from_utf8(out).unwrap(),
+        "name,x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux\nA,1,2,3,0,0,1,1.5,0.25,1.75\n"
+    );
+}
+
+#[test]
+fn the_grid_picture_colours_cells_by_value_with_a_legend() {
+    // 3 x 2 cells, values rising along the row; the largest is red, 0 dark blue.
+    let values = [0.0, 50.0, 100.0, 25.0, 75.0, 100.0];
+    let img = grid_picture(&values, [3, 2]);
+    assert!(img.width() > 3 * 24 && img.height() >= 240);
+    assert_eq!(false_colour(0.0), [0, 0, 153]);
+    assert_eq!(false_colour(1.0), [230, 26, 0]);
+    // Row 0 is drawn at the bottom: cell (0, 0) holds 0 (dark blue) at its corner pixel
+    // just inside the white grid line.
+    let cell = (img.width() as i64 - 20 - 90) / 3;
+    let bottom_left = img.get_pixel(10 + 1, (10 + 2 * cell - 2) as u32).0;
+    assert_eq!(bottom_left, false_colour(0.0));
+    let top_left = img.get_pixel(10 + 1, 10 + 1).0;
+    assert_eq!(top_left, false_colour(0.25));
+    assert_eq!(lux_label(1234.4), "1234");
+    assert_eq!(lux_label(12.34), "12.3");
+    assert_eq!(lux_label(1.234), "1.23");
+}
