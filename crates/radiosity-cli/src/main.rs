@@ -21,8 +21,8 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 use args::{
-    BenchArgs, CheckArgs, CompareArgs, ExportArgs, FormFactorArgs, GenerateCommand, PathTraceArgs,
-    RenderArgs, SolveArgs, ValidateCommand, ViewArgs,
+    BenchArgs, CheckArgs, CompareArgs, ExportArgs, FormFactorArgs, GenerateCommand,
+    IlluminanceArgs, PathTraceArgs, RenderArgs, SolveArgs, ValidateCommand, ViewArgs,
 };
 use errors::describe;
 
@@ -45,6 +45,10 @@ enum Command {
     Formfactors(FormFactorArgs),
     /// Solve a scene and write the radiosity of every element as CSV (or JSON for *.json).
     Solve(SolveArgs),
+    /// Illuminance in lux at calculation points (--points P.csv) or on a grid (--grid, with
+    /// --png for a picture): direct (from emitting surfaces and point luminaires) and
+    /// indirect (from reflected light), computed at each point from the solution.
+    Illuminance(IlluminanceArgs),
     /// Print statistics of a scene: surfaces, elements, area, form-factor row sums,
     /// reciprocity, energy balance and stage times.
     Check(CheckArgs),
@@ -96,6 +100,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => commands::render::run(args),
         Command::Formfactors(args) => commands::formfactors::run(args),
         Command::Solve(args) => commands::solve::run(args),
+        Command::Illuminance(args) => commands::illuminance::run(args),
         Command::Check(args) => commands::check::run(args),
         Command::Bench(args) => commands::bench::run(args),
         Command::Compare(args) => commands::compare::run(args),

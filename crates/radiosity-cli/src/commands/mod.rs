@@ -7,6 +7,7 @@ pub mod compare;
 pub mod export;
 pub mod formfactors;
 pub mod generate;
+pub mod illuminance;
 pub mod pathtrace;
 pub mod render;
 pub mod solve;

@@ -7,6 +7,7 @@ mod browser;
 mod commands;
 mod formats_out;
 mod hostile;
+mod illuminance;
 mod imports;
 mod pathtrace;
 mod validate;
