@@ -18,7 +18,8 @@ case "$target" in
     vrml) options=(-dict=vrml.dict -max_len=8192) ;;
     dxf) options=(-dict=dxf.dict -max_len=8192) ;;
     ies) options=(-dict=ies.dict -max_len=8192) ;;
-    *) echo "unknown target $target (scene_file, form_factor_file, obj, gltf, vrml, dxf or ies)" >&2; exit 2 ;;
+    points) options=(-max_len=4096) ;;
+    *) echo "unknown target $target (scene_file, form_factor_file, obj, gltf, vrml, dxf, ies or points)" >&2; exit 2 ;;
 esac
 host=$(rustc -vV | sed -n "s/^host: //p")
 binary="${CARGO_TARGET_DIR:-target}/$host/release/$target"

@@ -419,3 +419,33 @@ pub fn ies(data: &[u8]) {
         assert!(stated > 0.0, "stated lumens {stated}");
     }
 }
+
+/// The illuminance command's points CSV reader on arbitrary text: it never panics, refuses
+/// with the file and a line from 1, and every point it accepts is finite with a non-zero
+/// normal; the accepted points written as a lux CSV give one row each under the header.
+pub fn points(data: &[u8]) {
+    use radiosity::illuminance::{parse_points, write_lux_csv, Lux, LUX_HEADER};
+    init();
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match parse_points(text, "fuzz.csv") {
+        Ok(points) => {
+            for p in &points {
+                assert!(p.position.is_finite() && p.normal.is_finite());
+                assert!(p.normal.length_squared() > 0.0);
+            }
+            let lux = vec![Lux::default(); points.len()];
+            let mut out = Vec::new();
+            write_lux_csv(&points, &lux, &mut out).expect("writing to memory");
+            let written = String::from_utf8(out).expect("UTF-8");
+            assert!(written.starts_with(LUX_HEADER));
+            // Names hold no line break (lines split them), so one row per point.
+            assert_eq!(written.lines().count(), 1 + points.len());
+        }
+        Err(error) => {
+            let message = error.to_string();
+            assert!(message.starts_with("fuzz.csv:"), "{message}");
+        }
+    }
+}
