@@ -210,3 +210,14 @@ fn rows_report_percent_and_pass_within_tolerance() {
     assert_eq!(rows[0].difference_percent(), None);
     assert!(rows[0].passes(0.5));
 }
+
+#[test]
+fn every_case_scene_parses_with_its_lights_and_openings() {
+    for case in cases() {
+        let file = crate::io::scene_file::parse_scene(&case.scene, &case.stem)
+            .unwrap_or_else(|e| panic!("case {}: {e}", case.id));
+        let lights = file.scene.lights.len();
+        let expected = usize::from(!matches!(case.id.as_str(), "5.3" | "5.9" | "5.11"));
+        assert_eq!(lights, expected, "case {}", case.id);
+    }
+}
