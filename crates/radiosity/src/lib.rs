@@ -71,6 +71,7 @@ pub mod budget;
 pub mod compare;
 pub mod form_factor;
 pub mod geometry;
+pub mod illuminance;
 pub mod io;
 pub mod light;
 pub mod luminaire;
