@@ -128,7 +128,8 @@ fn floor_and_rug(lift: f64, rug_only: bool) -> radiosity::scene::Scene {
         name: name.into(),
         emission: Rgb::BLACK,
         reflectance: Rgb([0.5; 3]),
-        vertices, photometry: Default::default(), 
+        vertices,
+        photometry: Default::default(),
     };
     let mut surfaces = vec![surface("floor", quad(0., 4., 0., 4., 0.))];
     if rug_only {
@@ -137,7 +138,8 @@ fn floor_and_rug(lift: f64, rug_only: bool) -> radiosity::scene::Scene {
     surfaces.push(surface("rug", quad(1., 3., 1., 2., lift)));
     Scene {
         surfaces,
-        camera: None, lights: Vec::new(), 
+        camera: None,
+        lights: Vec::new(),
     }
 }
 

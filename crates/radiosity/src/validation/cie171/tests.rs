@@ -221,3 +221,53 @@ fn every_case_scene_parses_with_its_lights_and_openings() {
         assert_eq!(lights, expected, "case {}", case.id);
     }
 }
+
+/// The small cases run through the program (mesh, solve, illuminance at the points) in
+/// `cargo test`: every point within the 1 % of the reference.
+#[test]
+fn direct_cases_are_within_one_percent_through_the_program() {
+    for case in [
+        point_source(),
+        area_source(),
+        roof_opening(),
+        facade_opening(),
+    ] {
+        let computed = compute(&case, crate::Solver::DEFAULT_GAUSS_SEIDEL).unwrap();
+        for row in case.compare(&computed) {
+            assert!(
+                row.passes(case.tolerance_percent),
+                "case {} point {}: reference {} computed {} ({:?} %)",
+                row.case,
+                row.point,
+                row.reference,
+                row.computed,
+                row.difference_percent()
+            );
+        }
+    }
+}
+
+/// Every case through the program, with the table printed: `cargo test -p radiosity --lib
+/// all_cie171_cases -- --ignored --nocapture` (minutes: 5.6 and 5.7 mesh 2,000 elements).
+#[test]
+#[ignore = "minutes in a test build; `radiosity validate cie171` runs the same"]
+fn all_cie171_cases_within_the_targets() {
+    let mut failures = Vec::new();
+    for case in cases() {
+        let computed = compute(&case, crate::Solver::DEFAULT_GAUSS_SEIDEL).unwrap();
+        for row in case.compare(&computed) {
+            println!(
+                "| {} | {} | {:.4} | {:.4} | {:?} |",
+                row.case,
+                row.point,
+                row.reference,
+                row.computed,
+                row.difference_percent()
+            );
+            if !row.passes(case.tolerance_percent) {
+                failures.push(format!("{} {}", row.case, row.point));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "outside the targets: {failures:?}");
+}
