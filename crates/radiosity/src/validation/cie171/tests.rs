@@ -271,3 +271,28 @@ fn all_cie171_cases_within_the_targets() {
     }
     assert!(failures.is_empty(), "outside the targets: {failures:?}");
 }
+
+/// 5.7 at half the element area: how the points next to the obstruction's shadows move
+/// under refinement (`-- --ignored --nocapture`; a minute or more).
+#[test]
+#[ignore = "a minute or more in a test build"]
+fn reflection_obstructed_under_refinement() {
+    let case = reflection_obstructed();
+    let overrides = crate::Overrides {
+        max_patch_area: Some(0.02),
+        integral_steps: None,
+    };
+    let computed = compute_with(&case, crate::Solver::DEFAULT_GAUSS_SEIDEL, overrides).unwrap();
+    let rows = case.compare(&computed);
+    for row in &rows {
+        println!(
+            "| {} 0.02 | {} | {:.4} | {:.4} | {:?} |",
+            row.case,
+            row.point,
+            row.reference,
+            row.computed,
+            row.difference_percent()
+        );
+    }
+    assert!(rows.iter().all(|r| r.passes(case.tolerance_percent)));
+}
