@@ -272,27 +272,35 @@ fn all_cie171_cases_within_the_targets() {
     assert!(failures.is_empty(), "outside the targets: {failures:?}");
 }
 
-/// 5.7 at half the element area: how the points next to the obstruction's shadows move
-/// under refinement (`-- --ignored --nocapture`; a minute or more).
+/// 5.7 at the scene's mesh and at half its element area: the points whose view of the lit
+/// floor is cut by the obstruction's shadows err by a few percent (-2.6 % and -1.6 % at
+/// MAX_PATCH_AREA 0.04 on the first run), and the error must shrink under refinement
+/// (-1.7 % and -0.8 % at 0.02): partly shadowed, partly visible elements are sampled, not
+/// clipped, so the error is first order in the element size (`-- --ignored --nocapture`;
+/// a minute or more).
 #[test]
 #[ignore = "a minute or more in a test build"]
-fn reflection_obstructed_under_refinement() {
+fn reflection_obstructed_error_shrinks_under_refinement() {
     let case = reflection_obstructed();
+    let solver = crate::Solver::DEFAULT_GAUSS_SEIDEL;
+    let coarse = case.compare(&compute(&case, solver).unwrap());
     let overrides = crate::Overrides {
         max_patch_area: Some(0.02),
         integral_steps: None,
     };
-    let computed = compute_with(&case, crate::Solver::DEFAULT_GAUSS_SEIDEL, overrides).unwrap();
-    let rows = case.compare(&computed);
-    for row in &rows {
-        println!(
-            "| {} 0.02 | {} | {:.4} | {:.4} | {:?} |",
-            row.case,
-            row.point,
-            row.reference,
-            row.computed,
-            row.difference_percent()
+    let fine = case.compare(&compute_with(&case, solver, overrides).unwrap());
+    for (c, f) in coarse.iter().zip(&fine) {
+        let (dc, df) = (
+            c.difference_percent().unwrap(),
+            f.difference_percent().unwrap(),
         );
+        println!(
+            "| 5.7 | {} | {:.4} | {dc:+.3} % at 0.04 | {df:+.3} % at 0.02 |",
+            c.point, c.reference
+        );
+        // Points off the shadows' lines are within 0.1 % on both meshes and may wobble.
+        if dc.abs() > 0.5 {
+            assert!(df.abs() < 0.8 * dc.abs(), "{}: {dc} % then {df} %", c.point);
+        }
     }
-    assert!(rows.iter().all(|r| r.passes(case.tolerance_percent)));
 }
