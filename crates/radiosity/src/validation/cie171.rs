@@ -713,6 +713,62 @@ pub fn cases() -> Vec<Case> {
     all
 }
 
+/// Runs `case` through the program: parses its scene, meshes it, computes the form factors
+/// by the exact contour integral ([`crate::form_factor::FormFactorMethod::Contour`], with
+/// the scene's `INTEGRAL_STEPS` for the visibility of occluded pairs: a closed room's rows
+/// then sum to 1 to rounding, which the cube at reflectance 0.95 needs, as any leak is
+/// multiplied by 1 / (1 - rho)), solves with `solver` (point lights are the first bounce)
+/// and returns `(direct, indirect)` lux at each point by
+/// [`crate::illuminance::illuminance`], the calculation `radiosity illuminance` makes.
+pub fn compute(case: &Case, solver: crate::Solver) -> Result<Vec<(f64, f64)>, ComputeError> {
+    compute_with(case, solver, crate::Overrides::default())
+}
+
+/// [`compute`] with the scene's meshing settings overridden (a finer `MAX_PATCH_AREA`).
+pub fn compute_with(
+    case: &Case,
+    solver: crate::Solver,
+    overrides: crate::Overrides,
+) -> Result<Vec<(f64, f64)>, ComputeError> {
+    use crate::progress::NoProgress;
+    let file = crate::io::scene_file::parse_scene(&case.scene, &case.stem)
+        .map_err(|e| ComputeError(e.to_string()))?;
+    let settings = overrides.apply(file.settings);
+    let mut prepared = crate::Prepared::new(file.scene, settings, &NoProgress)
+        .map_err(|e| ComputeError(e.to_string()))?;
+    prepared.method = crate::form_factor::FormFactorMethod::Contour {
+        steps: settings.integral_steps,
+    };
+    let request = crate::SolveRequest::new(solver);
+    let solution = crate::pipeline::solve(
+        &prepared,
+        &request,
+        &mut crate::solve::keep_going,
+        &NoProgress,
+    )
+    .map_err(|e| ComputeError(e.to_string()))?;
+    let points: Vec<crate::illuminance::CalcPoint> = case
+        .points
+        .iter()
+        .map(|p| crate::illuminance::CalcPoint {
+            name: p.name.clone(),
+            position: p.position,
+            normal: p.normal,
+        })
+        .collect();
+    Ok(
+        crate::illuminance::illuminance(&prepared, &solution, &points)
+            .into_iter()
+            .map(|lux| (lux.direct, lux.indirect))
+            .collect(),
+    )
+}
+
+/// A case that could not be run: the scene, the mesh or the solve refused, with why.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct ComputeError(pub String);
+
 /// Writes every case's scene and points file into `dir` (`<stem>.scene`,
 /// `<stem>.points.csv`), returning the paths written.
 pub fn write_files(dir: &std::path::Path) -> std::io::Result<Vec<std::path::PathBuf>> {

@@ -36,7 +36,14 @@ pub fn point_polygon_factor(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
         let angle = length.atan2(a.dot(b));
         sum += angle * n.dot(cross / length);
     }
-    (sum / (2.0 * std::f64::consts::PI)).abs()
+    let factor = (sum / (2.0 * std::f64::consts::PI)).abs();
+    // A polygon seen edge-on (in the point's own plane) has no form factor; the contour sum
+    // leaves rounding of about 1e-13 there.
+    if factor < 1e-12 {
+        0.0
+    } else {
+        factor
+    }
 }
 
 /// The polygon's part where `n . (x - p) >= 0` (Sutherland-Hodgman against one plane).
