@@ -373,3 +373,79 @@ pub fn dxf(data: &[u8]) {
         &ImportOptions::default(),
     ));
 }
+
+/// The IES LM-63 reader on arbitrary bytes: text through `IesPhotometry::parse`, bytes that
+/// are not UTF-8 through `IesPhotometry::read` (a file, read as Latin-1). Every error must
+/// format and name the file; an accepted table must give finite, non-negative intensities in
+/// every direction tried, a finite non-negative flux and tilt factors.
+pub fn ies(data: &[u8]) {
+    use radiosity::photometry::{IesError, IesPhotometry, ies::MAX_CANDELA};
+    init();
+    let result = match std::str::from_utf8(data) {
+        Ok(text) => IesPhotometry::parse(text, std::path::Path::new("fuzz.ies")),
+        Err(_) => {
+            let path = scratch_file("lamp.ies");
+            std::fs::write(&path, data).expect("writing the scratch file");
+            let result = IesPhotometry::read(&path);
+            let _ = std::fs::remove_file(&path);
+            result
+        }
+    };
+    let ies = match result {
+        Ok(ies) => ies,
+        Err(error) => {
+            let message = error.to_string();
+            assert!(message.contains("lamp.ies") || message.contains("fuzz.ies"), "{message}");
+            if let IesError::Invalid { line, .. } = error {
+                assert!(line >= 1, "{message}");
+            }
+            return;
+        }
+    };
+    for i in 0..64 {
+        let theta = f64::from(i) * 0.05 - 0.2;
+        let phi = f64::from(i) * 0.7 - 3.0;
+        let candela = ies.candela(theta, phi);
+        assert!(
+            candela.is_finite() && (0.0..=MAX_CANDELA * (1.0 + 1e-12)).contains(&candela),
+            "candela {candela} at theta {theta}, phi {phi}"
+        );
+        let tilt = ies.tilt_factor(theta);
+        assert!(tilt.is_finite() && tilt >= 0.0, "tilt factor {tilt}");
+    }
+    let flux = ies.table_lumens();
+    assert!(flux.is_finite() && flux >= 0.0, "table lumens {flux}");
+    if let Some(stated) = ies.stated_lumens() {
+        assert!(stated > 0.0, "stated lumens {stated}");
+    }
+}
+
+/// The illuminance command's points CSV reader on arbitrary text: it never panics, refuses
+/// with the file and a line from 1, and every point it accepts is finite with a non-zero
+/// normal; the accepted points written as a lux CSV give one row each under the header.
+pub fn points(data: &[u8]) {
+    use radiosity::illuminance::{parse_points, write_lux_csv, Lux, LUX_HEADER};
+    init();
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match parse_points(text, "fuzz.csv") {
+        Ok(points) => {
+            for p in &points {
+                assert!(p.position.is_finite() && p.normal.is_finite());
+                assert!(p.normal.length_squared() > 0.0);
+            }
+            let lux = vec![Lux::default(); points.len()];
+            let mut out = Vec::new();
+            write_lux_csv(&points, &lux, &mut out).expect("writing to memory");
+            let written = String::from_utf8(out).expect("UTF-8");
+            assert!(written.starts_with(LUX_HEADER));
+            // Names hold no line break (lines split them), so one row per point.
+            assert_eq!(written.lines().count(), 1 + points.len());
+        }
+        Err(error) => {
+            let message = error.to_string();
+            assert!(message.starts_with("fuzz.csv:"), "{message}");
+        }
+    }
+}

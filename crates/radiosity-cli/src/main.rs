@@ -22,8 +22,8 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 use args::{
-    BenchArgs, CheckArgs, CompareArgs, ExportArgs, FormFactorArgs, GenerateCommand, PathTraceArgs,
-    RenderArgs, SolveArgs, ViewArgs,
+    BenchArgs, CheckArgs, CompareArgs, ExportArgs, FormFactorArgs, GenerateCommand,
+    IlluminanceArgs, PathTraceArgs, RenderArgs, SolveArgs, ValidateCommand, ViewArgs,
 };
 use errors::describe;
 
@@ -46,6 +46,10 @@ enum Command {
     Formfactors(FormFactorArgs),
     /// Solve a scene and write the radiosity of every element as CSV (or JSON for *.json).
     Solve(SolveArgs),
+    /// Illuminance in lux at calculation points (--points P.csv) or on a grid (--grid, with
+    /// --png for a picture): direct (from emitting surfaces and point luminaires) and
+    /// indirect (from reflected light), computed at each point from the solution.
+    Illuminance(IlluminanceArgs),
     /// Print statistics of a scene: surfaces, elements, area, form-factor row sums,
     /// reciprocity, energy balance and stage times.
     Check(CheckArgs),
@@ -72,6 +76,11 @@ enum Command {
         #[command(subcommand)]
         what: GenerateCommand,
     },
+    /// Run published validation cases and compare with their reference values.
+    Validate {
+        #[command(subcommand)]
+        what: ValidateCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -92,6 +101,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => commands::render::run(args),
         Command::Formfactors(args) => commands::formfactors::run(args),
         Command::Solve(args) => commands::solve::run(args),
+        Command::Illuminance(args) => commands::illuminance::run(args),
         Command::Check(args) => commands::check::run(args),
         Command::Bench(args) => commands::bench::run(args),
         Command::Compare(args) => commands::compare::run(args),
@@ -101,5 +111,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Generate {
             what: GenerateCommand::Building(args),
         } => commands::generate::building(args),
+        Command::Validate {
+            what: ValidateCommand::Cie171(args),
+        } => commands::validate::cie171(args),
     }
 }

@@ -26,6 +26,8 @@
 //! * [`render`]: a CPU ray-cast camera (paper 2.6), exposure and gamma (paper 2.7), PNG
 //!   images.
 //! * [`pathtrace`]: an unbiased diffuse path tracer, the yardstick for radiosity images.
+//! * [`photometry`]: luminaire data: IES LM-63 candela tables.
+//! * [`validation`]: the CIE 171:2006 analytical cases with references from first principles.
 //! * [`progress`]: the one interface long work reports through.
 //! * [`io`]: every file read or written: the paper's Appendix A scene format, the
 //!   form-factor file (paper 2.8), the per-element solution as CSV or JSON, PNG images.
@@ -69,10 +71,13 @@ pub mod budget;
 pub mod compare;
 pub mod form_factor;
 pub mod geometry;
+pub mod illuminance;
 pub mod io;
 pub mod light;
+pub mod luminaire;
 pub mod mesh;
 pub mod pathtrace;
+pub mod photometry;
 pub mod pipeline;
 pub mod progress;
 pub mod render;
@@ -80,6 +85,7 @@ pub mod scene;
 pub mod shade;
 pub mod solve;
 mod splitmix;
+pub mod validation;
 pub mod visibility;
 
 #[cfg(test)]

@@ -224,11 +224,18 @@ impl ElementLight {
     }
 
     /// Each element gets the reflectance and emission of the scene surface it belongs to.
+    ///
+    /// With point luminaires in the scene, their direct light is the first bounce: each
+    /// element's average illuminance from them, with occlusion by the scene's surfaces
+    /// ([`crate::luminaire::element_irradiance`]), times its reflectance, is added to its
+    /// emission. Every solver then carries it on unchanged; the element's own emission is
+    /// still its surface's ([`crate::scene::Surface::emission`]), which is what reports of
+    /// direct and indirect light separate.
     pub fn of_mesh(
         mesh: &crate::mesh::Mesh,
         scene: &crate::scene::Scene,
     ) -> Result<ElementLight, LightError> {
-        let (reflectance, emission) = mesh
+        let (reflectance, mut emission): (Vec<Rgb>, Vec<Rgb>) = mesh
             .elements
             .iter()
             .map(|e| {
@@ -236,6 +243,13 @@ impl ElementLight {
                 (s.reflectance, s.emission)
             })
             .unzip();
+        if !scene.lights.is_empty() {
+            let occluders = crate::visibility::PolygonBvh::over_surfaces(scene);
+            let direct = crate::luminaire::element_irradiance(mesh, &scene.lights, &occluders);
+            for ((e, rho), d) in emission.iter_mut().zip(&reflectance).zip(direct) {
+                *e += *rho * d;
+            }
+        }
         ElementLight::new(reflectance, emission)
     }
 

@@ -21,6 +21,7 @@ fn surface(name: &str, vertices: Vec<DVec3>, emission: f64) -> Surface {
         emission: Rgb([emission; 3]),
         reflectance: Rgb([0.5; 3]),
         vertices,
+        photometry: Default::default(),
     }
 }
 
@@ -100,7 +101,7 @@ proptest! {
                 surface("lower", ellipse_polygon(&lower, a, b, 0.0, false), 1.0),
                 surface("upper", ellipse_polygon(&upper, b, a, gap, true), 0.0),
             ],
-            camera: None,
+            camera: None, lights: Vec::new(),
         };
         let moved = transformed(&scene, scale, shift * scale);
         // One element per triangle or quad, a fan of triangles for larger polygons: the
@@ -140,7 +141,7 @@ proptest! {
             .enumerate()
             .map(|(k, v)| surface(&format!("f{k}"), v, if k == 0 { 1.0 } else { 0.0 }))
             .collect();
-        let scene = Scene { surfaces, camera: None };
+        let scene = Scene { surfaces, camera: None, lights: Vec::new(),  };
         let moved = transformed(&scene, scale, shift * scale);
         // About four elements to a face; the ratio of area to MAX_PATCH_AREA is irrational
         // enough (0.2371...) that rounding cannot move a grid count.
@@ -261,6 +262,7 @@ fn meshing_refuses_a_degenerate_surface_before_planning() {
             0.0,
         )],
         camera: None,
+        lights: Vec::new(),
     };
     match mesh_scene(&scene, 1.0) {
         Err(MeshError::InvalidSurface {
@@ -278,6 +280,7 @@ fn meshing_refuses_a_degenerate_surface_before_planning() {
             0.0,
         )],
         camera: None,
+        lights: Vec::new(),
     };
     match mesh_scene(&unit, 1e-300) {
         Err(e @ MeshError::TooManyElements { suggested, .. }) => {
@@ -350,6 +353,7 @@ fn ray_queries_answer_the_same_at_any_scale_and_position() {
             Scene {
                 surfaces: vec![floor, ceiling],
                 camera: None,
+                lights: Vec::new(),
             },
             0.1 * q * q,
         );

@@ -226,6 +226,7 @@ mod tests {
             emission: Rgb([emission; 3]),
             reflectance: Rgb([0.5; 3]),
             vertices,
+            photometry: Default::default(),
         }
     }
 
@@ -233,6 +234,7 @@ mod tests {
         Scene {
             surfaces,
             camera: None,
+            lights: Vec::new(),
         }
     }
 

@@ -656,10 +656,12 @@ SCENEEND
             emission: Rgb([0.0; 3]),
             reflectance: Rgb([0.5; 3]),
             vertices: square_at_z(z, 0).0.remove(0).into_iter().rev().collect(),
+            photometry: Default::default(),
         };
         let scene = Scene {
             surfaces: vec![surface("near", 1.0), surface("far", 2.0)],
             camera: None,
+            lights: Vec::new(),
         };
         let surfaces = PolygonBvh::over_surfaces(&scene);
         assert_eq!(surfaces.len(), 2);

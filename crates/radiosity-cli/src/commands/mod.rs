@@ -7,9 +7,11 @@ pub mod compare;
 pub mod export;
 pub mod formfactors;
 pub mod generate;
+pub mod illuminance;
 pub mod pathtrace;
 pub mod render;
 pub mod solve;
+pub mod validate;
 pub mod view;
 
 use std::ops::ControlFlow;

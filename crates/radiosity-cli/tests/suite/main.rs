@@ -8,6 +8,8 @@ mod commands;
 mod first_hour;
 mod formats_out;
 mod hostile;
+mod illuminance;
 mod imports;
 mod pathtrace;
+mod validate;
 mod view;

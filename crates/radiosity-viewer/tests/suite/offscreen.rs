@@ -129,6 +129,7 @@ fn floor_and_rug(lift: f64, rug_only: bool) -> radiosity::scene::Scene {
         emission: Rgb::BLACK,
         reflectance: Rgb([0.5; 3]),
         vertices,
+        photometry: Default::default(),
     };
     let mut surfaces = vec![surface("floor", quad(0., 4., 0., 4., 0.))];
     if rug_only {
@@ -138,6 +139,7 @@ fn floor_and_rug(lift: f64, rug_only: bool) -> radiosity::scene::Scene {
     Scene {
         surfaces,
         camera: None,
+        lights: Vec::new(),
     }
 }
 

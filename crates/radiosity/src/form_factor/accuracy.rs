@@ -79,6 +79,7 @@ fn surface(name: &str, vertices: Vec<DVec3>) -> Surface {
         emission: Rgb::BLACK,
         reflectance: Rgb([0.5; 3]),
         vertices,
+        photometry: Default::default(),
     }
 }
 
@@ -86,6 +87,7 @@ fn scene(surfaces: Vec<Surface>) -> Scene {
     Scene {
         surfaces,
         camera: None,
+        lights: Vec::new(),
     }
 }
 

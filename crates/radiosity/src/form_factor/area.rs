@@ -525,10 +525,12 @@ pub fn area_integral_pair(poly1: &[DVec3], poly2: &[DVec3], k: u32) -> f64 {
         emission: Rgb::BLACK,
         reflectance: Rgb::BLACK,
         vertices: v.to_vec(),
+        photometry: Default::default(),
     };
     let scene = Scene {
         surfaces: vec![surface(poly1), surface(poly2)],
         camera: None,
+        lights: Vec::new(),
     };
     let mesh = mesh_scene(&scene, f64::MAX).expect("two polygons always mesh");
     let empty = crate::visibility::PolygonBvh::new::<Vec<DVec3>>(&[], &[]);

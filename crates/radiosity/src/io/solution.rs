@@ -164,10 +164,12 @@ mod tests {
             emission: Rgb::BLACK,
             reflectance: Rgb([0.5; 3]),
             vertices: rect(z),
+            photometry: Default::default(),
         };
         Scene {
             surfaces: vec![surface("plain", 0.0), surface("a, \"b\"\nc", 1.0)],
             camera: None,
+            lights: Vec::new(),
         }
     }
 

@@ -179,10 +179,12 @@ mod tests {
             emission: Rgb::BLACK,
             reflectance: Rgb([0.5; 3]),
             vertices: rect(z, w),
+            photometry: Default::default(),
         };
         let scene = Scene {
             surfaces: vec![surface("wall", 0.0, 3.0), surface("a, b", 1.0, 1.0)],
             camera: None,
+            lights: Vec::new(),
         };
         let mesh = mesh_scene(&scene, 1.0).unwrap();
         assert_eq!(mesh.len(), 4);

@@ -213,8 +213,10 @@ mod tests {
                     dvec3(4., 4., 0.),
                     dvec3(0., 4., 0.),
                 ],
+                photometry: Default::default(),
             }],
             camera: None,
+            lights: Vec::new(),
         };
         (mesh_scene(&scene, 1.0).unwrap(), 1)
     }

@@ -454,8 +454,10 @@ mod tests {
                     dvec3(3., 2., 0.),
                     dvec3(0., 2., 0.),
                 ],
+                photometry: Default::default(),
             }],
             camera: None,
+            lights: Vec::new(),
         };
         let mesh = mesh_scene(&scene, 1.0).unwrap();
         let d = mesh.display();
@@ -521,6 +523,7 @@ mod tests {
             emission: Rgb::BLACK,
             reflectance: Rgb([0.5; 3]),
             vertices,
+            photometry: Default::default(),
         };
         let mut surfaces = vec![surface(
             "floor",
@@ -538,6 +541,7 @@ mod tests {
         let scene = Scene {
             surfaces,
             camera: None,
+            lights: Vec::new(),
         };
         let grid = mesh_scene(&scene, 1.0).unwrap();
         let (mesh, report) = refine_contacts(&grid, &scene, &PolygonBvh::over_surfaces(&scene));

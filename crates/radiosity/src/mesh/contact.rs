@@ -358,6 +358,7 @@ mod tests {
             emission: Rgb::BLACK,
             reflectance: Rgb([0.5; 3]),
             vertices,
+            photometry: Default::default(),
         }
     }
 
@@ -380,6 +381,7 @@ mod tests {
         Scene {
             surfaces,
             camera: None,
+            lights: Vec::new(),
         }
     }
 
@@ -450,6 +452,7 @@ mod tests {
                     surface("rug", quad(0.5, 2.5, 1., 2., lift)),
                 ],
                 camera: None,
+                lights: Vec::new(),
             };
             let (mesh, report) = refine(&scene);
             assert!(

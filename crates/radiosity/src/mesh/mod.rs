@@ -689,9 +689,11 @@ mod tests {
                     emission: Rgb::BLACK,
                     reflectance: Rgb([0.5; 3]),
                     vertices,
+                    photometry: Default::default(),
                 })
                 .collect(),
             camera: None,
+            lights: Vec::new(),
         }
     }
 

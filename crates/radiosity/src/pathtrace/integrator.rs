@@ -52,6 +52,9 @@ struct Traced {
 /// The surfaces of a scene in a BVH of whole polygons, ready to trace any number of paths.
 pub struct PathTracer {
     bvh: PolygonBvh,
+    /// The scene's point luminaires: sampled at every hit (next-event estimation to a
+    /// point, with no competing strategy: no bounce can reach a point).
+    points: Vec<crate::luminaire::Luminaire>,
     surfaces: Vec<Traced>,
     lights: Lights,
     /// Centre of the scene's bounding box.
@@ -101,6 +104,7 @@ impl PathTracer {
         Ok(PathTracer {
             epsilon: 1e-9 * bvh.scale(),
             lights: Lights::new(scene),
+            points: scene.lights.clone(),
             bvh,
             surfaces,
             centre: 0.5 * (lo + hi),
@@ -168,6 +172,9 @@ impl PathTracer {
             if nee && s.reflectance.max_band() > 0.0 {
                 radiosity += throughput * s.reflectance * self.light_sample(x, s.normal, rng);
             }
+            if !self.points.is_empty() && s.reflectance.max_band() > 0.0 {
+                radiosity += throughput * s.reflectance * self.point_irradiance(x, s.normal);
+            }
             throughput = throughput * s.reflectance;
             if bounces >= settings.roulette_after_bounces {
                 let q = throughput.max_band().min(MAX_SURVIVAL_PROBABILITY);
@@ -216,6 +223,21 @@ impl PathTracer {
         let bounce_density = cos_x * FRAC_1_PI;
         let weight = power_heuristic(light_density, bounce_density);
         light.emission * (bounce_density / light_density * weight)
+    }
+}
+
+impl PathTracer {
+    /// The illuminance at `x` (normal `n`) from the point luminaires, I cos / d^2 for each
+    /// whose segment to `x` is clear: exact, no random numbers.
+    fn point_irradiance(&self, x: DVec3, n: DVec3) -> Rgb {
+        let mut sum = Rgb::BLACK;
+        for l in &self.points {
+            let e = l.irradiance_unoccluded(x, n);
+            if e.max_band() > 0.0 && !self.bvh.segment_blocked(x, l.position) {
+                sum += e;
+            }
+        }
+        sum
     }
 }
 

@@ -138,6 +138,7 @@ mod tests {
             emission: e,
             reflectance: Rgb::splat(0.5),
             vertices,
+            photometry: Default::default(),
         };
         let scene = Scene {
             surfaces: vec![
@@ -146,6 +147,7 @@ mod tests {
                 surface(Rgb([3.0, 0.0, 0.0]), rect(10.0, 1.0)),
             ],
             camera: None,
+            lights: Vec::new(),
         };
         let lights = Lights::new(&scene);
         assert!((lights.area_density(0) - 0.2).abs() < 1e-15);

@@ -13,6 +13,7 @@ fn scene(surfaces: Vec<Surface>) -> Scene {
     Scene {
         surfaces,
         camera: None,
+        lights: Vec::new(),
     }
 }
 
@@ -22,6 +23,7 @@ fn surface(name: &str, emission: Rgb, reflectance: Rgb, vertices: Vec<DVec3>) ->
         emission,
         reflectance,
         vertices,
+        photometry: Default::default(),
     }
 }
 

@@ -189,6 +189,8 @@ impl Emitter {
 /// point ([`DirectLight::irradiance`]).
 pub struct DirectLight {
     emitters: Vec<Emitter>,
+    /// The point luminaires: I cos / d^2 with one shadow ray each (sharp shadows).
+    points: Vec<crate::luminaire::Luminaire>,
     occluders: PolygonBvh,
 }
 
@@ -203,19 +205,40 @@ impl DirectLight {
                 .filter(|s| s.emission.max_band() > 0.0)
                 .filter_map(Emitter::new)
                 .collect(),
+            points: scene.lights.clone(),
             occluders: PolygonBvh::over_surfaces(scene),
         }
     }
 
-    /// True when the scene has no emitter (every irradiance is then 0).
+    /// True when the scene has no emitter and no point luminaire (every irradiance is then
+    /// 0).
     pub fn is_empty(&self) -> bool {
-        self.emitters.is_empty()
+        self.emitters.is_empty() && self.points.is_empty()
+    }
+
+    /// The direct illuminance at `x` (unit normal `n`) from the point luminaires alone,
+    /// I cos / d^2 for each whose segment to `x` is clear.
+    pub fn point_irradiance(&self, x: DVec3, n: DVec3) -> Rgb {
+        let mut sum = Rgb::default();
+        for l in &self.points {
+            let e = l.irradiance_unoccluded(x, n);
+            if e.max_band() > 0.0 && !self.occluders.segment_blocked(x, l.position) {
+                sum += e;
+            }
+        }
+        sum
     }
 
     /// The direct irradiance at `x` on a surface with unit front normal `n`:
-    /// `sum_j E_j F(x -> j) V_j`, per band (the quantity that, times rho, is the direct part
-    /// of the reflected radiosity). `salt` jitters the shadow rays' strata.
+    /// `sum_j E_j F(x -> j) V_j` over the emitting surfaces plus the point luminaires'
+    /// ([`DirectLight::point_irradiance`]), per band (the quantity that, times rho, is the
+    /// direct part of the reflected radiosity). `salt` jitters the shadow rays' strata.
     pub fn irradiance(&self, x: DVec3, n: DVec3, salt: u64) -> Rgb {
+        self.surface_irradiance(x, n, salt) + self.point_irradiance(x, n)
+    }
+
+    /// The direct irradiance at `x` (unit normal `n`) from the emitting surfaces alone.
+    pub fn surface_irradiance(&self, x: DVec3, n: DVec3, salt: u64) -> Rgb {
         let mut sum = Rgb::default();
         for e in &self.emitters {
             let f = point_to_polygon(x, n, &e.polygon);

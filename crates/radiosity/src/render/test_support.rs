@@ -10,6 +10,7 @@ pub(crate) fn scene(surfaces: Vec<Surface>) -> Scene {
     Scene {
         surfaces,
         camera: None,
+        lights: Vec::new(),
     }
 }
 
@@ -19,6 +20,7 @@ pub(crate) fn surface(name: &str, emission: f64, vertices: Vec<DVec3>) -> Surfac
         emission: Rgb([emission; 3]),
         reflectance: Rgb([0.5; 3]),
         vertices,
+        photometry: Default::default(),
     }
 }
 

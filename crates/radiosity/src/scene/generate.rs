@@ -471,6 +471,7 @@ pub fn building(params: &BuildingParams) -> SceneFile {
         scene: Scene {
             surfaces: b.surfaces,
             camera: None,
+            lights: Vec::new(),
         },
     }
 }
@@ -512,6 +513,7 @@ impl Builder<'_> {
             emission,
             reflectance,
             vertices,
+            photometry: Default::default(),
         });
     }
 

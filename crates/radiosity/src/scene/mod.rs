@@ -48,6 +48,34 @@ pub struct Surface {
     pub reflectance: Rgb,
     /// The corners, counter-clockwise seen from the front; at least 3, planar and convex.
     pub vertices: Vec<DVec3>,
+    /// How the scene file gave the emission, and whether the surface is an opening: kept so
+    /// that the writer gives the file back as it was written ([`SurfacePhotometry`]).
+    pub photometry: SurfacePhotometry,
+}
+
+/// How a surface's light was written in its scene file. The values that the solvers use
+/// are [`Surface::emission`] and [`Surface::reflectance`]; this only says where they came
+/// from, so that a written scene reads back with the same keywords.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfacePhotometry {
+    /// The emission's keywords.
+    pub emission: EmissionGiven,
+    /// `OPENING`: a hole in the model (a window, a roof light) through which light leaves;
+    /// its reflectance is 0. With a luminance it is a uniform sky seen through it.
+    pub opening: bool,
+}
+
+/// The keywords a surface's emission was written with (scene units: lengths in metres make
+/// exitances lm/m^2, see [`crate::io::scene_file`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum EmissionGiven {
+    /// `Er Eg Eb`: the exitance per band.
+    #[default]
+    Exitance,
+    /// `LUMINANCE L` (cd/m^2): a Lambertian emitter, exitance pi L in every band.
+    Luminance(f64),
+    /// `FLUX P` (lm): P spread uniformly over the surface, exitance P / area in every band.
+    Flux(f64),
 }
 
 /// A checked scene: its surfaces (geometry, emission and reflectance), and the camera it
@@ -58,6 +86,8 @@ pub struct Scene {
     pub surfaces: Vec<Surface>,
     /// A suggested camera, for scenes that come with one (the built-in Cornell box).
     pub camera: Option<CameraHint>,
+    /// The point luminaires (`LIGHTBEGIN` blocks), in file order.
+    pub lights: Vec<crate::luminaire::Luminaire>,
 }
 
 /// A camera that a scene suggests for rendering it.

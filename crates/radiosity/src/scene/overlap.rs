@@ -185,6 +185,7 @@ mod tests {
             emission: Rgb::BLACK,
             reflectance: Rgb([0.5; 3]),
             vertices,
+            photometry: Default::default(),
         };
         // The rectangle [x0, x1] x [z0, z1] at height y, facing +y.
         let quad = |x0: f64, x1: f64, z0: f64, z1: f64, y: f64| {
@@ -196,6 +197,7 @@ mod tests {
                 surface("rug", quad(1., 3., 1., 2., lift)),
             ],
             camera: None,
+            lights: Vec::new(),
         }
     }
 

@@ -363,15 +363,18 @@ fn scene_convenience_uses_surface_properties() {
                 emission: Rgb([1.0, 2.0, 3.0]),
                 reflectance: Rgb([0.1, 0.2, 0.3]),
                 vertices: bottom,
+                photometry: Default::default(),
             },
             Surface {
                 name: "ceiling".into(),
                 emission: Rgb::BLACK,
                 reflectance: Rgb([0.5, 0.6, 0.7]),
                 vertices: top,
+                photometry: Default::default(),
             },
         ],
         camera: None,
+        lights: Vec::new(),
     };
     let mesh = mesh_scene(&scene, 1.0).unwrap();
     assert_eq!(mesh.len(), 2);
@@ -428,9 +431,11 @@ fn closed_cube_with_computed_form_factors_stays_within_furnace_bounds() {
                 emission: Rgb([e; 3]),
                 reflectance: Rgb([rho; 3]),
                 vertices,
+                photometry: Default::default(),
             })
             .collect(),
         camera: None,
+        lights: Vec::new(),
     };
     assert_eq!(scene.surfaces[1].vertices[1], dvec3(0., 1., 1.));
     let mesh = mesh_scene(&scene, 0.25).unwrap();

@@ -38,15 +38,18 @@ fn scene() -> Scene {
                     dvec3(4., 0., 4.),
                     dvec3(4., 0., 0.),
                 ],
+                photometry: Default::default(),
             },
             Surface {
                 name: "light".into(),
                 emission: Rgb([E; 3]),
                 reflectance: Rgb::BLACK,
                 vertices: light(),
+                photometry: Default::default(),
             },
         ],
         camera: None,
+        lights: Vec::new(),
     }
 }
 

@@ -20,6 +20,7 @@ pub fn surface(name: &str, vertices: Vec<DVec3>) -> Surface {
         emission: Rgb::BLACK,
         reflectance: Rgb([0.5; 3]),
         vertices,
+        photometry: Default::default(),
     }
 }
 
@@ -46,6 +47,7 @@ pub fn closed_cube() -> Scene {
             .map(|(i, v)| surface(&format!("face{i}"), v.to_vec()))
             .collect(),
         camera: None,
+        lights: Vec::new(),
     }
 }
 

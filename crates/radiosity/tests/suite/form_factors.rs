@@ -164,6 +164,7 @@ fn occluder_blocks_opposed_squares() {
                 blocker(lo, hi),
             ],
             camera: None,
+            lights: Vec::new(),
         };
         let f = Meshed::new(&scene, 2.0).matrix(FormFactorMethod::AreaIntegral { steps: 8 });
         let unoccluded = reference::parallel_rectangles(1.0, 1.0, 1.0);
@@ -197,6 +198,7 @@ fn opposed_squares_scene() -> Scene {
             surface("b", opposed_square()),
         ],
         camera: None,
+        lights: Vec::new(),
     }
 }
 
@@ -337,6 +339,7 @@ fn perpendicular_squares_scene() -> Scene {
             surface("b", perpendicular_square()),
         ],
         camera: None,
+        lights: Vec::new(),
     }
 }
 
@@ -487,6 +490,7 @@ fn a_near_pair_is_judged_on_the_parts_that_face_each_other() {
             surface("floor", floor.clone()),
         ],
         camera: None,
+        lights: Vec::new(),
     };
     // Without the panel the pair exchanges something (the 5 cm strip): the test is not
     // vacuous.
@@ -544,6 +548,7 @@ fn a_partly_hidden_near_pair_is_judged_from_fine_points() {
             surface("plate", plate),
         ],
         camera: None,
+        lights: Vec::new(),
     };
     let (f, mesh) = matrix_for(&scene, 10.0, FormFactorMethod::AreaIntegral { steps: 2 });
     assert_eq!(mesh.len(), 3);

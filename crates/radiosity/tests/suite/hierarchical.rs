@@ -688,6 +688,7 @@ fn polygon_under_a_light(n: usize) -> Scene {
         emission: Light([e; 3]),
         reflectance: Light([0.5; 3]),
         vertices,
+        photometry: Default::default(),
     };
     Scene {
         surfaces: vec![
@@ -695,6 +696,7 @@ fn polygon_under_a_light(n: usize) -> Scene {
             surface("light", light, 10.0),
         ],
         camera: None,
+        lights: Vec::new(),
     }
 }
 

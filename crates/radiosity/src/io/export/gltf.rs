@@ -335,6 +335,7 @@ mod tests {
                 dvec3(2., 0., 1.),
                 dvec3(2., 0., 0.),
             ],
+            photometry: Default::default(),
         };
         let light = Surface {
             name: "light #1".into(),
@@ -346,10 +347,12 @@ mod tests {
                 dvec3(1., 1., 1.),
                 dvec3(0., 1., 1.),
             ],
+            photometry: Default::default(),
         };
         Scene {
             surfaces: vec![floor, light],
             camera: None,
+            lights: Vec::new(),
         }
     }
 

@@ -123,6 +123,7 @@ mod tests {
                 dvec3(0.5, 2., -1.),
                 dvec3(-0.5, 1., -1.),
             ],
+            photometry: Default::default(),
         });
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("box.obj");

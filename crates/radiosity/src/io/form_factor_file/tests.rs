@@ -35,9 +35,11 @@ fn scene(lift: f64) -> Scene {
                 emission: Rgb::BLACK,
                 reflectance: Rgb([0.5; 3]),
                 vertices,
+                photometry: Default::default(),
             })
             .collect(),
         camera: None,
+        lights: Vec::new(),
     }
 }
 

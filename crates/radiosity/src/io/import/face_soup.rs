@@ -187,6 +187,7 @@ impl FaceSoup {
             Scene {
                 surfaces,
                 camera: None,
+                lights: Vec::new(),
             },
             warnings,
         ))
@@ -357,6 +358,7 @@ impl FaceSoup {
                     emission: m.emission,
                     reflectance: m.reflectance,
                     vertices: p.vertices,
+                    photometry: Default::default(),
                 }
             })
             .collect()

@@ -119,12 +119,22 @@ pub(super) enum Keyword {
     Center,
     Radius,
     Resolution,
+    Luminance,
+    Flux,
+    Opening,
+    LightBegin,
+    LightEnd,
+    Position,
+    Aim,
+    Intensity,
+    Distribution,
+    Colour,
     /// Anything else.
     Unknown,
 }
 
 /// The fixed keywords and their canonical spelling.
-const WORDS: [(&str, Keyword); 29] = [
+const WORDS: [(&str, Keyword); 40] = [
     ("MAX_PATCH_AREA", Keyword::MaxPatchArea),
     ("INTEGRAL_STEPS", Keyword::IntegralSteps),
     ("SCENEBEGIN", Keyword::SceneBegin),
@@ -154,6 +164,18 @@ const WORDS: [(&str, Keyword); 29] = [
     ("CENTER", Keyword::Center),
     ("RADIUS", Keyword::Radius),
     ("RESOLUTION", Keyword::Resolution),
+    ("LUMINANCE", Keyword::Luminance),
+    ("FLUX", Keyword::Flux),
+    ("OPENING", Keyword::Opening),
+    ("LIGHTBEGIN", Keyword::LightBegin),
+    ("LIGHTEND", Keyword::LightEnd),
+    ("POSITION", Keyword::Position),
+    ("AIM", Keyword::Aim),
+    ("INTENSITY", Keyword::Intensity),
+    ("DISTRIBUTION", Keyword::Distribution),
+    ("COLOUR", Keyword::Colour),
+    // The American spelling reads as the same keyword (written back as COLOUR).
+    ("COLOR", Keyword::Colour),
 ];
 
 impl Keyword {

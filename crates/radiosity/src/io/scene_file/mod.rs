@@ -79,6 +79,42 @@
 //! CONEEND
 //! ```
 //!
+//! # Photometric units, openings and point luminaires
+//!
+//! Scene lengths are metres (unless `--scale` says otherwise); `Er Eg Eb` are luminous
+//! exitances in lm/m^2 per band, and photometric reports give Y = 0.2126 R + 0.7152 G +
+//! 0.0722 B ([`crate::light::Rgb::luminance`]). In any block, instead of the three
+//! emission lines, `LUMINANCE L` (cd/m^2) makes a Lambertian emitter of exitance pi L in
+//! every band, and `FLUX P` (lm) spreads P uniformly over the block's surfaces (exitance P /
+//! their area). Instead of the three reflectance lines, `OPENING` makes the block an
+//! opening: reflectance 0 in every band, light leaves the room through it; with a
+//! `LUMINANCE` it is a uniform sky seen through a window or roof light:
+//!
+//! ```text
+//! PATCHBEGIN
+//! #Window
+//! VERTICES 4
+//! LUMINANCE 3000            // cd/m^2 (a sky); or FLUX 1200 (lm over the patch)
+//! OPENING                   // reflectance 0
+//! VERTEX0 ...
+//! PATCHEND
+//! ```
+//!
+//! The writer gives these keywords back (a `FLUX` spread over several surfaces, a box's or
+//! a split patch's, is written as each surface's exitance). Point luminaires are blocks of
+//! their own ([`crate::luminaire`]), with `#NAME` first and the other lines in any order:
+//!
+//! ```text
+//! LIGHTBEGIN
+//! #Downlight
+//! POSITION 2 2 3
+//! AIM 0 0 -1              // the axis of the distribution (a direction; default 0 0 -1)
+//! INTENSITY 1000          // cd on the axis; or FLUX 10000 (lm in all directions)
+//! DISTRIBUTION COSINE     // ISOTROPIC | COSINE (I0 cos theta, nothing above 90 deg) | IES file.ies
+//! COLOUR 1 1 1            // optional tint per band (COLOR is read too)
+//! LIGHTEND
+//! ```
+//!
 //! A patch may have any number of vertices (3 or more). One that is planar but not convex,
 //! with an outline that does not cross itself (an L, a dart), is split into triangles
 //! `NAME.0`, `NAME.1`, ... (ear clipping on its plane); a crossing outline (a bow tie, most

@@ -10,9 +10,10 @@ use super::polygon;
 use super::SceneFile;
 use crate::geometry;
 use crate::light::Rgb;
+use crate::luminaire::{Distribution, Luminaire, Output, DEFAULT_AIM};
 use crate::mesh::MeshSettings;
 use crate::scene::shape::{self, Facing};
-use crate::scene::{Scene, Surface};
+use crate::scene::{EmissionGiven, Scene, Surface, SurfacePhotometry};
 
 /// Two surfaces in one plane are the same surface given twice when one covers all but this
 /// fraction of the larger's area (module [`Parser::duplicates`]).
@@ -122,6 +123,11 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneErro
         errors: Vec::new(),
         surface_lines: Vec::new(),
         block_line: (0, 0),
+        lights: Vec::new(),
+        folder: Path::new(source_name)
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default(),
     };
     let settings = parser.header();
     let surfaces = parser.body();
@@ -134,6 +140,7 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneErro
             scene: Scene {
                 surfaces,
                 camera: None,
+                lights: parser.lights,
             },
         }),
         _ => Err(SceneError {
@@ -185,6 +192,7 @@ pub(crate) fn duplicate_surfaces(surfaces: &[Surface]) -> Vec<(usize, usize)> {
     let scene = Scene {
         surfaces: kept.iter().map(|&i| surfaces[i].clone()).collect(),
         camera: None,
+        lights: Vec::new(),
     };
     let bvh = crate::visibility::PolygonBvh::over_surfaces(&scene);
     for o in crate::scene::lying_on(&scene, &bvh) {
@@ -225,6 +233,7 @@ fn is_block_start(k: Keyword) -> bool {
             | Keyword::SphereBegin
             | Keyword::CylinderBegin
             | Keyword::ConeBegin
+            | Keyword::LightBegin
             | Keyword::SceneEnd
     )
 }
@@ -284,6 +293,10 @@ struct Parser<'a> {
     surface_lines: Vec<(usize, usize)>,
     /// The line of the block read last.
     block_line: (usize, usize),
+    /// The `LIGHTBEGIN` blocks read so far.
+    lights: Vec<Luminaire>,
+    /// The folder that paths in the file (IES files) are relative to: the source name's.
+    folder: std::path::PathBuf,
 }
 
 /// A patch or box block's name and colours.
@@ -291,6 +304,10 @@ struct Head {
     name: String,
     emission: Rgb,
     reflectance: Rgb,
+    /// How the emission was given and whether the block is an opening.
+    photometry: SurfacePhotometry,
+    /// `FLUX P`: the lumens, spread over the block's surfaces once they are known.
+    flux: Option<f64>,
 }
 
 /// The corners of a polygon and where they were written.
@@ -580,6 +597,12 @@ impl<'a> Parser<'a> {
                     surfaces.extend(self.round_block(kind).into_iter().flatten());
                     self.surface_lines.resize(surfaces.len(), self.block_line);
                 }
+                Some(Keyword::LightBegin) => {
+                    // Not counted: a scene needs surfaces, and lights alone are "no patches".
+                    if let Some(light) = self.light_block() {
+                        self.lights.push(light);
+                    }
+                }
                 Some(Keyword::SceneEnd) => {
                     self.scene_end(blocks);
                     return surfaces;
@@ -641,7 +664,7 @@ impl<'a> Parser<'a> {
 
     /// Reports a line where a block should start and skips to the next block.
     fn stray_line(&mut self) {
-        self.unexpected("PATCHBEGIN, BOXBEGIN or SCENEEND");
+        self.unexpected("PATCHBEGIN, BOXBEGIN or SCENEEND (or LIGHTBEGIN)");
         self.pos += 1;
         while let Some(k) = self.current_keyword() {
             if is_block_start(k) {
@@ -725,7 +748,7 @@ impl<'a> Parser<'a> {
             geometry::validate_polygon(&corners.vertices)
         {
             if let Some(triangles) = simple_triangles(&corners.vertices) {
-                let surfaces = triangles
+                let mut surfaces: Vec<Surface> = triangles
                     .into_iter()
                     .enumerate()
                     .map(|(k, t)| Surface {
@@ -733,18 +756,23 @@ impl<'a> Parser<'a> {
                         emission: head.emission,
                         reflectance: head.reflectance,
                         vertices: t.to_vec(),
+                        photometry: head.photometry,
                     })
                     .collect();
+                Self::spread_flux(&head, &mut surfaces);
                 return Some(surfaces);
             }
         }
         self.check_polygon(&mut corners)?;
-        Some(vec![Surface {
-            name: head.name,
+        let mut surfaces = vec![Surface {
+            name: head.name.clone(),
             emission: head.emission,
             reflectance: head.reflectance,
             vertices: corners.vertices,
-        }])
+            photometry: head.photometry,
+        }];
+        Self::spread_flux(&head, &mut surfaces);
+        Some(surfaces)
     }
 
     /// Checks and flattens a polygon ([`geometry::validate_polygon`], [`geometry::flatten`]),
@@ -772,40 +800,121 @@ impl<'a> Parser<'a> {
         Ok(after_hash.trim().to_string())
     }
 
-    /// `Er`, `Eg`, `Eb`, `Rr`, `Rg`, `Rb` in that order, range-checked.
+    /// `Er`, `Eg`, `Eb` (or `LUMINANCE L`, or `FLUX P`), then `Rr`, `Rg`, `Rb` (or
+    /// `OPENING`), in that order, range-checked.
     fn colours(&mut self, name: String) -> Step<Head> {
         let mut emission = [0.0; 3];
-        for (i, k) in [Keyword::Er, Keyword::Eg, Keyword::Eb]
-            .into_iter()
-            .enumerate()
-        {
-            let (v, token, line) = self.value_or_recorded(k)?;
-            if let (true, Some(token)) = (v < 0.0, token) {
-                let msg = format!("emission must not be negative, found \"{}\"", token.text);
-                self.error_at(token, &line, msg);
+        let mut photometry = SurfacePhotometry::default();
+        let mut flux = None;
+        match self.current_keyword() {
+            Some(k @ (Keyword::Luminance | Keyword::Flux)) => {
+                let (v, token, line) = self.value_or_recorded(k)?;
+                if let (true, Some(token)) = (v < 0.0, token) {
+                    let what = if k == Keyword::Luminance {
+                        "LUMINANCE (cd/m^2)"
+                    } else {
+                        "FLUX (lm)"
+                    };
+                    let msg = format!("{what} must not be negative, found \"{}\"", token.text);
+                    self.error_at(token, &line, msg);
+                }
+                if k == Keyword::Luminance {
+                    emission = [std::f64::consts::PI * v; 3];
+                    photometry.emission = EmissionGiven::Luminance(v);
+                } else {
+                    flux = Some(v);
+                    photometry.emission = EmissionGiven::Flux(v);
+                }
             }
-            emission[i] = v;
+            _ => {
+                for (i, k) in [Keyword::Er, Keyword::Eg, Keyword::Eb]
+                    .into_iter()
+                    .enumerate()
+                {
+                    let wanted = if i == 0 {
+                        "Er (or LUMINANCE L, or FLUX P)".to_string()
+                    } else {
+                        k.spelling()
+                    };
+                    let line = self.expect_either(k, &wanted)?;
+                    let found = self.number(&line, 1, "a number").ok();
+                    self.line_end(&line, 2);
+                    let (v, token) = (found.map_or(0.0, |f| f.0), found.map(|f| f.1));
+                    if let (true, Some(token)) = (v < 0.0, token) {
+                        let msg =
+                            format!("emission must not be negative, found \"{}\"", token.text);
+                        self.error_at(token, &line, msg);
+                    }
+                    emission[i] = v;
+                }
+            }
         }
         let mut reflectance = [0.0; 3];
-        for (i, k) in [Keyword::Rr, Keyword::Rg, Keyword::Rb]
-            .into_iter()
-            .enumerate()
-        {
-            let (v, token, line) = self.value_or_recorded(k)?;
-            if let (false, Some(token)) = ((0.0..1.0).contains(&v), token) {
-                let msg = format!(
-                    "reflectance must be at least 0 and below 1, found \"{}\"",
-                    token.text
-                );
-                self.error_at(token, &line, msg);
+        if self.current_keyword() == Some(Keyword::Opening) {
+            let line = self.expect(Keyword::Opening)?;
+            self.line_end(&line, 1);
+            photometry.opening = true;
+            if let Some(next) = self.current() {
+                if matches!(next.keyword(), Keyword::Rr | Keyword::Rg | Keyword::Rb) {
+                    let head = next.head();
+                    let msg = format!(
+                        "expected the block's shape after OPENING, found \"{}\": an opening \
+                         has reflectance 0 (light leaves through it), so it takes no Rr, Rg, Rb",
+                        head.text
+                    );
+                    return Err(self.error_at(head, &next, msg));
+                }
             }
-            reflectance[i] = v;
+        } else {
+            for (i, k) in [Keyword::Rr, Keyword::Rg, Keyword::Rb]
+                .into_iter()
+                .enumerate()
+            {
+                let wanted = if i == 0 {
+                    "Rr (or OPENING)".to_string()
+                } else {
+                    k.spelling()
+                };
+                let line = self.expect_either(k, &wanted)?;
+                let found = self.number(&line, 1, "a number").ok();
+                self.line_end(&line, 2);
+                let (v, token) = (found.map_or(0.0, |f| f.0), found.map(|f| f.1));
+                if let (false, Some(token)) = ((0.0..1.0).contains(&v), token) {
+                    let msg = format!(
+                        "reflectance must be at least 0 and below 1, found \"{}\"",
+                        token.text
+                    );
+                    self.error_at(token, &line, msg);
+                }
+                reflectance[i] = v;
+            }
         }
         Ok(Head {
             name,
             emission: Rgb(emission),
             reflectance: Rgb(reflectance),
+            photometry,
+            flux,
         })
+    }
+
+    /// A block's `FLUX P` spread over its surfaces: exitance P / (their total area) on
+    /// each. A block of one surface keeps the keyword for the writer; the pieces of a
+    /// split patch or a primitive are written back as their exitance.
+    fn spread_flux(head: &Head, surfaces: &mut [Surface]) {
+        let Some(p) = head.flux else { return };
+        let area: f64 = surfaces
+            .iter()
+            .map(|s| geometry::polygon_area(&s.vertices))
+            .sum();
+        let exitance = if area > 0.0 { p / area } else { 0.0 };
+        let single = surfaces.len() == 1;
+        for s in surfaces {
+            s.emission = Rgb::splat(exitance);
+            if !single {
+                s.photometry.emission = EmissionGiven::Exitance;
+            }
+        }
     }
 
     /// `VERTICES n` with a whole `n` of at least `min`.
@@ -855,6 +964,207 @@ impl<'a> Parser<'a> {
         })
     }
 
+    // ----- point luminaires -----
+
+    /// A `LIGHTBEGIN` block: `#NAME`, then `POSITION x y z`, `AIM x y z` (optional),
+    /// `INTENSITY I` or `FLUX P`, `DISTRIBUTION ISOTROPIC | COSINE | IES file.ies`, `COLOUR r g b`
+    /// (optional), in any order, each at most once.
+    fn light_block(&mut self) -> Option<Luminaire> {
+        let begin = self
+            .current()
+            .map_or((0, 0), |l| (l.number, l.head().column));
+        let light = self.block(Keyword::LightBegin, Keyword::LightEnd, |p| {
+            let name = p.name_line()?;
+            p.light_fields(name, begin)
+        })?;
+        Some(light)
+    }
+
+    /// The lines of a light block after its name, up to (not including) `LIGHTEND`.
+    fn light_fields(&mut self, name: String, begin: (usize, usize)) -> Step<Luminaire> {
+        let mut position = None;
+        let mut aim = None;
+        let mut output = None;
+        let mut distribution = None;
+        let mut colour = None;
+        let mut seen: Vec<(Keyword, usize)> = Vec::new();
+        loop {
+            let Some(line) = self.current() else {
+                return Err(self.unexpected("LIGHTEND"));
+            };
+            let k = line.keyword();
+            if k == Keyword::LightEnd || is_block_start(k) {
+                break;
+            }
+            let key = match k {
+                Keyword::Flux => Keyword::Intensity,
+                other => other,
+            };
+            if let Some((_, first)) = seen.iter().find(|(s, _)| *s == key) {
+                let head = line.head();
+                let what = if key == Keyword::Intensity {
+                    "INTENSITY or FLUX".to_string()
+                } else {
+                    key.spelling()
+                };
+                let msg = format!(
+                    "{what} is given twice in this light (first on line {first}); give it once"
+                );
+                return Err(self.error_at(head, &line, msg));
+            }
+            seen.push((key, line.number));
+            match k {
+                Keyword::Position => {
+                    let (read, l) = self.triple_read(Keyword::Position, "coordinate")?;
+                    for (v, token) in read.iter().flatten() {
+                        self.check_range(*v, *token, &l);
+                    }
+                    position = Some(DVec3::from(read.map(|t| t.map_or(0.0, |t| t.0))));
+                }
+                Keyword::Aim => {
+                    let (read, l) = self.triple_read(Keyword::Aim, "component")?;
+                    let v = DVec3::from(read.map(|t| t.map_or(0.0, |t| t.0)));
+                    if read.iter().all(Option::is_some) && v.length_squared() == 0.0 {
+                        let head = l.head();
+                        self.error_at(
+                            head,
+                            &l,
+                            "AIM must be a direction (not 0 0 0): the axis of the light, \
+                             for example 0 0 -1 for straight down",
+                        );
+                    }
+                    aim = Some(v);
+                }
+                Keyword::Intensity | Keyword::Flux => {
+                    let (v, token, l) = self.value_or_recorded(k)?;
+                    if let (true, Some(token)) = (v < 0.0, token) {
+                        let msg = format!(
+                            "{} must not be negative, found \"{}\"",
+                            k.spelling(),
+                            token.text
+                        );
+                        self.error_at(token, &l, msg);
+                    }
+                    output = Some(if k == Keyword::Intensity {
+                        Output::Intensity(v)
+                    } else {
+                        Output::Flux(v)
+                    });
+                }
+                Keyword::Distribution => {
+                    self.pos += 1;
+                    distribution = Some(self.distribution_line(&line)?);
+                }
+                Keyword::Colour => {
+                    let (read, l) = self.triple_read(Keyword::Colour, "band")?;
+                    for (v, token) in read.iter().flatten() {
+                        if *v < 0.0 {
+                            let msg =
+                                format!("COLOUR must not be negative, found \"{}\"", token.text);
+                            self.error_at(*token, &l, msg);
+                        }
+                    }
+                    colour = Some(Rgb(read.map(|t| t.map_or(0.0, |t| t.0))));
+                }
+                _ => {
+                    return Err(self.unexpected(
+                        "POSITION, AIM, INTENSITY, FLUX, DISTRIBUTION, COLOUR or LIGHTEND",
+                    ))
+                }
+            }
+        }
+        let (line, column) = begin;
+        let Some(position) = position else {
+            return Err(self.error(
+                line,
+                column,
+                format!("the light \"{name}\" has no POSITION x y z (where it is, in scene units)"),
+            ));
+        };
+        let Some(distribution) = distribution else {
+            return Err(self.error(
+                line,
+                column,
+                format!(
+                    "the light \"{name}\" has no DISTRIBUTION line: expected ISOTROPIC, COSINE \
+                     or IES file.ies"
+                ),
+            ));
+        };
+        let light = Luminaire {
+            name,
+            position,
+            aim: aim.unwrap_or(DEFAULT_AIM),
+            output: output.unwrap_or(Output::AsTabulated),
+            distribution,
+            colour: colour.unwrap_or(Rgb::splat(1.0)),
+        };
+        if let Err(e) = light.check() {
+            return Err(self.error(line, column, format!("the light \"{}\": {e}", light.name)));
+        }
+        Ok(light)
+    }
+
+    /// The `DISTRIBUTION` line's value (the line is already taken).
+    fn distribution_line(&mut self, line: &Line<'a>) -> Step<Distribution> {
+        let Some(word) = line.tokens.get(1).copied() else {
+            let msg = "expected ISOTROPIC, COSINE or IES file.ies after \"DISTRIBUTION\", \
+                       found end of line";
+            return Err(self.error(line.number, line.end_column, msg));
+        };
+        let upper = word.text.to_ascii_uppercase();
+        match upper.as_str() {
+            "ISOTROPIC" | "COSINE" => {
+                self.line_end(line, 2);
+                Ok(if upper == "ISOTROPIC" {
+                    Distribution::Isotropic
+                } else {
+                    Distribution::Cosine
+                })
+            }
+            "IES" => self.ies_distribution(line, word),
+            _ => {
+                let msg = format!(
+                    "expected ISOTROPIC, COSINE or IES file.ies after \"DISTRIBUTION\", found \"{}\"",
+                    word.text
+                );
+                Err(self.error_at(word, line, msg))
+            }
+        }
+    }
+
+    /// `DISTRIBUTION IES file.ies`: the rest of the line (trimmed) is the path, relative to
+    /// the scene file's folder.
+    fn ies_distribution(&mut self, line: &Line<'a>, word: Token<'a>) -> Step<Distribution> {
+        // The rest of the line after the word IES: a path may hold spaces.
+        let start = line
+            .code
+            .char_indices()
+            .nth(word.column - 1)
+            .map_or(line.code.len(), |(b, _)| b + word.text.len());
+        let written = line.code.get(start..).unwrap_or("").trim().to_string();
+        if written.is_empty() {
+            let msg = "expected the IES file's path after \"IES\" (relative to the scene \
+                       file), found end of line";
+            return Err(self.error(line.number, line.end_column, msg));
+        }
+        let path = self.folder.join(&written);
+        match crate::photometry::ies::IesPhotometry::read(&path) {
+            Ok(photometry) => Ok(Distribution::Ies {
+                written,
+                photometry: std::sync::Arc::new(photometry),
+            }),
+            Err(e) => {
+                let column = line.tokens.get(2).map_or(word.column, |t| t.column);
+                let msg = format!(
+                    "the light's IES file \"{written}\" (relative to the scene file's folder) \
+                     cannot be used: {e}"
+                );
+                Err(self.error(line.number, column, msg))
+            }
+        }
+    }
+
     // ----- boxes -----
 
     /// A `BOXBEGIN` block as its six checked faces.
@@ -896,7 +1206,7 @@ impl<'a> Parser<'a> {
                 return None;
             }
         }
-        let surfaces = shape::FACE_NAMES
+        let mut surfaces: Vec<Surface> = shape::FACE_NAMES
             .iter()
             .zip(faces)
             .map(|(suffix, vertices)| Surface {
@@ -904,8 +1214,10 @@ impl<'a> Parser<'a> {
                 emission: head.emission,
                 reflectance: head.reflectance,
                 vertices,
+                photometry: head.photometry,
             })
             .collect();
+        Self::spread_flux(&head, &mut surfaces);
         Some(surfaces)
     }
 
@@ -968,8 +1280,10 @@ impl<'a> Parser<'a> {
                 emission: head.emission,
                 reflectance: head.reflectance,
                 vertices,
+                photometry: head.photometry,
             });
         }
+        Self::spread_flux(&head, &mut surfaces);
         Some(surfaces)
     }
 
@@ -1123,3 +1437,7 @@ mod tests;
 #[cfg(test)]
 #[path = "round_tests.rs"]
 mod round_tests;
+
+#[cfg(test)]
+#[path = "photometric_tests.rs"]
+mod photometric_tests;

@@ -9,8 +9,13 @@
 use std::io::{self, Write};
 use std::path::Path;
 
+use std::f64::consts::PI;
+
+use crate::geometry;
+use crate::light::Rgb;
+use crate::luminaire::{Distribution, Luminaire, Output};
 use crate::mesh::MeshSettings;
-use crate::scene::{Scene, Surface};
+use crate::scene::{EmissionGiven, Scene, Surface};
 
 /// Writes `scene` with `settings` as scene-file text to `out`.
 ///
@@ -19,6 +24,10 @@ use crate::scene::{Scene, Surface};
 pub fn write_scene(scene: &Scene, settings: MeshSettings, out: &mut impl Write) -> io::Result<()> {
     for (i, s) in scene.surfaces.iter().enumerate() {
         check_name(i, &s.name)?;
+    }
+    for (i, l) in scene.lights.iter().enumerate() {
+        check_name(i, &l.name)
+            .map_err(|e| io::Error::new(e.kind(), e.to_string().replacen("surface", "light", 1)))?;
     }
     writeln!(
         out,
@@ -32,6 +41,10 @@ pub fn write_scene(scene: &Scene, settings: MeshSettings, out: &mut impl Write) 
     for surface in &scene.surfaces {
         writeln!(out)?;
         write_patch(surface, out)?;
+    }
+    for light in &scene.lights {
+        writeln!(out)?;
+        write_light(light, out)?;
     }
     writeln!(out)?;
     writeln!(out, "SCENEEND")
@@ -48,16 +61,58 @@ fn write_patch(s: &Surface, out: &mut impl Write) -> io::Result<()> {
     writeln!(out, "PATCHBEGIN")?;
     writeln!(out, "#{}", s.name)?;
     writeln!(out, "VERTICES {}", s.vertices.len())?;
-    for (key, value) in ["Er", "Eg", "Eb"].iter().zip(s.emission.0) {
-        writeln!(out, "{key} {value}")?;
+    // The photometric keywords only where they give back exactly the values the surface
+    // has (a surface recoloured since it was read is written with its new exitance).
+    match s.photometry.emission {
+        EmissionGiven::Luminance(l) if s.emission == Rgb::splat(PI * l) => {
+            writeln!(out, "LUMINANCE {l}")?;
+        }
+        EmissionGiven::Flux(p)
+            if s.emission == Rgb::splat(p / geometry::polygon_area(&s.vertices)) =>
+        {
+            writeln!(out, "FLUX {p}")?;
+        }
+        _ => {
+            for (key, value) in ["Er", "Eg", "Eb"].iter().zip(s.emission.0) {
+                writeln!(out, "{key} {value}")?;
+            }
+        }
     }
-    for (key, value) in ["Rr", "Rg", "Rb"].iter().zip(s.reflectance.0) {
-        writeln!(out, "{key} {value}")?;
+    if s.photometry.opening && s.reflectance == Rgb::BLACK {
+        writeln!(out, "OPENING")?;
+    } else {
+        for (key, value) in ["Rr", "Rg", "Rb"].iter().zip(s.reflectance.0) {
+            writeln!(out, "{key} {value}")?;
+        }
     }
     for (k, v) in s.vertices.iter().enumerate() {
         writeln!(out, "VERTEX{k} {} {} {}", v.x, v.y, v.z)?;
     }
     writeln!(out, "PATCHEND")
+}
+
+/// One `LIGHTBEGIN` ... `LIGHTEND` block.
+fn write_light(l: &Luminaire, out: &mut impl Write) -> io::Result<()> {
+    writeln!(out, "LIGHTBEGIN")?;
+    writeln!(out, "#{}", l.name)?;
+    let (p, a) = (l.position, l.aim);
+    writeln!(out, "POSITION {} {} {}", p.x, p.y, p.z)?;
+    writeln!(out, "AIM {} {} {}", a.x, a.y, a.z)?;
+    match l.output {
+        Output::Intensity(i) => writeln!(out, "INTENSITY {i}")?,
+        Output::Flux(f) => writeln!(out, "FLUX {f}")?,
+        Output::AsTabulated => {}
+    }
+    match &l.distribution {
+        Distribution::Isotropic => writeln!(out, "DISTRIBUTION ISOTROPIC")?,
+        Distribution::Cosine => writeln!(out, "DISTRIBUTION COSINE")?,
+        Distribution::Ies { written, .. } => writeln!(out, "DISTRIBUTION IES {written}")?,
+    }
+    if l.colour != Rgb::splat(1.0) {
+        let c = l.colour.0;
+        writeln!(out, "COLOUR {} {} {}", c[0], c[1], c[2])?;
+    }
+    writeln!(out, "LIGHTEND")
 }
 
 /// An error for a name that the reader would not give back unchanged.

@@ -306,6 +306,11 @@ pub fn solve_hierarchical(
     if scene.surfaces.is_empty() {
         return Err(SolveError::NoSurfaces);
     }
+    if !scene.lights.is_empty() {
+        return Err(SolveError::PointLightsUnsupported {
+            lights: scene.lights.len(),
+        });
+    }
     let start = Instant::now();
     let mut solver = Solver {
         nodes: Vec::new(),

@@ -1,0 +1,37 @@
+//! `radiosity validate cie171`: the files it writes are the repository's `validation/`, and
+//! a case id that names nothing is refused with the list of cases.
+
+use std::path::Path;
+
+use crate::fixtures::{radiosity, scratch_dir, stderr, stdout};
+
+#[test]
+fn validate_cie171_write_reproduces_the_validation_folder() {
+    let dir = scratch_dir("validate-write");
+    let out = radiosity(&["validate", "cie171", "--write", "cases"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("wrote 26 files"), "{}", stdout(&out));
+    let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation");
+    for entry in std::fs::read_dir(dir.join("cases")).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap();
+        let ours = std::fs::read_to_string(&path).unwrap();
+        let theirs = std::fs::read_to_string(committed.join(name))
+            .unwrap_or_else(|e| panic!("validation/{}: {e}", name.to_string_lossy()));
+        assert_eq!(ours, theirs, "{}", name.to_string_lossy());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn validate_cie171_unknown_case_lists_the_cases() {
+    let dir = scratch_dir("validate-unknown");
+    let out = radiosity(&["validate", "cie171", "--case", "9.9"], &dir);
+    assert!(!out.status.success());
+    let message = stderr(&out);
+    assert!(
+        message.contains("\"9.9\"") && message.contains("5.2, 5.3, 5.6, 5.7"),
+        "{message}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

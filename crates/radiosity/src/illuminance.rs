@@ -1,0 +1,489 @@
+//! Illuminance at calculation points: what a lighting designer's light meter would read at
+//! a point with a given normal, split into the direct and the indirect light.
+//!
+//! * **Direct**: the light that arrives straight from emission: each emitting surface's
+//!   own exitance times Lambert's exact point-to-polygon form factor times the visible
+//!   fraction (shadow rays, [`crate::render::DirectLight`]), plus each point luminaire's
+//!   I cos / d^2 where its segment is clear.
+//! * **Indirect**: the light that arrives from reflected light: every element's reflected
+//!   exitance (its radiosity less its surface's own emission; progressive refinement's
+//!   ambient term included) times the exact point-to-polygon form factor to the element
+//!   times the visible fraction of the element (kernel-weighted shadow rays to 3 x 3 points
+//!   of it; an element seen whole needs no more).
+//!
+//! Both are computed at the point from the solution, not interpolated from vertices. Values
+//! are photometric: the luminance-weighted Y = 0.2126 R + 0.7152 G + 0.0722 B of the bands
+//! ([`crate::light::Rgb::luminance`]); with lengths in metres and exitances in lm/m^2 they
+//! are lux.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::form_factor::exact::point_to_polygon;
+use crate::light::Rgb;
+use crate::pipeline::{Prepared, Solution};
+use crate::render::DirectLight;
+
+/// A calculation point: where, and the unit normal of the (imaginary) meter's face.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CalcPoint {
+    /// A label (the CSV's `name`).
+    pub name: String,
+    /// The point.
+    pub position: DVec3,
+    /// The normal the illuminance is measured on (normalised on use).
+    pub normal: DVec3,
+}
+
+/// The illuminance at one point, in lux (Y of the bands).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Lux {
+    /// Straight from emitting surfaces and point luminaires.
+    pub direct: f64,
+    /// From reflected light.
+    pub indirect: f64,
+    /// direct + indirect.
+    pub total: f64,
+}
+
+/// The shadow-ray points per element side for the indirect light's visibility.
+const ELEMENT_POINTS: u32 = 3;
+
+/// The illuminance at each of `points` for the scene of `prepared` solved as `solution`
+/// (any solver's: its mesh may be the prepared one, adaptive subdivision's or hierarchical
+/// radiosity's leaves). Points run in parallel; the result is in the order of `points` and
+/// does not depend on threads.
+pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint]) -> Vec<Lux> {
+    let scene = &prepared.scene;
+    let direct = DirectLight::new(scene);
+    let mesh = &solution.mesh;
+    let reflectance: Vec<Rgb> = mesh
+        .elements
+        .iter()
+        .map(|e| scene.surfaces[e.surface as usize].reflectance)
+        .collect();
+    let shown = solution.display_radiosity(&reflectance);
+    // Each element's reflected exitance (Y) and corners; the elements that reflect nothing
+    // are left out.
+    let reflecting: Vec<(usize, f64, Vec<DVec3>)> = mesh
+        .elements
+        .iter()
+        .enumerate()
+        .filter_map(|(i, e)| {
+            let own = scene.surfaces[e.surface as usize].emission;
+            let r = (shown[i] - own).luminance();
+            (r > 0.0).then(|| (i, r, mesh.corner_positions(i).collect()))
+        })
+        .collect();
+    let occluders = &prepared.occluders;
+    points
+        .par_iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let n = p.normal.normalize_or_zero();
+            if n == DVec3::ZERO {
+                return Lux::default();
+            }
+            let salt = 0x5eed_0000_0000_0000 ^ k as u64;
+            let d = direct.irradiance(p.position, n, salt).luminance();
+            let mut ind = 0.0;
+            let mut samples = Vec::with_capacity((ELEMENT_POINTS * ELEMENT_POINTS) as usize);
+            for (e, r, poly) in &reflecting {
+                let f = point_to_polygon(p.position, n, poly);
+                if f <= 0.0 {
+                    continue;
+                }
+                samples.clear();
+                mesh.integration_points(*e, ELEMENT_POINTS, &mut samples);
+                let normal = mesh.elements[*e].normal;
+                let (mut seen, mut total) = (0.0, 0.0);
+                for &(y, w) in &samples {
+                    let dv = y - p.position;
+                    let r2 = dv.length_squared();
+                    let (cx, cy) = (n.dot(dv), -normal.dot(dv));
+                    if cx <= 0.0 || cy <= 0.0 || r2 <= 0.0 {
+                        continue;
+                    }
+                    let kw = w * cx * cy / (r2 * r2);
+                    total += kw;
+                    if !occluders.segment_blocked(p.position, y) {
+                        seen += kw;
+                    }
+                }
+                // All points behind the meter's plane while Lambert sees a sliver: seen.
+                let fraction = if total > 0.0 { seen / total } else { 1.0 };
+                ind += r * f * fraction;
+            }
+            Lux {
+                direct: d,
+                indirect: ind,
+                total: d + ind,
+            }
+        })
+        .collect()
+}
+
+/// The points of a rectangular grid from corner `a` to corner `b` (an axis-aligned
+/// rectangle: the corners agree in at least one axis; or a line, or one point) every
+/// `spacing`, all with `normal`: along each axis where the corners differ, `a + i spacing`
+/// for i = 0, 1, ... while within the span (the far corner itself when the span is a whole
+/// number of spacings, to 1e-9 of a spacing). Named `gI_J` (column I along the first varying
+/// axis, x before y before z; row J along the second). `None` for a spacing that is not
+/// positive and finite, corners that differ in all three axes, or a grid of more than
+/// `max_points`.
+pub fn grid(
+    a: DVec3,
+    b: DVec3,
+    spacing: f64,
+    normal: DVec3,
+    max_points: usize,
+) -> Option<(Vec<CalcPoint>, [usize; 2])> {
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return None;
+    }
+    let varying: Vec<usize> = (0..3).filter(|&i| a[i] != b[i]).collect();
+    if varying.len() > 2 {
+        return None;
+    }
+    let count = |axis: usize| -> f64 { ((b[axis] - a[axis]).abs() / spacing + 1e-9).floor() + 1.0 };
+    let counts: Vec<f64> = varying.iter().map(|&i| count(i)).collect();
+    if counts.iter().product::<f64>() > max_points as f64 {
+        return None;
+    }
+    let (nu, nv) = (
+        counts.first().copied().unwrap_or(1.0) as usize,
+        counts.get(1).copied().unwrap_or(1.0) as usize,
+    );
+    let mut out = Vec::with_capacity(nu * nv);
+    for j in 0..nv {
+        for i in 0..nu {
+            let mut p = a;
+            for (index, &axis) in varying.iter().enumerate() {
+                let k = if index == 0 { i } else { j } as f64;
+                p[axis] = a[axis] + (b[axis] - a[axis]).signum() * k * spacing;
+            }
+            out.push(CalcPoint {
+                name: format!("g{i}_{j}"),
+                position: p,
+                normal,
+            });
+        }
+    }
+    Some((out, [nu, nv]))
+}
+
+#[cfg(test)]
+#[path = "illuminance_tests.rs"]
+mod tests;
+
+/// The header a points file must start with (the contract of `radiosity illuminance`).
+pub const POINTS_HEADER: &str = "name,x,y,z,nx,ny,nz";
+
+/// The header of the illuminance CSV written for the points.
+pub const LUX_HEADER: &str = "name,x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux";
+
+/// A problem in a points file, at a line.
+#[derive(Debug, thiserror::Error)]
+pub enum PointsError {
+    /// The file cannot be read.
+    #[error("{path}: error: cannot read the points file: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A line is not what the format says.
+    #[error("{path}:{line}: error: {message}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// The line, from 1.
+        line: usize,
+        /// What was found and what was expected.
+        message: String,
+    },
+}
+
+/// Reads a points CSV: the header `name,x,y,z,nx,ny,nz`, then one point a line (blank lines
+/// skipped); every number finite, the normal not zero.
+pub fn read_points(path: &std::path::Path) -> Result<Vec<CalcPoint>, PointsError> {
+    let name = path.display().to_string();
+    crate::io::note_input(path);
+    let text = std::fs::read_to_string(path).map_err(|source| PointsError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    parse_points(&text, &name)
+}
+
+/// [`read_points`] on text; `source_name` names it in errors.
+pub fn parse_points(text: &str, source_name: &str) -> Result<Vec<CalcPoint>, PointsError> {
+    let bad = |line: usize, message: String| PointsError::Invalid {
+        path: source_name.to_string(),
+        line,
+        message,
+    };
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((i, header)) = lines.next() else {
+        return Err(bad(
+            1,
+            format!("expected the header \"{POINTS_HEADER}\", found an empty file"),
+        ));
+    };
+    let cols: Vec<String> = header
+        .split(',')
+        .map(|c| c.trim().to_ascii_lowercase())
+        .collect();
+    if cols.join(",") != POINTS_HEADER {
+        return Err(bad(
+            i + 1,
+            format!(
+                "expected the header \"{POINTS_HEADER}\", found \"{}\"",
+                header.trim()
+            ),
+        ));
+    }
+    let mut out = Vec::new();
+    for (i, line) in lines {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != 7 {
+            return Err(bad(
+                i + 1,
+                format!(
+                    "expected 7 fields (name,x,y,z,nx,ny,nz), found {}",
+                    fields.len()
+                ),
+            ));
+        }
+        let mut v = [0.0; 6];
+        for (k, f) in fields[1..].iter().enumerate() {
+            let what = ["x", "y", "z", "nx", "ny", "nz"][k];
+            v[k] = match f.parse::<f64>() {
+                Ok(x) if x.is_finite() => x,
+                _ => {
+                    return Err(bad(
+                        i + 1,
+                        format!("expected a finite number for {what}, found \"{f}\""),
+                    ))
+                }
+            };
+        }
+        let normal = DVec3::new(v[3], v[4], v[5]);
+        if normal.length_squared() == 0.0 {
+            return Err(bad(
+                i + 1,
+                "the normal nx,ny,nz is 0,0,0; give the direction the meter faces (0,0,1 \
+                 for a horizontal work plane in a z-up scene)"
+                    .to_string(),
+            ));
+        }
+        out.push(CalcPoint {
+            name: fields[0].to_string(),
+            position: DVec3::new(v[0], v[1], v[2]),
+            normal,
+        });
+    }
+    Ok(out)
+}
+
+/// Writes the illuminance CSV ([`LUX_HEADER`]), one row per point, numbers as Rust's
+/// shortest round-trip text.
+pub fn write_lux_csv(
+    points: &[CalcPoint],
+    lux: &[Lux],
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    writeln!(out, "{LUX_HEADER}")?;
+    for (p, l) in points.iter().zip(lux) {
+        let (x, n) = (p.position, p.normal);
+        writeln!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{}",
+            p.name, x.x, x.y, x.z, n.x, n.y, n.z, l.direct, l.indirect, l.total
+        )?;
+    }
+    Ok(())
+}
+
+/// A 3 x 5 pixel font for the grid picture's numbers and unit: each glyph is five rows of
+/// three bits (most significant bit left).
+fn glyph(c: char) -> Option<[u8; 5]> {
+    Some(match c {
+        '0' => [7, 5, 5, 5, 7],
+        '1' => [2, 6, 2, 2, 7],
+        '2' => [7, 1, 7, 4, 7],
+        '3' => [7, 1, 7, 1, 7],
+        '4' => [5, 5, 7, 1, 1],
+        '5' => [7, 4, 7, 1, 7],
+        '6' => [7, 4, 7, 5, 7],
+        '7' => [7, 1, 1, 1, 1],
+        '8' => [7, 5, 7, 5, 7],
+        '9' => [7, 5, 7, 1, 7],
+        '.' => [0, 0, 0, 0, 2],
+        '-' => [0, 0, 7, 0, 0],
+        'l' => [4, 4, 4, 4, 3],
+        'x' => [0, 5, 2, 5, 5],
+        'u' => [0, 5, 5, 5, 7],
+        'e' => [7, 5, 7, 4, 7],
+        '+' => [0, 2, 7, 2, 0],
+        ' ' => [0; 5],
+        _ => return None,
+    })
+}
+
+/// Draws `text` with its top left corner at (x, y), each font pixel `s` x `s`.
+fn draw_text(img: &mut image::RgbImage, x: i64, y: i64, s: i64, text: &str, colour: [u8; 3]) {
+    for (k, c) in text.chars().enumerate() {
+        let Some(rows) = glyph(c) else { continue };
+        for (r, bits) in rows.iter().enumerate() {
+            for col in 0..3 {
+                if bits >> (2 - col) & 1 == 1 {
+                    for dy in 0..s {
+                        for dx in 0..s {
+                            let px = x + (k as i64 * 4 + col) * s + dx;
+                            let py = y + r as i64 * s + dy;
+                            if px >= 0
+                                && py >= 0
+                                && (px as u32) < img.width()
+                                && (py as u32) < img.height()
+                            {
+                                img.put_pixel(px as u32, py as u32, image::Rgb(colour));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The width in pixels of `text` at font scale `s`.
+fn text_width(text: &str, s: i64) -> i64 {
+    (text.chars().count() as i64 * 4 - 1).max(0) * s
+}
+
+/// The false-colour scale: dark blue at 0 through cyan, green and yellow to red at 1 (the
+/// ramp of lighting tools' false-colour views).
+pub fn false_colour(t: f64) -> [u8; 3] {
+    const STOPS: [[f64; 3]; 5] = [
+        [0.0, 0.0, 0.6],
+        [0.0, 0.7, 1.0],
+        [0.1, 0.8, 0.2],
+        [1.0, 0.9, 0.0],
+        [0.9, 0.1, 0.0],
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (STOPS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - i as f64;
+    let c: [f64; 3] = std::array::from_fn(|b| STOPS[i][b] * (1.0 - f) + STOPS[i + 1][b] * f);
+    c.map(|v| (v * 255.0).round() as u8)
+}
+
+/// A value as lighting tools print it: whole lux from 100, one decimal from 10, two below.
+pub fn lux_label(v: f64) -> String {
+    if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else if v.abs() >= 10.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+/// The grid as lighting tools draw it: one cell per point coloured by its value on the
+/// false-colour scale from 0 to the largest value, the value printed in the cell (where it
+/// fits), row 0 at the bottom (a plan seen from above for a z-up floor grid), and on the
+/// right a scale bar with six values and the unit `lx`. `values` run column by column
+/// within rows (as [`grid`] makes them); `dims` = [columns, rows].
+pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
+    let [nu, nv] = dims;
+    let max = values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let scale_of = |v: f64| if max > 0.0 { v / max } else { 0.0 };
+    // Cells wide enough for the longest label at font scale 2 where the grid allows it.
+    let longest = values
+        .iter()
+        .map(|&v| lux_label(v).len())
+        .max()
+        .unwrap_or(1) as i64;
+    let want = (text_width(&"8".repeat(longest as usize), 2) + 8).max(24);
+    let cell = want
+        .min((1600 / nu.max(1) as i64).max(4))
+        .min((1200 / nv.max(1) as i64).max(4));
+    let (gw, gh) = (cell * nu as i64, cell * nv as i64);
+    let margin = 10;
+    let legend_w = 90;
+    let height = (gh + 2 * margin).max(240);
+    let width = gw + 2 * margin + legend_w;
+    let mut img = image::RgbImage::from_pixel(width as u32, height as u32, image::Rgb([255; 3]));
+    for j in 0..nv {
+        for i in 0..nu {
+            let v = values.get(j * nu + i).copied().unwrap_or(0.0);
+            let c = false_colour(scale_of(v));
+            let (x0, y0) = (
+                margin + i as i64 * cell,
+                margin + (nv - 1 - j) as i64 * cell,
+            );
+            for y in y0..y0 + cell {
+                for x in x0..x0 + cell {
+                    let edge = x == x0 || y == y0;
+                    let px = if edge && cell >= 8 { [255; 3] } else { c };
+                    img.put_pixel(x as u32, y as u32, image::Rgb(px));
+                }
+            }
+            let label = lux_label(v);
+            let tw = text_width(&label, 2);
+            if tw + 4 <= cell && cell >= 14 {
+                let lum = 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64;
+                let ink = if lum > 110.0 { [0; 3] } else { [255; 3] };
+                draw_text(
+                    &mut img,
+                    x0 + (cell - tw) / 2,
+                    y0 + (cell - 10) / 2,
+                    2,
+                    &label,
+                    ink,
+                );
+            }
+        }
+    }
+    // The scale bar: top = max, bottom = 0, with the unit above it.
+    let bx = gw + 2 * margin;
+    let (by0, by1) = (margin + 20, height - margin - 6);
+    draw_text(&mut img, bx, margin, 2, "lx", [0; 3]);
+    for y in by0..by1 {
+        let t = 1.0 - (y - by0) as f64 / (by1 - by0 - 1).max(1) as f64;
+        for x in bx..bx + 18 {
+            img.put_pixel(x as u32, y as u32, image::Rgb(false_colour(t)));
+        }
+    }
+    for k in 0..=5 {
+        let t = k as f64 / 5.0;
+        let y = by1 - 1 - ((by1 - by0 - 1) as f64 * t).round() as i64;
+        for x in bx + 18..bx + 23 {
+            img.put_pixel(x as u32, y as u32, image::Rgb([0; 3]));
+        }
+        draw_text(
+            &mut img,
+            bx + 26,
+            (y - 5).max(0),
+            2,
+            &lux_label(max * t),
+            [0; 3],
+        );
+    }
+    img
+}

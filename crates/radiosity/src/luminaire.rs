@@ -1,0 +1,318 @@
+//! Point luminaires: a position, an axis and a luminous intensity distribution, as written
+//! in a scene file's `LIGHTBEGIN` ... `LIGHTEND` block ([`crate::io::scene_file`]).
+//!
+//! # Units
+//!
+//! Scene lengths are metres (unless the command line's `--scale` said otherwise), so a
+//! luminous intensity I in candela gives an illuminance `E = I cos(theta) / d^2` in lux at a
+//! distance d in metres, and the radiosity solution's exitances are lm/m^2. Each band of the
+//! light is the intensity times its `COLOUR` (1 1 1 unless given): photometric reports weigh
+//! the bands by [`crate::light::Rgb::luminance`], so an untinted light reports its own value.
+//!
+//! # Distributions
+//!
+//! * `ISOTROPIC`: I in every direction; flux 4 pi I.
+//! * `COSINE`: I0 cos(theta) in the hemisphere around the axis, nothing behind it; flux
+//!   pi I0 (a Lambertian disc seen from far away).
+//! * `IES file.ies`: an IES LM-63 type C table ([`crate::photometry::ies`]).
+//!
+//! `INTENSITY I` gives the intensity on the axis (for `ISOTROPIC`, in every direction);
+//! `FLUX P` gives the lumens emitted in all directions instead, and the intensity follows
+//! from the distribution's shape. An IES light takes `FLUX` to scale its table to P lumens,
+//! and otherwise its candela values stand as the file gives them.
+//!
+//! # Angles and the azimuth convention
+//!
+//! theta is the angle from the axis (`AIM`, default 0 0 -1: straight down), the photometric
+//! axis of type C photometry (theta = 0 is nadir for a downlight). The azimuth phi (the C
+//! plane) is measured round the axis from a reference direction `u` towards `v = aim x u`,
+//! counter-clockwise seen from behind the light looking along the axis... for the default
+//! aim (down) that is: phi = 0 along +x, phi = 90 degrees along +y (counter-clockwise seen
+//! from above, as the C planes of LM-63 go). For another aim, (u, v) are +x and +y turned by
+//! the smallest rotation that takes 0 0 -1 to the aim, so they change continuously with the
+//! aim; an aim straight up (0 0 1) uses the half turn about x (u = +x, v = -y).
+
+use std::f64::consts::PI;
+
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use crate::light::Rgb;
+use crate::photometry::ies::IesPhotometry;
+
+/// The default `AIM`: straight down.
+pub const DEFAULT_AIM: DVec3 = DVec3::new(0.0, 0.0, -1.0);
+
+/// The shape of a luminaire's intensity distribution.
+#[derive(Clone, Debug)]
+pub enum Distribution {
+    /// The same intensity in every direction.
+    Isotropic,
+    /// I0 cos(theta) in front of the axis, 0 behind.
+    Cosine,
+    /// A measured type C table.
+    Ies {
+        /// The path as written in the scene file (relative to the scene file's folder).
+        written: String,
+        /// The file's photometry, read when the scene was read.
+        photometry: Arc<IesPhotometry>,
+    },
+}
+
+/// Two IES distributions are the same when the scene names the same file (as written).
+impl PartialEq for Distribution {
+    fn eq(&self, other: &Distribution) -> bool {
+        match (self, other) {
+            (Distribution::Isotropic, Distribution::Isotropic)
+            | (Distribution::Cosine, Distribution::Cosine) => true,
+            (Distribution::Ies { written: a, .. }, Distribution::Ies { written: b, .. }) => a == b,
+            _ => false,
+        }
+    }
+}
+
+/// How much light a luminaire gives, as written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Output {
+    /// `INTENSITY I`: candela on the axis.
+    Intensity(f64),
+    /// `FLUX P`: lumens in all directions.
+    Flux(f64),
+    /// Neither (an IES light whose file's values stand).
+    AsTabulated,
+}
+
+/// A point light of the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Luminaire {
+    /// The block's `#NAME`.
+    pub name: String,
+    /// Where it is.
+    pub position: DVec3,
+    /// The axis as written (a direction, not necessarily of unit length).
+    pub aim: DVec3,
+    /// INTENSITY, FLUX or neither.
+    pub output: Output,
+    /// The distribution's shape.
+    pub distribution: Distribution,
+    /// The tint per band (`COLOUR`, default 1 1 1).
+    pub colour: Rgb,
+}
+
+/// Problems with a luminaire's values (the scene reader reports them at their lines).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LuminaireError {
+    /// The aim is the zero vector or not finite.
+    #[error("the aim must be a non-zero direction")]
+    ZeroAim,
+    /// INTENSITY given for an IES distribution.
+    #[error("an IES distribution takes FLUX (to scale the table) or neither, not INTENSITY")]
+    IntensityWithIes,
+    /// Neither INTENSITY nor FLUX for ISOTROPIC or COSINE.
+    #[error("an ISOTROPIC or COSINE light needs INTENSITY (cd) or FLUX (lm)")]
+    NoOutput,
+    /// The IES table emits nothing, so FLUX cannot scale it.
+    #[error("the IES table emits no light, so FLUX cannot scale it")]
+    DarkTable,
+}
+
+impl Luminaire {
+    /// Checks the combination of values (the ranges are the reader's).
+    pub fn check(&self) -> Result<(), LuminaireError> {
+        if !(self.aim.is_finite() && self.aim.length_squared() > 0.0) {
+            return Err(LuminaireError::ZeroAim);
+        }
+        match (&self.distribution, self.output) {
+            (Distribution::Ies { .. }, Output::Intensity(_)) => {
+                Err(LuminaireError::IntensityWithIes)
+            }
+            (Distribution::Ies { photometry, .. }, Output::Flux(_))
+                if !(photometry.table_lumens() > 0.0) =>
+            {
+                Err(LuminaireError::DarkTable)
+            }
+            (Distribution::Isotropic | Distribution::Cosine, Output::AsTabulated) => {
+                Err(LuminaireError::NoOutput)
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The unit axis (theta = 0).
+    pub fn axis(&self) -> DVec3 {
+        self.aim.normalize()
+    }
+
+    /// The frame (u, v, w): w the axis, u the azimuth's zero, v = w x u... see the module
+    /// documentation for the convention (phi = 0 along u, phi = 90 degrees along v).
+    pub fn frame(&self) -> (DVec3, DVec3, DVec3) {
+        let w = self.axis();
+        let down = DEFAULT_AIM;
+        let c = down.dot(w);
+        let u = if c < -1.0 + 1e-6 {
+            // Straight up (or within 1e-3 rad of it, where the rotation's axis is lost in
+            // rounding): the half turn about x.
+            DVec3::X
+        } else {
+            // Rodrigues' rotation taking `down` to `w`: R x = x c + (k x x) + k (k . x) / (1 + c)
+            // with k = down x w (not normalised).
+            let k = down.cross(w);
+            DVec3::X * c + k.cross(DVec3::X) + k * (k.dot(DVec3::X) / (1.0 + c))
+        };
+        // Orthonormal to rounding, and right-handed like (x, y, -z).
+        let u = (u - w * w.dot(u)).normalize();
+        let v = -w.cross(u);
+        (u, v, w)
+    }
+
+    /// The candela scale applied to the distribution's shape (its value on the axis for
+    /// ISOTROPIC and COSINE; the factor on the table for IES).
+    fn scale(&self) -> f64 {
+        match (&self.distribution, self.output) {
+            (_, Output::Intensity(i)) => i,
+            (Distribution::Isotropic, Output::Flux(p)) => p / (4.0 * PI),
+            (Distribution::Cosine, Output::Flux(p)) => p / PI,
+            (Distribution::Ies { photometry, .. }, Output::Flux(p)) => {
+                p / photometry.table_lumens()
+            }
+            (Distribution::Ies { .. }, Output::AsTabulated) => 1.0,
+            (_, Output::AsTabulated) => 0.0,
+        }
+    }
+
+    /// The luminous intensity (cd, untinted) towards the unit direction `d` (from the
+    /// light outwards).
+    pub fn candela(&self, d: DVec3) -> f64 {
+        let (u, v, w) = self.frame();
+        let cos_theta = d.dot(w).clamp(-1.0, 1.0);
+        let shape = match &self.distribution {
+            Distribution::Isotropic => 1.0,
+            Distribution::Cosine => cos_theta.max(0.0),
+            Distribution::Ies { photometry, .. } => {
+                let theta = cos_theta.acos();
+                let phi = d.dot(v).atan2(d.dot(u)).rem_euclid(2.0 * PI);
+                photometry.candela(theta, phi)
+            }
+        };
+        self.scale() * shape
+    }
+
+    /// The intensity per band towards `d` (candela times the colour).
+    pub fn intensity(&self, d: DVec3) -> Rgb {
+        self.colour * self.candela(d)
+    }
+
+    /// The lumens it emits in all directions (untinted): 4 pi I, pi I0, or the table's
+    /// lumens times the scale.
+    pub fn flux(&self) -> f64 {
+        match &self.distribution {
+            Distribution::Isotropic => 4.0 * PI * self.scale(),
+            Distribution::Cosine => PI * self.scale(),
+            Distribution::Ies { photometry, .. } => photometry.table_lumens() * self.scale(),
+        }
+    }
+
+    /// The illuminance per band at `x` on a surface with unit normal `n`, unoccluded:
+    /// I(d) cos / r^2 (0 behind the surface).
+    pub fn irradiance_unoccluded(&self, x: DVec3, n: DVec3) -> Rgb {
+        let to_light = self.position - x;
+        let r2 = to_light.length_squared();
+        if r2 <= 0.0 {
+            return Rgb::BLACK;
+        }
+        let l = to_light / r2.sqrt();
+        let cos = n.dot(l);
+        if cos <= 0.0 {
+            return Rgb::BLACK;
+        }
+        self.intensity(-l) * (cos / r2)
+    }
+}
+
+/// The signed solid angle of triangle (a, b, c) seen from the origin (Van Oosterom and
+/// Strackee 1983): positive when the corners run counter-clockwise seen from the origin.
+pub fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let (la, lb, lc) = (a.length(), b.length(), c.length());
+    let num = a.dot(b.cross(c));
+    let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+    2.0 * num.atan2(den)
+}
+
+/// The power per band that `light` sends onto the front of the planar convex polygon
+/// `poly` (counter-clockwise from its front), divided by nothing: the integral of I over the
+/// solid angle the polygon subtends, with visibility. The polygon is fanned from corner 0
+/// and each triangle cut into `k` x `k` sub-triangles; each sub-triangle's exact solid
+/// angle is weighted by the intensity towards its centroid and by whether the segment from
+/// its centroid to the light is clear (`blocked`). For an isotropic light and no occluder
+/// this is exact (the solid angles add up), so a closed room receives every lumen to
+/// rounding. 0 when the light is behind the polygon's front.
+pub fn power_onto(
+    light: &Luminaire,
+    poly: &[DVec3],
+    k: u32,
+    blocked: impl Fn(DVec3, DVec3) -> bool,
+) -> Rgb {
+    let Some(normal) = crate::geometry::polygon_normal(poly) else {
+        return Rgb::BLACK;
+    };
+    let p = light.position;
+    if normal.dot(p - poly[0]) <= 0.0 {
+        return Rgb::BLACK;
+    }
+    let mut sum = Rgb::BLACK;
+    for i in 1..poly.len() - 1 {
+        let t = [poly[0], poly[i], poly[i + 1]];
+        crate::mesh::for_each_subtriangle(t, k, |s| {
+            // Seen from the light, a front-facing triangle runs clockwise: the solid angle
+            // comes out negative.
+            let omega = -triangle_solid_angle(s[0] - p, s[1] - p, s[2] - p);
+            if omega <= 0.0 {
+                return;
+            }
+            let centroid = (s[0] + s[1] + s[2]) / 3.0;
+            if blocked(centroid, p) {
+                return;
+            }
+            let d = (centroid - p).normalize_or_zero();
+            sum += light.intensity(d) * omega;
+        });
+    }
+    sum
+}
+
+/// The sub-triangles per fan triangle edge used for elements' first bounce
+/// ([`power_onto`]): 4 x 4 = 16 shadow rays per triangle.
+pub const ELEMENT_SUBDIVISION: u32 = 4;
+
+/// Each element's average illuminance from the point lights of `scene` (per band,
+/// lm/m^2), with the scene's surfaces as occluders: [`power_onto`] over the element divided
+/// by its area. Times rho, it is the first bounce that the solvers add to the emission.
+pub fn element_irradiance(
+    mesh: &crate::mesh::Mesh,
+    lights: &[Luminaire],
+    occluders: &crate::visibility::PolygonBvh,
+) -> Vec<Rgb> {
+    use rayon::prelude::*;
+    (0..mesh.len())
+        .into_par_iter()
+        .map(|e| {
+            let el = &mesh.elements[e];
+            if lights.is_empty() || el.area <= 0.0 {
+                return Rgb::BLACK;
+            }
+            let poly: Vec<DVec3> = mesh.corner_positions(e).collect();
+            let mut sum = Rgb::BLACK;
+            for l in lights {
+                sum += power_onto(l, &poly, ELEMENT_SUBDIVISION, |x, y| {
+                    occluders.segment_blocked(x, y)
+                });
+            }
+            sum * (1.0 / el.area)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+#[path = "luminaire_tests.rs"]
+mod tests;
