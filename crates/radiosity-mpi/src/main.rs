@@ -291,7 +291,13 @@ fn follow(world: &SimpleCommunicator, cli: Cli) -> Result<()> {
         }));
         match block {
             Ok(block) => {
-                let message = wire::result(&block.rows, rays.get(), &block.data);
+                let message = wire::result(
+                    &block.rows,
+                    rays.get(),
+                    &block.data,
+                    computer.n(),
+                    computer.upper_only(),
+                );
                 drop(block);
                 root.send_with_tag(&message[..], Tag::Result as i32);
                 blocks += 1;
@@ -668,7 +674,7 @@ fn run_job(
                         }
                     }
                     Some(Tag::Result) => {
-                        let (rows, rays, data) = wire::read_result(&bytes, n)?;
+                        let (rows, rays, data) = wire::read_result(&bytes, n, computer.upper_only())?;
                         drop(bytes);
                         job.take(rank, rows, rays, &data)?;
                     }
