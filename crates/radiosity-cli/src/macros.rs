@@ -1,7 +1,9 @@
 //! `errln!` and `outln!`: `eprintln!` and `println!` that ignore a closed or failing
-//! stream. Declared first in `main.rs` (`#[macro_use]`), so every module can use them.
+//! stream. Declared first in `lib.rs` (`#[macro_use]`), so every module can use them;
+//! exported for the binaries (`#[macro_use] extern crate radiosity_cli`).
 
 /// `eprintln!` that ignores a closed or failing stderr (a `| head` must not abort a run).
+#[macro_export]
 macro_rules! errln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
@@ -10,6 +12,7 @@ macro_rules! errln {
 }
 
 /// `println!` that ignores a closed or failing stdout.
+#[macro_export]
 macro_rules! outln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;

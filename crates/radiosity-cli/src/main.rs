@@ -1,20 +1,12 @@
 //! `radiosity`: the command-line program. A thin layer over the `radiosity` library:
 //! parse the arguments, run the pipeline, report progress and timings.
 //!
-//! `args` holds the flags as clap parses them, `setup` builds the library's objects from
-//! them, `commands` has one file per command, `report` prints what they report.
+//! The modules live in the library (src/lib.rs), shared with `radiosity-mpi`.
 
 #[macro_use]
-mod macros;
+extern crate radiosity_cli;
 
-mod args;
-mod commands;
-mod errors;
-mod peak_memory;
-mod progress_bar;
-mod report;
-mod runtime_dir;
-mod setup;
+use radiosity_cli::{args, commands, errors};
 
 use std::process::ExitCode;
 

@@ -84,8 +84,9 @@ fn method_flag_given(args: &crate::args::MethodArgs) -> Option<&'static str> {
 }
 
 /// The scene loaded, meshed with its file's settings overridden by the flags, and its
-/// form-factor method set.
-fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
+/// form-factor method set; none of [`prepare`]'s memory and work checks (for a caller that
+/// computes the matrix in blocks and never holds it: `radiosity-mpi`).
+pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
     let (file, stem) = load_scene(args.scene.as_deref(), args.scale, reporter)?;
     let overrides = Overrides {
         max_patch_area: args.max_area,
@@ -169,7 +170,8 @@ fn max_area_origin(args: &SceneArgs) -> String {
     }
 }
 
-fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
+/// The note on the scene every command prints: surfaces, elements and mesh settings.
+pub fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
     reporter.note(&format!(
         "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
         stem,

@@ -625,7 +625,7 @@ pub fn compute_matrix_reusing(
                         };
                         let g = integrator.couplings(i, j..end, rays, &mut scratch.area);
                         for (f, g) in row[j..end].iter_mut().zip(g) {
-                            *f = (g / areas[i]) as f32;
+                            *f = upper_entry(g, areas[i]);
                         }
                         done += (end - j) as u64;
                         j = end;
@@ -635,8 +635,8 @@ pub fn compute_matrix_reusing(
             // Lower triangle by reciprocity: F_ji = A_i F_ij / A_j.
             for i in 0..n {
                 for j in i + 1..n {
-                    let g = matrix.data[i * n + j] as f64 * areas[i];
-                    matrix.data[j * n + i] = (g / areas[j]) as f32;
+                    matrix.data[j * n + i] =
+                        mirrored_entry(matrix.data[i * n + j], areas[i], areas[j]);
                 }
             }
         });
@@ -656,6 +656,94 @@ pub fn compute_matrix_reusing(
         });
     }
     Ok(matrix)
+}
+
+/// F_ij = G_ij / A_i as stored (f32), from the coupling G_ij = A_i F_ij of the upper
+/// triangle: the one place this rounding is written, shared by [`compute_matrix`] and
+/// [`BlockComputer`].
+fn upper_entry(g: f64, a_i: f64) -> f32 {
+    (g / a_i) as f32
+}
+
+/// F_ji = A_i F_ij / A_j as stored (f32), from the stored (f32) upper-triangle entry F_ij:
+/// how [`compute_matrix`] fills the lower triangle of a reciprocal method, and how a writer
+/// of [`BlockComputer`]'s upper-triangle blocks must fill it to give the same bytes.
+pub fn mirrored_entry(f_ij: f32, a_i: f64, a_j: f64) -> f32 {
+    ((f_ij as f64 * a_i) / a_j) as f32
+}
+
+/// True when [`compute_matrix`] integrates only the upper triangle with `method` and fills
+/// the lower one by reciprocity ([`mirrored_entry`]): the area integral and the contour
+/// integral. Then [`BlockComputer`] gives only the entries j > i of each row.
+pub fn fills_lower_by_reciprocity(method: FormFactorMethod) -> bool {
+    // Both are pair methods (Engine::Pairs), the condition compute_matrix tests.
+    method.is_reciprocal()
+}
+
+/// Computes blocks of rows of the matrix exactly as [`compute_matrix`] does (the same
+/// arithmetic, so the same f32 bits), for a matrix split over processes or machines that
+/// each compute some blocks: the per-method machinery is built once, and each block is
+/// computed in parallel over its rows.
+///
+/// Where [`fills_lower_by_reciprocity`] holds for the method, a block holds only the upper
+/// triangle: row i's entries j > i, the others 0 (the diagonal is 0 in the matrix too);
+/// whoever assembles the matrix fills F_ji from F_ij with [`mirrored_entry`]. So each pair
+/// is integrated once over all blocks. Otherwise each row is complete.
+pub struct BlockComputer<'a> {
+    ctx: &'a FormFactorContext<'a>,
+    engine: Engine<'a>,
+    upper_only: bool,
+}
+
+impl<'a> BlockComputer<'a> {
+    /// Prepares `method` for the elements and occluders of `ctx`.
+    pub fn new(ctx: &'a FormFactorContext<'a>, method: FormFactorMethod) -> BlockComputer<'a> {
+        let engine = Engine::new(ctx, method);
+        let upper_only = fills_lower_by_reciprocity(method) && matches!(engine, Engine::Pairs(_));
+        BlockComputer {
+            ctx,
+            engine,
+            upper_only,
+        }
+    }
+
+    /// True when blocks hold the upper triangle only (see the type's documentation).
+    pub fn upper_only(&self) -> bool {
+        self.upper_only
+    }
+
+    /// The number of elements (the length of every row).
+    pub fn n(&self) -> usize {
+        self.ctx.mesh.len()
+    }
+
+    /// Rows `rows` (n entries each, row-major), counting visibility rays in `rays`.
+    pub fn block(&self, rows: Range<usize>, rays: &RayCounter) -> RowBlock {
+        let n = self.n();
+        let mesh = self.ctx.mesh;
+        let mut data = vec![0.0f32; rows.len() * n];
+        data.par_chunks_mut(n.max(1))
+            .zip(rows.clone().into_par_iter())
+            .for_each_init(Scratch::default, |scratch, (row, i)| match &self.engine {
+                Engine::Pairs(integrator) if self.upper_only => {
+                    // As compute_matrix: one call for the columns after i.
+                    let a_i = mesh.elements[i].area;
+                    let g = integrator.couplings(i, i + 1..n, rays, &mut scratch.area);
+                    for (f, g) in row[i + 1..].iter_mut().zip(g) {
+                        *f = upper_entry(g, a_i);
+                    }
+                }
+                engine => {
+                    for (f, v) in row
+                        .iter_mut()
+                        .zip(engine.row(self.ctx, i, rays, scratch))
+                    {
+                        *f = v as f32;
+                    }
+                }
+            });
+        RowBlock { rows, data }
+    }
 }
 
 /// Computes rows `rows` of the matrix (all n columns each), without using reciprocity, so

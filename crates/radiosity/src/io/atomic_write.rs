@@ -35,6 +35,25 @@ pub fn write_atomically(
             return out.flush();
         }
     }
+    let (file, tmp, target) = temporary_beside(path)?;
+    let mut out = io::BufWriter::new(file);
+    write(&mut out)?;
+    out.flush()?;
+    out.get_ref().sync_all()?;
+    drop(out);
+    tmp.persist(target).map_err(|e| e.error)
+}
+
+/// The temporary file that [`write_atomically`] writes and renames onto `path`: made beside
+/// `path` (beside the target of a symbolic link), named `.NAME.PID.RANDOM.tmp`, with the
+/// permissions [`std::fs::File::create`] would give, after the stale temporaries of `path`
+/// are removed. Returns the file, its path, and the path to rename it to (`path`, or the
+/// target of the link): `tmp.persist(target)` puts it in place; dropping `tmp` removes it. For writers
+/// that fill a file out of order (`form_factor_file::FormFactorStreamWriter`); the caller
+/// refuses inputs and non-regular files first.
+pub(crate) fn temporary_beside(
+    path: &Path,
+) -> io::Result<(std::fs::File, tempfile::TempPath, std::path::PathBuf)> {
     let resolved;
     let path = match std::fs::symlink_metadata(path) {
         Ok(meta) if meta.file_type().is_symlink() => {
@@ -60,14 +79,9 @@ pub fn write_atomically(
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
     // The file is written through its own handle; `tmp` removes it when dropped, which is
-    // what happens on every early return below.
+    // what happens on every early return of the callers.
     let (file, tmp) = builder.tempfile_in(dir)?.into_parts();
-    let mut out = io::BufWriter::new(file);
-    write(&mut out)?;
-    out.flush()?;
-    out.get_ref().sync_all()?;
-    drop(out);
-    tmp.persist(path).map_err(|e| e.error)
+    Ok((file, tmp, path.to_path_buf()))
 }
 
 /// How long a dead run's temporary file is left alone: longer than any write of ours takes

@@ -301,6 +301,199 @@ pub fn write_form_factors(
     })
 }
 
+/// Writes a form-factor file block by block, in any order, with the same bytes as
+/// [`write_form_factors`] of the whole matrix: for a matrix computed in blocks by several
+/// processes ([`crate::form_factor::BlockComputer`]), so that the writer never holds more
+/// than the block at hand.
+///
+/// The file is made beside `path` as [`crate::io::write_atomically`] makes its temporary
+/// file, sized for the whole matrix (zeros), and each block is written at its place. Where
+/// the blocks hold the upper triangle only (`areas` given: the method fills the lower one by
+/// reciprocity), each block's entries F_ij, j > i, are written in their rows and their
+/// mirrors F_ji ([`crate::form_factor::mirrored_entry`]) in the rows below. [`Self::finish`]
+/// refuses to finish while a row is missing, then appends the checksum and renames the file
+/// onto `path`; dropped unfinished, the file is removed and `path` left as it was.
+pub struct FormFactorStreamWriter {
+    file: std::fs::File,
+    tmp: tempfile::TempPath,
+    target: PathBuf,
+    n: usize,
+    header_len: u64,
+    areas: Option<Vec<f64>>,
+    written: Vec<bool>,
+}
+
+impl FormFactorStreamWriter {
+    /// Starts the file for an n x n matrix with this mesh's `fingerprint` and `method`;
+    /// `areas` (n element areas) when blocks hold the upper triangle only.
+    pub fn create(
+        path: &Path,
+        n: usize,
+        fingerprint: u64,
+        method: &str,
+        areas: Option<Vec<f64>>,
+    ) -> io::Result<FormFactorStreamWriter> {
+        if method.len() > MAX_METHOD_LEN as usize {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "form-factor method description is {} bytes, more than {MAX_METHOD_LEN}",
+                    method.len()
+                ),
+            ));
+        }
+        if areas.as_ref().is_some_and(|a| a.len() != n) {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "one area per element is needed to mirror the upper triangle",
+            ));
+        }
+        crate::io::inputs::refuse_output(path)?;
+        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "a form-factor file written in blocks must be a regular file (it is filled \
+                 out of order, then renamed into place)",
+            ));
+        }
+        let (file, tmp, target) = crate::io::atomic_write::temporary_beside(path)?;
+        let mut header = Vec::new();
+        {
+            let mut w = CrcWriter {
+                inner: &mut header,
+                crc: crc32fast::Hasher::new(),
+            };
+            w.put(&FORM_FACTOR_MAGIC)?;
+            w.put(&FORM_FACTOR_FILE_VERSION.to_le_bytes())?;
+            w.put(&(n as u64).to_le_bytes())?;
+            w.put(&(method.len() as u32).to_le_bytes())?;
+            w.put(method.as_bytes())?;
+            w.put(&fingerprint.to_le_bytes())?;
+            w.put_crc()?;
+        }
+        let header_len = header.len() as u64;
+        let mut writer = FormFactorStreamWriter {
+            file,
+            tmp,
+            target,
+            n,
+            header_len,
+            areas,
+            written: vec![false; n],
+        };
+        writer.write_at(&header, 0)?;
+        // The matrix as zeros (sparse where the file system allows), then the blocks.
+        writer.file.set_len(header_len + 4 * (n as u64) * (n as u64))?;
+        Ok(writer)
+    }
+
+    /// The number of rows.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Rows written so far.
+    pub fn rows_written(&self) -> usize {
+        self.written.iter().filter(|&&w| w).count()
+    }
+
+    fn write_at(&mut self, bytes: &[u8], offset: u64) -> io::Result<()> {
+        use std::io::{Seek, SeekFrom};
+        self.file.seek(SeekFrom::Start(offset))?;
+        self.file.write_all(bytes)
+    }
+
+    fn entry_offset(&self, row: usize, col: usize) -> u64 {
+        self.header_len + 4 * (row as u64 * self.n as u64 + col as u64)
+    }
+
+    /// Writes rows `rows` (`data` row-major, n entries a row): whole rows, or with `areas`
+    /// the entries after the diagonal and their mirrors. A block written twice writes the
+    /// same bytes again.
+    pub fn write_block(&mut self, rows: std::ops::Range<usize>, data: &[f32]) -> io::Result<()> {
+        let n = self.n;
+        if rows.end > n || data.len() != rows.len() * n {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "block of rows {}..{} with {} entries does not fit a matrix of {n} rows",
+                    rows.start,
+                    rows.end,
+                    data.len()
+                ),
+            ));
+        }
+        let mut bytes = Vec::with_capacity(4 * n);
+        for (k, i) in rows.clone().enumerate() {
+            let row = &data[k * n..(k + 1) * n];
+            let from = if self.areas.is_some() { i + 1 } else { 0 };
+            bytes.clear();
+            bytes.extend(row[from..].iter().flat_map(|x| x.to_le_bytes()));
+            self.write_at(&bytes, self.entry_offset(i, from))?;
+        }
+        if let Some(areas) = self.areas.take() {
+            // Row j > rows.start gets columns rows.start..min(rows.end, j), one write a row.
+            let result: io::Result<()> = (|| {
+                for j in rows.start + 1..n {
+                    let cols = rows.start..rows.end.min(j);
+                    bytes.clear();
+                    for i in cols.clone() {
+                        let f_ij = data[(i - rows.start) * n + j];
+                        let f_ji = crate::form_factor::mirrored_entry(f_ij, areas[i], areas[j]);
+                        bytes.extend(f_ji.to_le_bytes());
+                    }
+                    self.write_at(&bytes, self.entry_offset(j, cols.start))?;
+                }
+                Ok(())
+            })();
+            self.areas = Some(areas);
+            result?;
+        }
+        for w in &mut self.written[rows] {
+            *w = true;
+        }
+        Ok(())
+    }
+
+    /// Appends the checksum and renames the file onto the path given to
+    /// [`Self::create`]; refused (`InvalidData`, naming the first missing rows) while a
+    /// row has not been written.
+    pub fn finish(mut self) -> io::Result<()> {
+        use std::io::{Seek, SeekFrom};
+        if let Some(first) = self.written.iter().position(|w| !w) {
+            let end = self.written[first..]
+                .iter()
+                .position(|&w| w)
+                .map_or(self.n, |k| first + k);
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "rows {first}..{end} of the form-factor matrix were never written ({} of \
+                     {} rows are)",
+                    self.rows_written(),
+                    self.n
+                ),
+            ));
+        }
+        self.file.seek(SeekFrom::Start(0))?;
+        let mut crc = crc32fast::Hasher::new();
+        let mut buf = vec![0u8; 4 * CHUNK_ENTRIES];
+        let mut reader = (&self.file).take(self.header_len + 4 * (self.n as u64).pow(2));
+        loop {
+            let got = reader.read(&mut buf)?;
+            if got == 0 {
+                break;
+            }
+            crc.update(&buf[..got]);
+        }
+        let end = self.header_len + 4 * (self.n as u64).pow(2);
+        self.write_at(&crc.finalize().to_le_bytes(), end)?;
+        self.file.sync_all()?;
+        drop(self.file);
+        self.tmp.persist(&self.target).map_err(|e| e.error)
+    }
+}
+
 /// Reads a form-factor file written by [`write_form_factors`].
 ///
 /// Refuses, with a message naming the file, anything but an intact current-version file whose

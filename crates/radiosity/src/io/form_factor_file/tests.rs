@@ -478,3 +478,89 @@ fn forged_row_sums_above_one_and_a_half_are_refused() {
     ));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The Cornell box (its tall block occludes) at a coarse mesh, for every method: the
+/// matrix computed in blocks by [`crate::form_factor::BlockComputer`] and written block by
+/// block, in a shuffled order, by [`FormFactorStreamWriter`] gives the very bytes of
+/// [`write_form_factors`] of [`crate::form_factor::compute_matrix`]. The MPI program relies
+/// on it to write what `radiosity formfactors` writes.
+#[test]
+fn blocks_streamed_in_any_order_give_the_whole_matrix_file() {
+    use crate::form_factor::{compute_matrix, fills_lower_by_reciprocity, BlockComputer, RayCounter};
+    use crate::pipeline::{Overrides, Prepared};
+    use crate::progress::NoProgress;
+    let file = crate::scene::cornell_box();
+    let coarse = Overrides {
+        max_patch_area: Some(40_000.0),
+        integral_steps: Some(2),
+    };
+    let mut prepared = Prepared::new(file.scene, coarse.apply(file.settings), &NoProgress).unwrap();
+    let n = prepared.mesh.len();
+    assert!(n > 20, "{n} elements: too few for blocks of 7 rows to matter");
+    let dir = temp_dir("stream");
+    for method in [
+        FormFactorMethod::AreaIntegral { steps: 2 },
+        FormFactorMethod::Contour { steps: 2 },
+        FormFactorMethod::Analytic { steps: 2 },
+        FormFactorMethod::Hemicube { resolution: 16 },
+        FormFactorMethod::MonteCarlo {
+            samples: 16,
+            seed: 7,
+        },
+    ] {
+        prepared.method = method;
+        let ctx = prepared.context();
+        let rays = RayCounter::default();
+        let whole = compute_matrix(&ctx, method, &rays, &NoProgress).unwrap();
+        let reference = dir.join("whole.ff");
+        write_form_factors(&reference, &whole, prepared.fingerprint(), &method.to_string())
+            .unwrap();
+        let computer = BlockComputer::new(&ctx, method);
+        assert_eq!(computer.upper_only(), fills_lower_by_reciprocity(method));
+        let streamed = dir.join("streamed.ff");
+        let areas = computer.upper_only().then(|| prepared.areas());
+        let mut writer = FormFactorStreamWriter::create(
+            &streamed,
+            n,
+            prepared.fingerprint(),
+            &method.to_string(),
+            areas,
+        )
+        .unwrap();
+        // Blocks of 7 rows (the last shorter), last first, then the even ones, then the odd.
+        let blocks: Vec<_> = (0..n).step_by(7).map(|s| s..(s + 7).min(n)).collect();
+        let mut order: Vec<usize> = vec![blocks.len() - 1];
+        order.extend((0..blocks.len() - 1).filter(|b| b % 2 == 0));
+        order.extend((0..blocks.len() - 1).filter(|b| b % 2 == 1));
+        for &b in &order {
+            let block = computer.block(blocks[b].clone(), &rays);
+            writer.write_block(block.rows, &block.data).unwrap();
+        }
+        writer.finish().unwrap();
+        assert!(
+            std::fs::read(&reference).unwrap() == std::fs::read(&streamed).unwrap(),
+            "{method}: the streamed file differs from the whole matrix's"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A block never written: `finish` refuses, naming the missing rows, and neither the file
+/// nor a temporary is left.
+#[test]
+fn a_stream_with_a_missing_block_is_not_finished() {
+    let dir = temp_dir("stream-missing");
+    let path = dir.join("out.ff");
+    let mut writer = FormFactorStreamWriter::create(&path, 6, 1, METHOD, None).unwrap();
+    writer.write_block(0..2, &[0.1; 12]).unwrap();
+    writer.write_block(4..6, &[0.1; 12]).unwrap();
+    let err = writer.finish().unwrap_err();
+    assert_eq!(err.kind(), io::ErrorKind::InvalidData);
+    assert!(
+        err.to_string()
+            .starts_with("rows 2..4 of the form-factor matrix were never written (4 of 6"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "left files behind");
+    let _ = std::fs::remove_dir_all(&dir);
+}
