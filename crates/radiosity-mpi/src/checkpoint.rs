@@ -221,7 +221,11 @@ impl Checkpoint {
         let mut files = checkpoint.block_files()?;
         files.sort_by_key(|(rows, _)| (rows.start, rows.end));
         for (rows, path) in files {
-            if result.blocks.last().is_some_and(|last| last.end > rows.start) {
+            if result
+                .blocks
+                .last()
+                .is_some_and(|last| last.end > rows.start)
+            {
                 result.refused.push((path, "overlaps another block".into()));
                 continue;
             }
@@ -263,7 +267,12 @@ impl Checkpoint {
     /// Writes a finished block (atomically: a killed job leaves the whole file or none).
     pub fn save(&self, rows: &Range<usize>, data: &[f32]) -> Result<(), CheckpointError> {
         let path = self.block_path(rows);
-        let bytes = encode_block(self.identity.fingerprint, self.identity.elements, rows, data);
+        let bytes = encode_block(
+            self.identity.fingerprint,
+            self.identity.elements,
+            rows,
+            data,
+        );
         radiosity::io::write_atomically(&path, |out| {
             use std::io::Write;
             out.write_all(&bytes)
@@ -336,12 +345,7 @@ fn decode_block(
         return Err("not a block file (it does not start with RADBLK)".into());
     }
     let word = |k: usize| u64::from_le_bytes(body[8 + 8 * k..16 + 8 * k].try_into().expect("8"));
-    let header = [
-        fingerprint,
-        n as u64,
-        rows.start as u64,
-        rows.end as u64,
-    ];
+    let header = [fingerprint, n as u64, rows.start as u64, rows.end as u64];
     if (0..4).map(word).ne(header) {
         return Err(format!(
             "its header (fingerprint {:016x}, {} elements, rows {}..{}) is not this job's block",
@@ -364,14 +368,13 @@ fn read_manifest(path: &Path) -> Result<JobIdentity, CheckpointError> {
         source,
     })?;
     let mut lines = text.lines();
-    let bad = |line: usize, expected: &'static str, found: Option<&str>| {
-        CheckpointError::BadManifest {
+    let bad =
+        |line: usize, expected: &'static str, found: Option<&str>| CheckpointError::BadManifest {
             path: path.to_path_buf(),
             line,
             expected,
             found: found.unwrap_or("end of file").to_string(),
-        }
-    };
+        };
     let first = lines.next();
     if first != Some(MANIFEST_HEADER) {
         return Err(bad(1, "`radiosity-mpi checkpoint 1`", first));
@@ -388,8 +391,13 @@ fn read_manifest(path: &Path) -> Result<JobIdentity, CheckpointError> {
         .parse()
         .map_err(|_| bad(3, "`elements N` with N a whole number", Some(&elements)))?;
     let fingerprint = field(4, "fingerprint", "`fingerprint HEX`")?;
-    let fingerprint = u64::from_str_radix(&fingerprint, 16)
-        .map_err(|_| bad(4, "`fingerprint HEX` with 16 hex digits", Some(&fingerprint)))?;
+    let fingerprint = u64::from_str_radix(&fingerprint, 16).map_err(|_| {
+        bad(
+            4,
+            "`fingerprint HEX` with 16 hex digits",
+            Some(&fingerprint),
+        )
+    })?;
     let method = field(5, "method", "`method NAME`")?;
     Ok(JobIdentity {
         scene,
@@ -440,7 +448,11 @@ mod tests {
         let (_, found) = Checkpoint::open(dir.path(), &identity(), true).unwrap();
         assert!(found.blocks.is_empty());
         assert_eq!(found.refused.len(), 1);
-        assert!(found.refused[0].1.starts_with("checksum"), "{:?}", found.refused);
+        assert!(
+            found.refused[0].1.starts_with("checksum"),
+            "{:?}",
+            found.refused
+        );
         bytes.truncate(20);
         std::fs::write(&path, &bytes).unwrap();
         let (_, found) = Checkpoint::open(dir.path(), &identity(), true).unwrap();
@@ -493,11 +505,21 @@ mod tests {
             )
         );
         // A fresh job in a directory holding a job, and a resume of nothing.
-        let err = Checkpoint::open(dir.path(), &identity(), false).err().unwrap();
-        assert!(matches!(err, CheckpointError::NotEmpty { blocks: 0, .. }), "{err}");
+        let err = Checkpoint::open(dir.path(), &identity(), false)
+            .err()
+            .unwrap();
+        assert!(
+            matches!(err, CheckpointError::NotEmpty { blocks: 0, .. }),
+            "{err}"
+        );
         let empty = tempfile::tempdir().unwrap();
-        let err = Checkpoint::open(empty.path(), &identity(), true).err().unwrap();
-        assert!(matches!(err, CheckpointError::NothingToResume { .. }), "{err}");
+        let err = Checkpoint::open(empty.path(), &identity(), true)
+            .err()
+            .unwrap();
+        assert!(
+            matches!(err, CheckpointError::NothingToResume { .. }),
+            "{err}"
+        );
     }
 
     /// A manifest edited by hand: the line and what was expected.
@@ -508,7 +530,9 @@ mod tests {
         let path = dir.path().join("manifest");
         let text = std::fs::read_to_string(&path).unwrap();
         std::fs::write(&path, text.replace("elements 5", "elements five")).unwrap();
-        let err = Checkpoint::open(dir.path(), &identity(), true).err().unwrap();
+        let err = Checkpoint::open(dir.path(), &identity(), true)
+            .err()
+            .unwrap();
         assert_eq!(
             err.to_string(),
             format!(

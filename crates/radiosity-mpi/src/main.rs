@@ -29,18 +29,18 @@ use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
+use radiosity::form_factor::available_memory_bytes;
 use radiosity::form_factor::{BlockComputer, RayCounter};
 use radiosity::io::form_factor_file::FormFactorStreamWriter;
 use radiosity::pipeline::Prepared;
-use radiosity::form_factor::available_memory_bytes;
 use radiosity::solve::SolverKind;
 use radiosity_cli::args::{
     FormFactorArgs, RenderArgs, SceneArgs, SolveArgs, SolveOptions, SolverArg,
 };
-use radiosity_cli::setup::DEFAULT_ADAPT_ROUNDS;
 use radiosity_cli::errors::describe;
 use radiosity_cli::progress_bar::Reporter;
 use radiosity_cli::setup;
+use radiosity_cli::setup::DEFAULT_ADAPT_ROUNDS;
 use radiosity_mpi::checkpoint::{Checkpoint, JobIdentity};
 use radiosity_mpi::deal::{default_block_rows, Dealer};
 use radiosity_mpi::wire::{self, Tag};
@@ -243,7 +243,12 @@ fn scratch_file(output: Option<&Path>) -> Result<tempfile::TempPath> {
         .prefix(".radiosity-mpi.")
         .suffix(".ff")
         .tempfile_in(&dir)
-        .with_context(|| format!("cannot make a temporary form-factor file in {}", dir.display()))?
+        .with_context(|| {
+            format!(
+                "cannot make a temporary form-factor file in {}",
+                dir.display()
+            )
+        })?
         .into_temp_path())
 }
 
@@ -357,7 +362,10 @@ impl Job<'_> {
             radiosity::form_factor::check_row(rows.start + k, row.iter().map(|&f| f as f64))
                 .map_err(|e| anyhow!("rank {rank}, rows {}..{}: {e}", rows.start, rows.end))?;
         }
-        let writer = self.writer.as_mut().expect("the writer lives until the end");
+        let writer = self
+            .writer
+            .as_mut()
+            .expect("the writer lives until the end");
         writer
             .write_block(rows.clone(), data)
             .with_context(|| format!("cannot write {}", self.output.display()))?;
@@ -533,7 +541,9 @@ fn run_job(
         scene: scene
             .scene
             .as_deref()
-            .map_or("the built-in Cornell box".into(), |p| p.display().to_string()),
+            .map_or("the built-in Cornell box".into(), |p| {
+                p.display().to_string()
+            }),
         elements: n,
         fingerprint: prepared.fingerprint(),
         method: method.to_string(),
@@ -542,12 +552,11 @@ fn run_job(
         Some(dir) => {
             let (cp, found) =
                 Checkpoint::open(dir, &identity, mpi.resume).map_err(|e| match e {
-                    e @ radiosity_mpi::checkpoint::CheckpointError::NotEmpty { .. } => {
-                        anyhow!(e).context(
+                    e @ radiosity_mpi::checkpoint::CheckpointError::NotEmpty { .. } => anyhow!(e)
+                        .context(
                             "add --resume to continue that job, or give --checkpoint an \
                              empty or new directory",
-                        )
-                    }
+                        ),
                     e => anyhow!(e),
                 })?;
             for (path, why) in &found.refused {
@@ -564,8 +573,14 @@ fn run_job(
     let ctx = prepared.context();
     let computer = BlockComputer::new(&ctx, method);
     let areas = computer.upper_only().then(|| prepared.areas());
-    let writer = FormFactorStreamWriter::create(output, n, prepared.fingerprint(), &method.to_string(), areas)
-        .with_context(|| format!("cannot write {}", output.display()))?;
+    let writer = FormFactorStreamWriter::create(
+        output,
+        n,
+        prepared.fingerprint(),
+        &method.to_string(),
+        areas,
+    )
+    .with_context(|| format!("cannot write {}", output.display()))?;
     let block_rows = mpi
         .block_rows
         .map_or_else(|| default_block_rows(n, ranks), |b| b as usize);
@@ -581,10 +596,15 @@ fn run_job(
         blocks_by_rank: vec![0; ranks],
     };
     if !found.is_empty() {
-        let cp = job.checkpoint.as_ref().expect("blocks come from a checkpoint");
+        let cp = job
+            .checkpoint
+            .as_ref()
+            .expect("blocks come from a checkpoint");
         let rows: usize = found.iter().map(|b| b.len()).sum();
         for b in &found {
-            let data = cp.load(b).map_err(|why| anyhow!("checkpoint block {}..{}: {why}", b.start, b.end))?;
+            let data = cp
+                .load(b)
+                .map_err(|why| anyhow!("checkpoint block {}..{}: {why}", b.start, b.end))?;
             job.writer
                 .as_mut()
                 .expect("the writer")
@@ -615,7 +635,8 @@ fn run_job(
     let result = std::thread::scope(|scope| -> Result<()> {
         // Rank 0 computes blocks too, on its own thread (which makes no MPI call).
         let (to_local, local_rx) = mpsc::channel::<Range<usize>>();
-        let (local_tx, from_local) = mpsc::channel::<(Range<usize>, u64, Result<Vec<f32>, String>)>();
+        let (local_tx, from_local) =
+            mpsc::channel::<(Range<usize>, u64, Result<Vec<f32>, String>)>();
         let computer = &computer;
         scope.spawn(move || {
             for rows in local_rx {
@@ -674,7 +695,8 @@ fn run_job(
                         }
                     }
                     Some(Tag::Result) => {
-                        let (rows, rays, data) = wire::read_result(&bytes, n, computer.upper_only())?;
+                        let (rows, rays, data) =
+                            wire::read_result(&bytes, n, computer.upper_only())?;
                         drop(bytes);
                         job.take(rank, rows, rays, &data)?;
                     }
@@ -689,7 +711,10 @@ fn run_job(
                             });
                         bail!("rank {rank} failed {block}: {text}");
                     }
-                    _ => bail!("rank {rank} sent an unexpected message (tag {})", status.tag()),
+                    _ => bail!(
+                        "rank {rank} sent an unexpected message (tag {})",
+                        status.tag()
+                    ),
                 }
                 match job.dealer.deal(rank) {
                     Some(rows) => peer.send_with_tag(&wire::assign(&rows)[..], Tag::Assign as i32),

@@ -43,11 +43,17 @@ fn mpirun() -> Option<PathBuf> {
 /// cores) and as root where the CI runs as root.
 fn mpi_command(mpirun: &Path, np: usize, args: &[&str]) -> Command {
     let mut cmd = Command::new(mpirun);
-    cmd.args(["--oversubscribe", "--allow-run-as-root", "-np", &np.to_string(), BIN])
-        .args(args)
-        // One rayon thread a rank: 4 ranks on 2 cores stay responsive.
-        .env("RAYON_NUM_THREADS", "1")
-        .stdin(Stdio::null());
+    cmd.args([
+        "--oversubscribe",
+        "--allow-run-as-root",
+        "-np",
+        &np.to_string(),
+        BIN,
+    ])
+    .args(args)
+    // One rayon thread a rank: 4 ranks on 2 cores stay responsive.
+    .env("RAYON_NUM_THREADS", "1")
+    .stdin(Stdio::null());
     cmd
 }
 
@@ -111,7 +117,13 @@ fn every_method_on_1_2_and_4_ranks_writes_the_single_process_file() {
     ];
     for method in methods {
         let reference = dir.path().join("single.ff");
-        let mut args = vec!["formfactors", scene, "-q", "-o", reference.to_str().unwrap()];
+        let mut args = vec![
+            "formfactors",
+            scene,
+            "-q",
+            "-o",
+            reference.to_str().unwrap(),
+        ];
         args.extend(MESH);
         args.extend(method);
         single(&args);
@@ -147,7 +159,10 @@ fn solve_and_render_on_2_ranks_write_the_single_process_files() {
     let mut args = vec!["solve", scene, "-q", "-o", &csv2];
     args.extend(MESH);
     run_mpi(&mpirun, 2, &args);
-    assert!(same_bytes(Path::new(&csv1), Path::new(&csv2)), "solve differs");
+    assert!(
+        same_bytes(Path::new(&csv1), Path::new(&csv2)),
+        "solve differs"
+    );
     let (png1, png2) = (path("single.png"), path("mpi.png"));
     let size = ["--width", "48", "--height", "32", "--supersample", "1"];
     let mut args = vec!["render", scene, "-q", "-o", &png1];
@@ -158,7 +173,10 @@ fn solve_and_render_on_2_ranks_write_the_single_process_files() {
     args.extend(MESH);
     args.extend(size);
     run_mpi(&mpirun, 2, &args);
-    assert!(same_bytes(Path::new(&png1), Path::new(&png2)), "render differs");
+    assert!(
+        same_bytes(Path::new(&png1), Path::new(&png2)),
+        "render differs"
+    );
     // Nothing left beside the outputs (the scratch form-factor file is removed).
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
@@ -183,10 +201,7 @@ fn pid_of_rank(rank: usize) -> Option<u32> {
             continue;
         }
         let environ = std::fs::read(entry.path().join("environ")).unwrap_or_default();
-        if environ
-            .split(|&b| b == 0)
-            .any(|v| v == want.as_bytes())
-        {
+        if environ.split(|&b| b == 0).any(|v| v == want.as_bytes()) {
             return Some(pid);
         }
     }
@@ -232,7 +247,13 @@ fn a_rank_killed_midway_then_resumed_gives_the_same_file() {
     let checkpoint = dir.path().join("checkpoint");
     // A finer mesh (about 400 elements), blocks of 2 rows: long enough to be killed midway.
     let mesh = ["--max-area", "0.1", "--steps", "1"];
-    let mut args = vec!["formfactors", scene, "-q", "-o", reference.to_str().unwrap()];
+    let mut args = vec![
+        "formfactors",
+        scene,
+        "-q",
+        "-o",
+        reference.to_str().unwrap(),
+    ];
     args.extend(mesh);
     single(&args);
     let mut args = vec![
@@ -253,7 +274,10 @@ fn a_rank_killed_midway_then_resumed_gives_the_same_file() {
         .unwrap();
     let start = Instant::now();
     while block_files(&checkpoint) < 3 {
-        assert!(start.elapsed() < Duration::from_secs(60), "no block after 60 s");
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no block after 60 s"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     let pid = pid_of_rank(1).expect("rank 1 runs");
@@ -330,7 +354,15 @@ fn a_checkpoint_of_another_method_or_mesh_is_refused() {
     let out = dir.path().join("a.ff");
     let checkpoint = dir.path().join("cp");
     let cp = checkpoint.to_str().unwrap();
-    let base = vec!["formfactors", scene, "-q", "-o", out.to_str().unwrap(), "--checkpoint", cp];
+    let base = vec![
+        "formfactors",
+        scene,
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+        "--checkpoint",
+        cp,
+    ];
     let with = |extra: &[&'static str]| -> Vec<&str> {
         let mut a = base.clone();
         a.extend(extra);
@@ -358,7 +390,10 @@ fn a_checkpoint_of_another_method_or_mesh_is_refused() {
     // Without --resume, a directory holding a job is refused too.
     let out2 = mpi_command(&mpirun, 1, &args).output().unwrap();
     let err = String::from_utf8_lossy(&out2.stderr);
-    assert!(err.contains("already holds a job") && err.contains("--resume"), "{err}");
+    assert!(
+        err.contains("already holds a job") && err.contains("--resume"),
+        "{err}"
+    );
     // The same job resumed: nothing to compute, the same file.
     let mut again = args.clone();
     again.push("--resume");

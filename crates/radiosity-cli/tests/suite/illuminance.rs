@@ -110,3 +110,25 @@ fn illuminance_at_points_and_on_a_grid() {
     assert!(stderr(&out).contains("--normal"), "{}", stderr(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn auto_takes_progressive_refinement_for_a_large_scene_with_point_lights() {
+    // Above 20,000 elements `auto` picks hierarchical radiosity, which does not take point
+    // luminaires yet (it refuses them with a typed error): a user who only meshed finer
+    // must still get a solution. The CIE 171 point-source room (96 m^2) at MAX_PATCH_AREA
+    // 0.004 meshes to just over 20,000 elements.
+    let dir = scratch_dir("auto-lights");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../validation/cie171_5_2_point_source.scene"
+    );
+    let out = radiosity(
+        &["solve", scene, "--max-area", "0.004", "-o", "out.csv"],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("point luminaire"), "{err}");
+    assert!(err.contains("progressive refinement instead"), "{err}");
+    assert!(dir.join("out.csv").exists(), "{err}");
+}

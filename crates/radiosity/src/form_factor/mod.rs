@@ -734,10 +734,7 @@ impl<'a> BlockComputer<'a> {
                     }
                 }
                 engine => {
-                    for (f, v) in row
-                        .iter_mut()
-                        .zip(engine.row(self.ctx, i, rays, scratch))
-                    {
+                    for (f, v) in row.iter_mut().zip(engine.row(self.ctx, i, rays, scratch)) {
                         *f = v as f32;
                     }
                 }

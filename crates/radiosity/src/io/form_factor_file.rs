@@ -383,7 +383,9 @@ impl FormFactorStreamWriter {
         };
         writer.write_at(&header, 0)?;
         // The matrix as zeros (sparse where the file system allows), then the blocks.
-        writer.file.set_len(header_len + 4 * (n as u64) * (n as u64))?;
+        writer
+            .file
+            .set_len(header_len + 4 * (n as u64) * (n as u64))?;
         Ok(writer)
     }
 

@@ -486,7 +486,9 @@ fn forged_row_sums_above_one_and_a_half_are_refused() {
 /// on it to write what `radiosity formfactors` writes.
 #[test]
 fn blocks_streamed_in_any_order_give_the_whole_matrix_file() {
-    use crate::form_factor::{compute_matrix, fills_lower_by_reciprocity, BlockComputer, RayCounter};
+    use crate::form_factor::{
+        compute_matrix, fills_lower_by_reciprocity, BlockComputer, RayCounter,
+    };
     use crate::pipeline::{Overrides, Prepared};
     use crate::progress::NoProgress;
     let file = crate::scene::cornell_box();
@@ -496,7 +498,10 @@ fn blocks_streamed_in_any_order_give_the_whole_matrix_file() {
     };
     let mut prepared = Prepared::new(file.scene, coarse.apply(file.settings), &NoProgress).unwrap();
     let n = prepared.mesh.len();
-    assert!(n > 20, "{n} elements: too few for blocks of 7 rows to matter");
+    assert!(
+        n > 20,
+        "{n} elements: too few for blocks of 7 rows to matter"
+    );
     let dir = temp_dir("stream");
     for method in [
         FormFactorMethod::AreaIntegral { steps: 2 },
@@ -513,8 +518,13 @@ fn blocks_streamed_in_any_order_give_the_whole_matrix_file() {
         let rays = RayCounter::default();
         let whole = compute_matrix(&ctx, method, &rays, &NoProgress).unwrap();
         let reference = dir.join("whole.ff");
-        write_form_factors(&reference, &whole, prepared.fingerprint(), &method.to_string())
-            .unwrap();
+        write_form_factors(
+            &reference,
+            &whole,
+            prepared.fingerprint(),
+            &method.to_string(),
+        )
+        .unwrap();
         let computer = BlockComputer::new(&ctx, method);
         assert_eq!(computer.upper_only(), fills_lower_by_reciprocity(method));
         let streamed = dir.join("streamed.ff");
@@ -561,6 +571,10 @@ fn a_stream_with_a_missing_block_is_not_finished() {
             .starts_with("rows 2..4 of the form-factor matrix were never written (4 of 6"),
         "{err}"
     );
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "left files behind");
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "left files behind"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
