@@ -23,6 +23,8 @@
 //! leaf's side of it (the bottom of that sphere saw none of the floor under it). Measured
 //! against the path tracer (BENCHMARKS.md): building_small 4.94 -> 3.18 % pixel RMS,
 //! room.scene 3.79 -> 2.81 %, the Cornell box unchanged, at up to twice the gather's time.
+//! Above [`CLUSTER_WALK_MAX_POINTS`] gather points it costs too much (the million-element
+//! building: four times the solve) and the clusters' links come through their bins.
 //!
 //! Before it, leaves that span several cells of the scene's mesh are split down to single
 //! cells (children inheriting their parent's radiosity), so that the solution has at least
@@ -51,7 +53,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::bins::cluster_emission;
+use super::bins::{cluster_emission, irradiance_for};
 use super::link::{patch_form_factor, Link};
 use super::solver::Solver;
 use super::tree::NONE;
@@ -75,6 +77,14 @@ const GATHER_PASSES: usize = 2;
 /// sum over the terms, no rays) until the power that changes is below the solve's
 /// tolerance, or this many passes.
 const MAX_GATHER_PASSES: usize = 200;
+
+/// The most gather points at which the links of the clusters above a leaf are gathered at
+/// the leaf (see the module documentation); with more, the leaves take them through the
+/// clusters' irradiance bins, as the sweeps do. On the million-element building (236,916
+/// points, 23,231 clusters) gathering them took the solve from 243 to about 950 s of CPU
+/// (1.8 billion rays) for 7.35 -> 6.63 % pixel RMS; on building_small (7,922 points) it
+/// about doubles the gather's time for 4.94 -> 3.18 %.
+const CLUSTER_WALK_MAX_POINTS: usize = 50_000;
 
 /// Leaves whose terms are made at once (the memory check runs between chunks).
 const TERM_CHUNK: usize = 1 << 16;
@@ -150,6 +160,30 @@ impl Solver<'_> {
                 stack.extend(children);
             }
         }
+    }
+
+    /// The irradiance each quadtree root receives through the irradiance bins of the
+    /// clusters above it (their links, accumulated downwards).
+    fn irradiance_from_clusters(&self) -> Vec<[f64; 3]> {
+        let mut out = vec![[0.0; 3]; self.root_count];
+        let mut stack = vec![(self.top, [[0.0; 6]; 3])];
+        while let Some((n, down)) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if node.is_cluster() {
+                let mut total = self.clusters[node.cluster as usize].incident;
+                for band in 0..3 {
+                    for k in 0..6 {
+                        total[band][k] += down[band][k];
+                    }
+                }
+                for &c in node.children() {
+                    stack.push((c, total));
+                }
+            } else {
+                out[n as usize] = irradiance_for(&down, self.normal[node.surface as usize]);
+            }
+        }
+        out
     }
 
     /// The terms of the irradiance at leaf `l` from patch source `q` (to `l`'s
@@ -311,6 +345,12 @@ impl Solver<'_> {
         let (parent, leaves) = self.parents_and_leaves();
         let points = self.gather_points(&leaves, self.settings.gather_points);
         self.gathered_at = points.len();
+        let walk = points.len() <= CLUSTER_WALK_MAX_POINTS;
+        let mut from_clusters = if walk {
+            Vec::new()
+        } else {
+            self.irradiance_from_clusters()
+        };
         let emitted: [f64; 3] = std::array::from_fn(|k| {
             leaves
                 .iter()
@@ -325,7 +365,7 @@ impl Solver<'_> {
         let mut kept: Vec<LeafTerms> = Vec::new();
         let mut bytes = 0u64;
         for chunk in points.chunks(TERM_CHUNK) {
-            let terms = self.leaf_terms(chunk, &parent);
+            let terms = self.leaf_terms(chunk, &parent, walk);
             bytes += terms.iter().map(LeafTerms::bytes).sum::<u64>();
             kept.extend(terms);
             if bytes > budget {
@@ -342,16 +382,23 @@ impl Solver<'_> {
         let mut h = Vec::new();
         for pass in 0..passes {
             if pass > 0 {
-                // The sources' radiosity and the clusters' power bins from the last pass.
+                // The sources' radiosity and the clusters' bins from the last pass.
                 self.pull_up(self.top);
+                if !walk {
+                    let incident = self.cluster_incident();
+                    for (c, inc) in self.clusters.iter_mut().zip(incident) {
+                        c.incident = inc;
+                    }
+                    from_clusters = self.irradiance_from_clusters();
+                }
             }
             let at_points = if cached {
-                self.evaluate(&kept)
+                self.evaluate(&kept, &from_clusters)
             } else {
                 let mut all = Vec::with_capacity(points.len());
                 for chunk in points.chunks(TERM_CHUNK) {
-                    let terms = self.leaf_terms(chunk, &parent);
-                    all.extend(self.evaluate(&terms));
+                    let terms = self.leaf_terms(chunk, &parent, walk);
+                    all.extend(self.evaluate(&terms, &from_clusters));
                 }
                 all
             };
@@ -393,8 +440,14 @@ impl Solver<'_> {
         if leaves.is_empty() {
             return;
         }
-        let terms = self.leaf_terms(&leaves, &parent);
-        let h = self.evaluate(&terms);
+        let walk = leaves.len() <= CLUSTER_WALK_MAX_POINTS;
+        let from_clusters = if walk {
+            Vec::new()
+        } else {
+            self.irradiance_from_clusters()
+        };
+        let terms = self.leaf_terms(&leaves, &parent, walk);
+        let h = self.evaluate(&terms, &from_clusters);
         for (&l, hl) in leaves.iter().zip(h) {
             let s = self.nodes[l as usize].surface as usize;
             self.b[l as usize] =
@@ -546,7 +599,7 @@ impl Solver<'_> {
     }
 
     /// The gather terms of `leaves`, in parallel; their rays are counted in the report.
-    fn leaf_terms(&mut self, leaves: &[u32], parent: &[u32]) -> Vec<LeafTerms> {
+    fn leaf_terms(&mut self, leaves: &[u32], parent: &[u32], walk: bool) -> Vec<LeafTerms> {
         let this = &*self;
         let terms: Vec<LeafTerms> = leaves
             .par_iter()
@@ -562,10 +615,11 @@ impl Solver<'_> {
                         t.patches.push((q, link.g));
                     }
                 }
-                // The ancestors' links, evaluated again for the leaf: its quadtree's and
-                // the clusters' above it (see `gather_cluster_link`).
-                let mut a = parent[l as usize];
-                while a != NONE {
+                // The ancestors' links, evaluated again for the leaf: its quadtree's, and
+                // with `walk` the clusters' above it (see `gather_cluster_link`); without,
+                // the clusters' links come through their bins to the root.
+                let (mut a, mut root) = (parent[l as usize], l);
+                while a != NONE && (walk || !this.nodes[a as usize].is_cluster()) {
                     let by_cluster = this.nodes[a as usize].is_cluster();
                     for link in &this.nodes[a as usize].links {
                         if by_cluster {
@@ -574,8 +628,12 @@ impl Solver<'_> {
                             this.gather_link(l, link, &mut t, scratch);
                         }
                     }
+                    if !by_cluster {
+                        root = a;
+                    }
                     a = parent[a as usize];
                 }
+                t.root = if walk { NONE } else { root };
                 t
             })
             .collect();
@@ -583,13 +641,18 @@ impl Solver<'_> {
         terms
     }
 
-    /// Each leaf's irradiance from its terms and the radiosity and power bins the nodes
-    /// hold now.
-    fn evaluate(&self, terms: &[LeafTerms]) -> Vec<[f64; 3]> {
+    /// Each leaf's irradiance from its terms, the radiosity and power bins the nodes hold
+    /// now, and (where the terms leave the clusters' links out) the irradiance each root
+    /// takes through the clusters' bins.
+    fn evaluate(&self, terms: &[LeafTerms], from_clusters: &[[f64; 3]]) -> Vec<[f64; 3]> {
         terms
             .par_iter()
             .map(|t| {
-                let mut h = [0.0; 3];
+                let mut h = if t.root == NONE {
+                    [0.0; 3]
+                } else {
+                    from_clusters[t.root as usize]
+                };
                 for &(q, f) in &t.patches {
                     let b = self.b[q as usize];
                     for k in 0..3 {
@@ -609,7 +672,7 @@ impl Solver<'_> {
     }
 }
 
-/// What a leaf gathers, as terms linear in the nodes' radiosity: H = sum f B_q
+/// What a leaf gathers, as terms linear in the nodes' radiosity: H = H_root + sum f B_q
 /// over patch sources + sum g I_c(d) over cluster sources.
 #[derive(Default)]
 struct LeafTerms {
@@ -617,6 +680,9 @@ struct LeafTerms {
     patches: Vec<(u32, f32)>,
     /// (cluster index, cos / (pi r^2) times visible fraction, direction from the cluster).
     clusters: Vec<(u32, f32, [f32; 3])>,
+    /// The leaf's quadtree root, which takes the irradiance through the clusters' bins
+    /// above it; `NONE` where the clusters' links are among the terms instead.
+    root: u32,
     /// Rays cast to find the terms.
     rays: u64,
 }
