@@ -274,7 +274,8 @@ fn closed_room_of_coplanar_wall_pieces_is_a_furnace_at_the_defaults() {
     // along the line between centres) overstated the exchange between clusters that meet
     // at an angle: 7.3 % of the emitted power was counted twice and surfaces' mean B came
     // out up to 16 % high. With cluster links weighed by their members' sample points,
-    // measured: escaped +0.06 % (-0.06 % since the gather takes clusters' links at the leaf), surfaces' mean B within 7.8 % (-5.9 % the light panel,
+    // measured: escaped +0.06 % (-0.06 % since the gather takes clusters' links at the
+    // leaf), surfaces' mean B within 7.8 % (-5.9 % the light panel,
     // +7.8 % a small piece by a corner; they converge as epsilon falls: within 1.4 % at
     // epsilon 0.005). Bounds: the 0.5 % for the account; 10 % per surface, the
     // defaults' coarse links (epsilon 0.05 of the mean B per link) with a little room.
