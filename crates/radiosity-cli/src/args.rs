@@ -26,8 +26,8 @@ pub enum ValidateCommand {
     /// area source, 5.6 and 5.7 diffuse reflection without and with an obstruction, 5.8
     /// inter-reflection in a 4 m cube for reflectances 0 to 0.95, 5.9 and 5.11 openings under
     /// a uniform sky): runs each scene, prints case, point, reference, computed and
-    /// difference in %, and fails if any is outside the targets (1 %; 0.5 % for the
-    /// cube's mean indirect illuminance).
+    /// difference in %, and fails if any is outside its target (1 % of the reference per
+    /// point; 0.5 % for the cube's mean indirect illuminance).
     Cie171(Cie171Args),
 }
 
@@ -84,7 +84,8 @@ pub struct BuildingArgs {
 /// Options every command shares.
 #[derive(Args)]
 pub struct SceneArgs {
-    /// Scene file, by extension: .scene (Appendix A format) or .obj (with its MTL); the
+    /// Scene file, by extension: .scene (Appendix A format), .obj (with its MTL), .gltf or
+    /// .glb, .dxf (with NAME.materials.toml) or .wrl (VRML97); the
     /// built-in Cornell box when omitted.
     pub scene: Option<PathBuf>,
     /// Multiply every coordinate of the scene file by this (0.001 reads a model in
@@ -349,7 +350,8 @@ pub struct PathTraceArgs {
     pub tone: ToneArgs,
     #[command(flatten)]
     pub camera: CameraArgs,
-    /// Output PNG of the path-traced view (default: <scene>-pathtrace.png). With --compare
+    /// Output of the path-traced view, PNG or, by extension, .exr (linear radiance)
+    /// (default: <scene>-pathtrace.png). With --compare
     /// the radiosity render and the error map go beside it, as <output>-radiosity.png and
     /// <output>-error.png.
     #[arg(short, long, value_name = "FILE")]
@@ -508,7 +510,8 @@ pub struct CompareArgs {
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Scene file, by extension: .scene (Appendix A format) or .obj (with its MTL); the
+    /// Scene file, by extension: .scene (Appendix A format), .obj (with its MTL), .gltf or
+    /// .glb, .dxf (with NAME.materials.toml) or .wrl (VRML97); the
     /// built-in Cornell box when omitted.
     pub scene: Option<PathBuf>,
     /// Multiply every coordinate of the scene file by this (0.001 reads a model in
@@ -556,7 +559,8 @@ pub struct BenchArgs {
 #[derive(Args)]
 #[cfg_attr(not(feature = "viewer"), allow(dead_code))]
 pub struct ViewArgs {
-    /// Scene file, by extension: .scene (Appendix A format) or .obj (with its MTL); the
+    /// Scene file, by extension: .scene (Appendix A format), .obj (with its MTL), .gltf or
+    /// .glb, .dxf (with NAME.materials.toml) or .wrl (VRML97); the
     /// built-in Cornell box when omitted.
     pub scene: Option<PathBuf>,
     /// Multiply every coordinate of the scene file by this (0.001 reads a model in

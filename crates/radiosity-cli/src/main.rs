@@ -21,8 +21,9 @@ use errors::describe;
 
 /// A radiosity renderer after De Angelis, "Radiosity: A Study in Photorealistic Rendering".
 ///
-/// Every command but `generate` takes an optional scene file (the paper's Appendix A
-/// format, or OBJ with its MTL); without one it uses the built-in Cornell box.
+/// Every command but `generate` and `validate` takes an optional scene file (the paper's
+/// Appendix A format, OBJ with its MTL, glTF, DXF or VRML97, by extension); without one it
+/// uses the built-in Cornell box.
 #[derive(Parser)]
 #[command(name = "radiosity", version)]
 struct Cli {
