@@ -321,6 +321,39 @@ fn solver(
         }
         other => other,
     };
+    // Flags of one solver given to another: said, as --tolerance with LU is (QA of issue
+    // #16: they were dropped without a word). A flag at its default value is not told apart
+    // from one left out.
+    let mut ignored = Vec::new();
+    if choice != SolverKind::Hierarchical {
+        if options.epsilon != radiosity::solve::HierarchicalSettings::DEFAULT_EPSILON {
+            ignored.push("--epsilon");
+        }
+        if options.min_area.is_some() {
+            ignored.push("--min-area");
+        }
+        if options.no_final_gather {
+            ignored.push("--no-final-gather");
+        }
+        if options.gather_points != radiosity::solve::GATHER_POINTS_DEFAULT {
+            ignored.push("--gather-points");
+        }
+    }
+    if choice != SolverKind::Progressive
+        && options.max_shots != radiosity::solve::ProgressiveSettings::default().max_shots
+    {
+        ignored.push("--max-shots");
+    }
+    if !ignored.is_empty() {
+        // Printed even with --quiet: the run does not do what the flags say.
+        errln!(
+            "warning: {} ignored: the solver is {} ({} apply to hierarchical radiosity, \
+             --max-shots to progressive refinement)",
+            ignored.join(", "),
+            choice.name(),
+            "--epsilon, --min-area, --no-final-gather and --gather-points"
+        );
+    }
     Ok(match choice {
         SolverKind::Auto => unreachable!("auto is resolved above"),
         SolverKind::Lu => {
@@ -583,6 +616,13 @@ pub fn adapt(
         );
     }
     let rounds = options.adapt_rounds.unwrap_or(DEFAULT_ADAPT_ROUNDS);
+    if !solver.needs_matrix() && options.adapt_rounds.is_some_and(|r| r > 0) {
+        // Printed even with --quiet: the run does not do what the flags say.
+        errln!(
+            "warning: --adapt-rounds ignored: adaptive subdivision refines the dense solvers' \
+             mesh (choose --solver gauss-seidel or lu)"
+        );
+    }
     if !solver.needs_matrix() || rounds == 0 {
         return Ok(None);
     }

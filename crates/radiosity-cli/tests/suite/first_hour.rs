@@ -296,3 +296,44 @@ fn compare_reports_the_dense_matrix_size_not_a_leftover_peak() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn flags_of_another_solver_are_said_to_be_ignored() {
+    // QA of issue #16: `--epsilon` (hierarchical radiosity's) with the dense solver, and
+    // `--adapt-rounds` (the dense solvers') with hierarchical radiosity, were dropped
+    // without a word, where `--tolerance` with LU is warned about.
+    let dir = scratch_dir("ignored-flags");
+    let out = radiosity(
+        &[
+            "solve",
+            "--max-area",
+            "5000",
+            "--epsilon",
+            "0.01",
+            "-o",
+            "a.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("--epsilon ignored"), "{err}");
+    let out = radiosity(
+        &[
+            "solve",
+            "--max-area",
+            "5000",
+            "--solver",
+            "hierarchical",
+            "--adapt-rounds",
+            "1",
+            "-o",
+            "b.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("--adapt-rounds ignored"), "{err}");
+    assert!(!err.contains("--epsilon ignored"), "{err}");
+}
