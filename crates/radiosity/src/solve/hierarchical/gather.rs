@@ -22,7 +22,8 @@
 //! cluster link's visibility, sampled from sixteen of the cluster's points, may miss the
 //! leaf's side of it (the bottom of that sphere saw none of the floor under it). Measured
 //! against the path tracer (BENCHMARKS.md): building_small 4.94 -> 3.18 % pixel RMS,
-//! room.scene 3.79 -> 2.81 %, the Cornell box unchanged, at up to twice the gather's time.
+//! room.scene 3.79 -> 2.81 %, the Cornell box unchanged; building_small's solve took
+//! about four times as long (3.9 -> 16.9 s under one load).
 //! Above [`CLUSTER_WALK_MAX_POINTS`] gather points it costs too much (the million-element
 //! building: four times the solve) and the clusters' links come through their bins.
 //!
@@ -83,7 +84,7 @@ const MAX_GATHER_PASSES: usize = 200;
 /// clusters' irradiance bins, as the sweeps do. On the million-element building (236,916
 /// points, 23,231 clusters) gathering them took the solve from 243 to about 950 s of CPU
 /// (1.8 billion rays) for 7.35 -> 6.63 % pixel RMS; on building_small (7,922 points) it
-/// about doubles the gather's time for 4.94 -> 3.18 %.
+/// takes the solve from 3.9 to 16.9 s (one load) for 4.94 -> 3.18 %.
 const CLUSTER_WALK_MAX_POINTS: usize = 50_000;
 
 /// Leaves whose terms are made at once (the memory check runs between chunks).
@@ -577,25 +578,6 @@ impl Solver<'_> {
             h.extend(v);
         }
         h
-    }
-
-    /// The irradiance node `n`'s own links bring from the radiosity and bins the nodes
-    /// hold now (what a sweep gathers at `n`).
-    fn links_irradiance(&self, n: &super::tree::Node) -> [f64; 3] {
-        let mut g = [0.0; 3];
-        for l in &n.links {
-            let c = self.cluster_of[l.source as usize];
-            let x = if c != NONE {
-                let d = DVec3::new(l.dir[0] as f64, l.dir[1] as f64, l.dir[2] as f64);
-                cluster_emission(&self.clusters[c as usize].power, d)
-            } else {
-                self.b[l.source as usize]
-            };
-            for k in 0..3 {
-                g[k] += l.g as f64 * x[k];
-            }
-        }
-        g
     }
 
     /// The gather terms of `leaves`, in parallel; their rays are counted in the report.

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use super::bins::{bin, cluster_emission, irradiance_for};
 use super::solver::{max3, Solver};
-use super::tree::NONE;
+use super::tree::{Node, NONE};
 use crate::solve::SolveError;
 
 /// Give up after this many sweeps in one solve.
@@ -171,6 +171,25 @@ impl Solver<'_> {
             .collect()
     }
 
+    /// The irradiance node `n`'s own links bring from the radiosity and bins the nodes
+    /// hold now (what a sweep gathers at `n`).
+    pub(super) fn links_irradiance(&self, n: &Node) -> [f64; 3] {
+        let mut g = [0.0; 3];
+        for l in &n.links {
+            let c = self.cluster_of[l.source as usize];
+            let x = if c != NONE {
+                let d = DVec3::new(l.dir[0] as f64, l.dir[1] as f64, l.dir[2] as f64);
+                cluster_emission(&self.clusters[c as usize].power, d)
+            } else {
+                self.b[l.source as usize]
+            };
+            for k in 0..3 {
+                g[k] += l.g as f64 * x[k];
+            }
+        }
+        g
+    }
+
     /// Gather / push-pull sweeps until the power that changes is below `tolerance` (a
     /// fraction of the emitted power); returns the sweeps made and the last residual.
     pub(super) fn solve(
@@ -179,29 +198,16 @@ impl Solver<'_> {
         tolerance: f64,
     ) -> Result<(usize, f64), SolveError> {
         for sweep in 1..=MAX_SWEEPS {
-            let nodes = &self.nodes;
-            let clusters = &self.clusters;
-            let (b, cluster_of) = (&self.b, &self.cluster_of);
-            let gathered: Vec<[f64; 3]> = nodes
+            let this = &*self;
+            let gathered: Vec<[f64; 3]> = this
+                .nodes
                 .par_iter()
                 .map(|n| {
-                    let mut g = [0.0; 3];
                     if n.is_cluster() {
-                        return g;
+                        [0.0; 3]
+                    } else {
+                        this.links_irradiance(n)
                     }
-                    for l in &n.links {
-                        let c = cluster_of[l.source as usize];
-                        let x = if c != NONE {
-                            let d = DVec3::new(l.dir[0] as f64, l.dir[1] as f64, l.dir[2] as f64);
-                            cluster_emission(&clusters[c as usize].power, d)
-                        } else {
-                            b[l.source as usize]
-                        };
-                        for k in 0..3 {
-                            g[k] += l.g as f64 * x[k];
-                        }
-                    }
-                    g
                 })
                 .collect();
             let incident = self.cluster_incident();
