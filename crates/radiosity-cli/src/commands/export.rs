@@ -1,7 +1,6 @@
 //! `radiosity export`: the solved scene as glTF with the radiosity in vertex colours, or
 //! the scene's surfaces as OBJ + MTL.
 
-use std::ops::ControlFlow;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
@@ -10,7 +9,7 @@ use radiosity::io::export::obj;
 use radiosity::progress::{run_stage, Stage};
 use radiosity::shade::{self, Exposure};
 
-use super::{exposure_note, solve_scene};
+use super::{exposure_note, solve_as_asked};
 use crate::args::ExportArgs;
 use crate::progress_bar::Reporter;
 use crate::setup::{camera, load_scene, prepare_solve, refuse_overwriting_inputs};
@@ -61,14 +60,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
     }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let camera = camera(&args.camera, &prepared.scene)?;
-    let (solution, _) = solve_scene(
-        &prepared,
-        solver,
-        crate::setup::adapt(&args.solve, &prepared, &solver)?,
-        args.solve.form_factors.as_deref(),
-        &mut |_| ControlFlow::Continue(()),
-        &reporter,
-    )?;
+    let solution = solve_as_asked(&prepared, solver, &args.solve, &reporter)?;
     let b = solution.element_rgb();
     let scale = args.exposure.scale(&prepared.scene, &solution.mesh, b);
     let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {

@@ -1,12 +1,10 @@
 //! `radiosity illuminance`: lux at calculation points or on a grid, from the solved scene.
 
-use std::ops::ControlFlow;
-
 use anyhow::{bail, Context, Result};
 use radiosity::illuminance::{self, CalcPoint};
 use radiosity::progress::{run_stage, Stage};
 
-use super::solve_scene;
+use super::solve_as_asked;
 use crate::args::IlluminanceArgs;
 use crate::progress_bar::Reporter;
 use crate::setup::{prepare_solve, refuse_overwriting_inputs};
@@ -45,14 +43,7 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         (None, None) => bail!("give --points P.csv or --grid x0,y0,z0:x1,y1,z1:SPACING"),
     };
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
-    let (solution, _) = solve_scene(
-        &prepared,
-        solver,
-        crate::setup::adapt(&args.solve, &prepared, &solver)?,
-        args.solve.form_factors.as_deref(),
-        &mut |_| ControlFlow::Continue(()),
-        &reporter,
-    )?;
+    let solution = solve_as_asked(&prepared, solver, &args.solve, &reporter)?;
     let lux = run_stage(&reporter, Stage::Render, points.len() as u64, || {
         illuminance::illuminance(&prepared, &solution, &points)
     });

@@ -33,6 +33,25 @@ use radiosity::solve::{Observer, Solver, Step};
 use crate::progress_bar::Reporter;
 use crate::report;
 
+/// [`solve_scene`] as the flags say, without an observer: adaptive subdivision where
+/// `options` ask for it (or by default), the form factors from `--form-factors` or computed.
+pub fn solve_as_asked(
+    prepared: &Prepared,
+    solver: Solver,
+    options: &crate::args::SolveOptions,
+    reporter: &Reporter,
+) -> Result<Solution> {
+    let (solution, _) = solve_scene(
+        prepared,
+        solver,
+        crate::setup::adapt(options, prepared, &solver)?,
+        options.form_factors.as_deref(),
+        &mut |_| ControlFlow::Continue(()),
+        reporter,
+    )?;
+    Ok(solution)
+}
+
 /// Solves with `solver`: the dense solvers on the form factors (read from `file` or
 /// computed, then dropped), the others from the scene. Returns the form-factor statistics
 /// when they were computed.

@@ -3,7 +3,6 @@
 //! difference and an error map; `--save-reference` / `--reference` keep an expensive view
 //! in an OpenEXR file.
 
-use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -14,7 +13,7 @@ use radiosity::render::{self, tonemap, Renderer, Shading};
 use radiosity::scene::Scene;
 use radiosity::shade::{self, Exposure};
 
-use super::solve_scene;
+use super::solve_as_asked;
 use crate::args::PathTraceArgs;
 use crate::progress_bar::Reporter;
 use crate::report;
@@ -154,14 +153,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     };
 
     // --compare: the radiosity render of the same camera, with the same exposure.
-    let (solution, _) = solve_scene(
-        prepared,
-        *solver,
-        crate::setup::adapt(&args.solve, prepared, &*solver)?,
-        args.solve.form_factors.as_deref(),
-        &mut |_| ControlFlow::Continue(()),
-        &reporter,
-    )?;
+    let solution = solve_as_asked(prepared, *solver, &args.solve, &reporter)?;
     let b = solution.element_rgb();
     let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
         shade::vertex_radiosity(&solution.mesh, b)

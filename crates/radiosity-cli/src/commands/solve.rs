@@ -1,12 +1,11 @@
 //! `radiosity solve`: solve a scene and write the radiosity of every element as CSV or JSON.
 
-use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use radiosity::progress::{run_stage, Stage};
 
-use super::solve_scene;
+use super::solve_as_asked;
 use crate::args::SolveArgs;
 use crate::progress_bar::Reporter;
 use crate::setup::{prepare_solve, refuse_overwriting_inputs, stem_of};
@@ -32,14 +31,7 @@ pub fn run(args: SolveArgs) -> Result<()> {
         }
     }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
-    let (solution, _) = solve_scene(
-        &prepared,
-        solver,
-        crate::setup::adapt(&args.solve, &prepared, &solver)?,
-        args.solve.form_factors.as_deref(),
-        &mut |_| ControlFlow::Continue(()),
-        &reporter,
-    )?;
+    let solution = solve_as_asked(&prepared, solver, &args.solve, &reporter)?;
     run_stage(&reporter, Stage::Write, 0, || {
         radiosity::solution::write_solution(
             &output,
