@@ -338,6 +338,15 @@ pub struct RenderArgs {
     /// Progressive: shots between snapshots.
     #[arg(long, default_value_t = 10, value_name = "N")]
     pub snapshot_every: usize,
+    /// Draw the illuminance (lux) on the surfaces in false colour, dark blue at 0 to red at
+    /// the top of the scale, with a scale bar (values and unit) on the right, instead of
+    /// the shaded view (a PNG; smooth or flat shading).
+    #[arg(long)]
+    pub false_colour: bool,
+    /// With --false-colour: the illuminance at the top of the scale, in lux (default: the
+    /// largest on any element); brighter surfaces take the top colour.
+    #[arg(long, value_name = "LUX", requires = "false_colour")]
+    pub lux_max: Option<f64>,
 }
 
 #[derive(Args)]

@@ -9,7 +9,14 @@
 //!   exitance (its radiosity less its surface's own emission; progressive refinement's
 //!   ambient term included) times the exact point-to-polygon form factor to the element
 //!   times the visible fraction of the element (kernel-weighted shadow rays to 3 x 3 points
-//!   of it; an element seen whole needs no more).
+//!   of it; an element seen whole needs no more). The first reflection of the point
+//!   luminaires' light is not taken from the element's mean: the solver's share of it
+//!   (rho times [`crate::luminaire::element_irradiance`]) is taken out of the element's
+//!   exitance and put back as rho E(y) at points y of the element, E with its own shadow
+//!   ray to each light and each y with its own shadow ray to the calculation point,
+//!   kernel-weighted, on sub-triangles refined where the shadows cut the element (down to
+//!   1/64 of its size): a floor half in a shadow, or half hidden from the point, counts as
+//!   the half that is lit and seen ([`FIRST_BOUNCE_MAX_DEPTH`]).
 //!
 //! Both are computed at the point from the solution, not interpolated from vertices. Values
 //! are photometric: the luminance-weighted Y = 0.2126 R + 0.7152 G + 0.0722 B of the bands
@@ -63,16 +70,34 @@ pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint
         .map(|e| scene.surfaces[e.surface as usize].reflectance)
         .collect();
     let shown = solution.display_radiosity(&reflectance);
-    // Each element's reflected exitance (Y) and corners; the elements that reflect nothing
-    // are left out.
-    let reflecting: Vec<(usize, f64, Vec<DVec3>)> = mesh
+    // The point lights' first bounce as the solver added it to the emission
+    // ([`crate::light::ElementLight::of_mesh`]: the same call on the same mesh and
+    // occluders), taken out of the element's exitance and integrated at the point instead.
+    let lit: Vec<Rgb> = if scene.lights.is_empty() {
+        vec![Rgb::BLACK; mesh.len()]
+    } else {
+        let occluders = crate::visibility::PolygonBvh::over_surfaces(scene);
+        crate::luminaire::element_irradiance(mesh, &scene.lights, &occluders)
+    };
+    // Each element's reflected exitance (Y) less the first bounce of the point lights, its
+    // reflectance when the point lights reach it, and its corners; the elements that
+    // reflect nothing are left out.
+    let reflecting: Vec<Reflecting> = mesh
         .elements
         .iter()
         .enumerate()
         .filter_map(|(i, e)| {
             let own = scene.surfaces[e.surface as usize].emission;
-            let r = (shown[i] - own).luminance();
-            (r > 0.0).then(|| (i, r, mesh.corner_positions(i).collect()))
+            let rho = reflectance[i];
+            let first = rho * lit[i];
+            let rest = (shown[i] - own - first).luminance();
+            let first_bounce = (first.luminance() > 0.0).then_some(rho);
+            (rest != 0.0 || first_bounce.is_some()).then(|| Reflecting {
+                element: i,
+                rest,
+                first_bounce,
+                corners: mesh.corner_positions(i).collect(),
+            })
         })
         .collect();
     let occluders = &prepared.occluders;
@@ -88,14 +113,36 @@ pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint
             let d = direct.irradiance(p.position, n, salt).luminance();
             let mut ind = 0.0;
             let mut samples = Vec::with_capacity((ELEMENT_POINTS * ELEMENT_POINTS) as usize);
-            for (e, r, poly) in &reflecting {
-                let f = point_to_polygon(p.position, n, poly);
+            for r in &reflecting {
+                let f = point_to_polygon(p.position, n, &r.corners);
                 if f <= 0.0 {
                     continue;
                 }
+                let normal = mesh.elements[r.element].normal;
+                let mut first_done = false;
+                if let Some(rho) = r.first_bounce {
+                    let sampler = FirstBounce {
+                        p: p.position,
+                        n,
+                        normal,
+                        lights: &scene.lights,
+                        occluders,
+                    };
+                    if let Some(mean) = sampler.mean(&r.corners) {
+                        ind += f * (rho * mean).luminance();
+                        first_done = true;
+                    }
+                }
+                let exitance = if first_done {
+                    r.rest
+                } else {
+                    r.rest + r.first_bounce.map_or(0.0, |rho| (rho * lit[r.element]).luminance())
+                };
+                if exitance == 0.0 {
+                    continue;
+                }
                 samples.clear();
-                mesh.integration_points(*e, ELEMENT_POINTS, &mut samples);
-                let normal = mesh.elements[*e].normal;
+                mesh.integration_points(r.element, ELEMENT_POINTS, &mut samples);
                 let (mut seen, mut total) = (0.0, 0.0);
                 for &(y, w) in &samples {
                     let dv = y - p.position;
@@ -112,7 +159,7 @@ pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint
                 }
                 // All points behind the meter's plane while Lambert sees a sliver: seen.
                 let fraction = if total > 0.0 { seen / total } else { 1.0 };
-                ind += r * f * fraction;
+                ind += exitance * f * fraction;
             }
             Lux {
                 direct: d,
@@ -121,6 +168,105 @@ pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint
             }
         })
         .collect()
+}
+
+/// An element that sends light to the calculation points.
+struct Reflecting {
+    element: usize,
+    /// Its reflected exitance (Y) less the point lights' first bounce where that is
+    /// integrated point by point ([`FirstBounce`]).
+    rest: f64,
+    /// Its reflectance, when the point lights reach it.
+    first_bounce: Option<Rgb>,
+    corners: Vec<DVec3>,
+}
+
+/// The first bounce's sub-triangles are halved down to this many times (1/64 of the
+/// element's fan triangles' size) where the shadow rays at their corners and centre
+/// disagree: a shadow edge's error is then that of a band 1/64 of an element wide.
+pub const FIRST_BOUNCE_MAX_DEPTH: u32 = 6;
+
+/// Every sub-triangle is halved at least this many times (4 per fan triangle), so that the
+/// illuminance's variation across a lit, seen element is integrated, not taken at one point.
+const FIRST_BOUNCE_MIN_DEPTH: u32 = 1;
+
+/// The point lights' illuminance over an element as a calculation point sees it.
+struct FirstBounce<'a> {
+    p: DVec3,
+    n: DVec3,
+    /// The element's unit normal.
+    normal: DVec3,
+    lights: &'a [crate::luminaire::Luminaire],
+    occluders: &'a crate::visibility::PolygonBvh,
+}
+
+impl FirstBounce<'_> {
+    /// What the shadow rays say at y: bit 0 set when y is hidden from the point, bit i + 1
+    /// when light i (of the first 63) is blocked from y.
+    fn state(&self, y: DVec3) -> u64 {
+        let mut s = u64::from(self.occluders.segment_blocked(self.p, y));
+        for (i, l) in self.lights.iter().take(63).enumerate() {
+            if self.occluders.segment_blocked(l.position, y) {
+                s |= 1 << (i + 1);
+            }
+        }
+        s
+    }
+
+    /// The mean over the element `poly` of E(y) V(p, y), weighted by the point-to-area
+    /// kernel cos cos / r^2 (E per band, each light with its own shadow ray from y; V the
+    /// visibility of y from the point); `None` when no part of the element is in front of
+    /// both (a sliver the form factor sees, left to the caller).
+    fn mean(&self, poly: &[DVec3]) -> Option<Rgb> {
+        let mut sum = (Rgb::BLACK, 0.0);
+        for i in 1..poly.len().saturating_sub(1) {
+            let (a, b, c) = (poly[0], poly[i], poly[i + 1]);
+            let (sa, sb, sc) = (self.state(a), self.state(b), self.state(c));
+            self.triangle([a, b, c], [sa, sb, sc], 0, &mut sum);
+        }
+        (sum.1 > 0.0).then(|| sum.0 * (1.0 / sum.1))
+    }
+
+    fn triangle(&self, t: [DVec3; 3], s: [u64; 3], depth: u32, sum: &mut (Rgb, f64)) {
+        let centre = (t[0] + t[1] + t[2]) / 3.0;
+        let sm = self.state(centre);
+        let uniform = s.iter().all(|&x| x == sm);
+        if depth < FIRST_BOUNCE_MIN_DEPTH || (!uniform && depth < FIRST_BOUNCE_MAX_DEPTH) {
+            let m = [
+                0.5 * (t[0] + t[1]),
+                0.5 * (t[1] + t[2]),
+                0.5 * (t[2] + t[0]),
+            ];
+            let ms = m.map(|y| self.state(y));
+            self.triangle([t[0], m[0], m[2]], [s[0], ms[0], ms[2]], depth + 1, sum);
+            self.triangle([m[0], t[1], m[1]], [ms[0], s[1], ms[1]], depth + 1, sum);
+            self.triangle([m[2], m[1], t[2]], [ms[2], ms[1], s[2]], depth + 1, sum);
+            self.triangle([m[0], m[1], m[2]], ms, depth + 1, sum);
+            return;
+        }
+        let dv = centre - self.p;
+        let r2 = dv.length_squared();
+        let (cx, cy) = (self.n.dot(dv), -self.normal.dot(dv));
+        if cx <= 0.0 || cy <= 0.0 || r2 <= 0.0 {
+            return;
+        }
+        let area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        let kw = area * cx * cy / (r2 * r2);
+        sum.1 += kw;
+        if sm & 1 == 1 {
+            return;
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            let blocked = if i < 63 {
+                sm >> (i + 1) & 1 == 1
+            } else {
+                self.occluders.segment_blocked(l.position, centre)
+            };
+            if !blocked {
+                sum.0 += l.irradiance_unoccluded(centre, self.normal) * kw;
+            }
+        }
+    }
 }
 
 /// The points of a rectangular grid from corner `a` to corner `b` (an axis-aligned
@@ -460,10 +606,16 @@ pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
             }
         }
     }
-    // The scale bar: top = max, bottom = 0, with the unit above it.
-    let bx = gw + 2 * margin;
-    let (by0, by1) = (margin + 20, height - margin - 6);
-    draw_text(&mut img, bx, margin, 2, "lx", [0; 3]);
+    draw_scale_bar(&mut img, gw + 2 * margin, margin, height - margin - 6, max);
+    img
+}
+
+/// The scale bar of a false-colour picture, `lx` at its top left corner (x, y), the bar
+/// from y + 20 down to `bottom` (top = `max`, bottom = 0), and six values beside it; 90
+/// pixels wide.
+fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: f64) {
+    let (by0, by1) = (y + 20, bottom);
+    draw_text(img, bx, y, 2, "lx", [0; 3]);
     for y in by0..by1 {
         let t = 1.0 - (y - by0) as f64 / (by1 - by0 - 1).max(1) as f64;
         for x in bx..bx + 18 {
@@ -476,14 +628,102 @@ pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
         for x in bx + 18..bx + 23 {
             img.put_pixel(x as u32, y as u32, image::Rgb([0; 3]));
         }
-        draw_text(
-            &mut img,
-            bx + 26,
-            (y - 5).max(0),
-            2,
-            &lux_label(max * t),
-            [0; 3],
-        );
+        draw_text(img, bx + 26, (y - 5).max(0), 2, &lux_label(max * t), [0; 3]);
     }
+}
+
+/// The illuminance in lux (Y of the bands) on the front of every element of the solution's
+/// mesh, for `render --false-colour`. Where the element reflects in every band it is read
+/// back from the solution: the irradiance H = (B - E) / rho per band (B the display
+/// radiosity, progressive refinement's ambient term included, E the surface's own
+/// emission), the mean over the element as the solver has it. Where a band's reflectance is
+/// 0 the solution holds no trace of the light that arrived, so the illuminance is computed
+/// at the element's centroid as [`illuminance`] computes it at a calculation point (direct
+/// plus indirect, exact form factors and shadow rays).
+pub fn element_illuminance(prepared: &Prepared, solution: &Solution) -> Vec<f64> {
+    let scene = &prepared.scene;
+    let mesh = &solution.mesh;
+    let reflectance: Vec<Rgb> = mesh
+        .elements
+        .iter()
+        .map(|e| scene.surfaces[e.surface as usize].reflectance)
+        .collect();
+    let shown = solution.display_radiosity(&reflectance);
+    let mut out = vec![0.0; mesh.len()];
+    let mut black = Vec::new();
+    for (i, el) in mesh.elements.iter().enumerate() {
+        let surface = &scene.surfaces[el.surface as usize];
+        let rho = surface.reflectance;
+        if rho.0.iter().all(|&r| r > 0.0) {
+            let h = Rgb(std::array::from_fn(|k| {
+                (shown[i].0[k] - surface.emission.0[k]) / rho.0[k]
+            }));
+            out[i] = h.luminance().max(0.0);
+        } else {
+            black.push(CalcPoint {
+                name: String::new(),
+                position: el.centroid,
+                normal: el.normal,
+            });
+        }
+    }
+    if !black.is_empty() {
+        let lux = illuminance(prepared, solution, &black);
+        let mut k = 0;
+        for (i, el) in mesh.elements.iter().enumerate() {
+            if !scene.surfaces[el.surface as usize]
+                .reflectance
+                .0
+                .iter()
+                .all(|&r| r > 0.0)
+            {
+                out[i] = lux[k].total;
+                k += 1;
+            }
+        }
+    }
+    out
+}
+
+/// The width in pixels of the scale bar [`false_colour_picture`] adds on the right.
+pub const SCALE_BAR_WIDTH: u32 = 100;
+
+/// A rendered view in false colour: `lux` and `coverage` per pixel (row by row from the
+/// top, `width` x `height`), coverage the fraction of the pixel's rays that met a surface
+/// (0 for the background, which stays white; edges blend into it). Each pixel's colour is
+/// [`false_colour`] of its illuminance over `max`, values above `max` in the top colour;
+/// on the right a [`SCALE_BAR_WIDTH`] wide scale bar from 0 to `max` with six values and
+/// the unit `lx`.
+pub fn false_colour_picture(
+    lux: &[f64],
+    coverage: &[f64],
+    width: u32,
+    height: u32,
+    max: f64,
+) -> image::RgbImage {
+    let total_w = width + SCALE_BAR_WIDTH;
+    let total_h = height.max(160);
+    let mut img = image::RgbImage::from_pixel(total_w, total_h, image::Rgb([255; 3]));
+    for y in 0..height {
+        for x in 0..width {
+            let k = (y * width + x) as usize;
+            let c = coverage.get(k).copied().unwrap_or(0.0).clamp(0.0, 1.0);
+            if c <= 0.0 {
+                continue;
+            }
+            let v = lux.get(k).copied().unwrap_or(0.0);
+            let t = if max > 0.0 { v / max } else { 0.0 };
+            let colour = false_colour(t);
+            let px = colour.map(|ch| (ch as f64 * c + 255.0 * (1.0 - c)).round() as u8);
+            img.put_pixel(x, y, image::Rgb(px));
+        }
+    }
+    draw_scale_bar(
+        &mut img,
+        width as i64 + 8,
+        10,
+        total_h as i64 - 16,
+        max,
+    );
     img
 }

@@ -316,3 +316,55 @@ fn the_path_tracer_and_the_renderer_see_point_lights_with_sharp_shadows() {
         Rgb::BLACK
     );
 }
+
+/// An IES light of the asymmetric table C0 80, C90 150, C180 210, C270 260 cd at 45 degrees
+/// from the axis (each plane its own value), aimed along `aim`, as it stands in a scene.
+fn asymmetric_ies_light(aim: DVec3) -> Luminaire {
+    let text = "IESNA:LM-63-2002\n[TEST] asymmetric\nTILT=NONE\n1 -1 1 3 4 1 2 0 0 0\n1 1 0\n\
+                0 45 90\n0 90 180 270\n100 80 0\n200 150 0\n300 210 0\n400 260 0\n";
+    let photometry =
+        crate::photometry::ies::IesPhotometry::parse(text, std::path::Path::new("a.ies"))
+            .unwrap();
+    light(
+        Distribution::Ies {
+            written: "a.ies".into(),
+            photometry: std::sync::Arc::new(photometry),
+        },
+        Output::AsTabulated,
+        aim,
+    )
+}
+
+#[test]
+fn asymmetric_ies_planes_point_where_the_azimuth_convention_says() {
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    // Aimed down (the default): C0 along +x, C90 along +y (counter-clockwise seen from
+    // above), C180 along -x, C270 along -y; 45 degrees from the axis in each.
+    let down = asymmetric_ies_light(dvec3(0.0, 0.0, -1.0));
+    for (d, expected) in [
+        (dvec3(s, 0.0, -s), 80.0),
+        (dvec3(0.0, s, -s), 150.0),
+        (dvec3(-s, 0.0, -s), 210.0),
+        (dvec3(0.0, -s, -s), 260.0),
+        // Half-way between C0 and C90 (azimuth 45 degrees): (80 + 150) / 2.
+        (dvec3(0.5, 0.5, -s), 115.0),
+    ] {
+        let got = down.candela(d);
+        assert!((got - expected).abs() < 1e-9, "{d}: {got} against {expected}");
+    }
+    // Aimed along +x: the smallest rotation taking 0 0 -1 to +x is a quarter turn about y,
+    // (x, y, z) -> (-z, y, x), which carries +x (C0 aimed down) onto +z and leaves +y (C90)
+    // where it is; so C0 points along +z, C90 along +y, C180 along -z, C270 along -y.
+    let sideways = asymmetric_ies_light(dvec3(2.0, 0.0, 0.0));
+    for (d, expected) in [
+        (dvec3(s, 0.0, s), 80.0),
+        (dvec3(s, s, 0.0), 150.0),
+        (dvec3(s, 0.0, -s), 210.0),
+        (dvec3(s, -s, 0.0), 260.0),
+    ] {
+        let got = sideways.candela(d);
+        assert!((got - expected).abs() < 1e-9, "{d}: {got} against {expected}");
+    }
+    // Nothing behind the light (vertical angles end at 90 degrees).
+    assert_eq!(sideways.candela(dvec3(-1.0, 0.0, 0.0)), 0.0);
+}

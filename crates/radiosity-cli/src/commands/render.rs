@@ -38,6 +38,26 @@ pub fn run(args: RenderArgs) -> Result<()> {
             output.display()
         );
     }
+    if args.false_colour {
+        if format == ImageFormat::Exr {
+            bail!(
+                "{}: --false-colour draws a PNG (colours and a scale bar, not radiance); give \
+                 a .png name",
+                output.display()
+            );
+        }
+        if settings.shading == render::Shading::Wireframe {
+            bail!("--false-colour colours the surfaces; give --shading smooth or flat");
+        }
+        if args.snapshots.is_some() {
+            bail!("--false-colour draws the solved scene once; drop --snapshots");
+        }
+        if let Some(max) = args.lux_max {
+            if !(max.is_finite() && max > 0.0) {
+                bail!("--lux-max {max}: give the top of the scale in lux, a number above 0");
+            }
+        }
+    }
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
@@ -103,6 +123,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(dir) = &args.snapshots {
         reporter.note(&format!("wrote {written} snapshots to {}", dir.display()));
     }
+    if args.false_colour {
+        return false_colour(
+            &args, &prepared, &solution, &camera, settings, &output, &reporter,
+        );
+    }
     if format == ImageFormat::Exr {
         let pixels = shade_and_render_linear(
             &prepared,
@@ -160,6 +185,69 @@ pub fn run(args: RenderArgs) -> Result<()> {
         output.display(),
         image.width(),
         image.height()
+    ));
+    reporter.print_timings();
+    Ok(())
+}
+
+/// `render --false-colour`: the illuminance of every element
+/// ([`radiosity::illuminance::element_illuminance`]) rendered as smooth or flat shading
+/// renders radiosity (without the per-ray direct light), divided per pixel by the fraction
+/// of its rays that met a surface (a second render of ones), then coloured with a scale bar.
+fn false_colour(
+    args: &RenderArgs,
+    prepared: &radiosity::pipeline::Prepared,
+    solution: &radiosity::pipeline::Solution,
+    camera: &radiosity::render::Camera,
+    settings: render::RenderSettings,
+    output: &std::path::Path,
+    reporter: &Reporter,
+) -> Result<()> {
+    use radiosity::illuminance::{element_illuminance, false_colour_picture};
+    let lux = run_stage(reporter, Stage::Shade, 0, || {
+        element_illuminance(prepared, solution)
+    });
+    let largest = lux
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let max = args.lux_max.unwrap_or(largest);
+    let settings = render::RenderSettings {
+        direct_light: false,
+        ..settings
+    };
+    let values: Vec<[f64; 3]> = lux.iter().map(|&v| [v; 3]).collect();
+    let ones = vec![[1.0; 3]; values.len()];
+    let linear = |b: &[[f64; 3]], reporter: &Reporter| {
+        shade_and_render_linear(prepared, &solution.mesh, b, camera, settings, reporter)
+            .map(|p| p.expect("a wireframe is refused above"))
+    };
+    let pixels = linear(&values, reporter)?;
+    let coverage = linear(&ones, &Reporter::new(true))?;
+    let (pixel_lux, coverage): (Vec<f64>, Vec<f64>) = pixels
+        .iter()
+        .zip(&coverage)
+        .map(|(v, c)| {
+            if c[0] > 0.0 {
+                (v[0] / c[0], c[0])
+            } else {
+                (0.0, 0.0)
+            }
+        })
+        .unzip();
+    let image = false_colour_picture(&pixel_lux, &coverage, camera.width, camera.height, max);
+    run_stage(reporter, Stage::Write, 0, || render::write_png(&image, output))
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    reporter.note(&format!(
+        "wrote {} ({} x {} and a {} pixel scale bar; false colour from 0 to {} lx, the \
+         largest element illuminance is {} lx; lux = lm/m^2 with scene lengths in metres)",
+        output.display(),
+        camera.width,
+        camera.height,
+        radiosity::illuminance::SCALE_BAR_WIDTH,
+        radiosity::illuminance::lux_label(max),
+        radiosity::illuminance::lux_label(largest),
     ));
     reporter.print_timings();
     Ok(())

@@ -384,3 +384,79 @@ fn tilt_check_on_a_line_with_a_multibyte_character_near_its_start() {
     let (line, problem) = refused("clo\u{9f}se\n1 2 3\n");
     assert_eq!((line, problem), (2, IesProblem::NoTilt));
 }
+
+/// An asymmetric type C table (LM-63-2002, metres, absolute photometry) with a different
+/// candela column in every C plane, so that each value read back names the plane it came
+/// from. Vertical angles 0, 45, 90; C planes as given; `columns` one per plane.
+fn asymmetric(horizontal: &str, columns: &[&str]) -> IesPhotometry {
+    let n = horizontal.split_whitespace().count();
+    assert_eq!(n, columns.len());
+    let text = format!(
+        "IESNA:LM-63-2002\n[TEST] asymmetric\nTILT=NONE\n1 -1 1 3 {n} 1 2 0 0 0\n1 1 0\n\
+         0 45 90\n{horizontal}\n{}\n",
+        columns.join("\n")
+    );
+    IesPhotometry::parse(&text, Path::new("asymmetric.ies")).unwrap()
+}
+
+/// The table's values at the knots, and linear in each angle between them: the expected
+/// numbers below are read off the table by hand (a half-way point is the mean of the two
+/// values; a point a quarter of the way is 3/4 of the first plus 1/4 of the second).
+#[test]
+fn asymmetric_full_table_reads_each_c_plane_and_interpolates_between_them() {
+    let deg = f64::to_radians;
+    // C0: 100 80 0; C90: 200 150 0; C180: 300 210 0; C270: 400 260 0.
+    let columns = ["100 80 0", "200 150 0", "300 210 0", "400 260 0"];
+    let open = asymmetric("0 90 180 270", &columns);
+    // The same table closed at 360 with the C0 column again.
+    let mut closed_columns = columns.to_vec();
+    closed_columns.push("100 80 0");
+    let closed = asymmetric("0 90 180 270 360", &closed_columns);
+    for ies in [&open, &closed] {
+        let at = |theta: f64, phi: f64| ies.candela(deg(theta), deg(phi));
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        // On the knots: each plane's own value at 45 degrees.
+        for (phi, expected) in [(0.0, 80.0), (90.0, 150.0), (180.0, 210.0), (270.0, 260.0)] {
+            assert!(close(at(45.0, phi), expected), "C{phi}: {}", at(45.0, phi));
+        }
+        // Half-way between planes at a knot: (80 + 150) / 2, (150 + 210) / 2.
+        assert!(close(at(45.0, 45.0), 115.0), "{}", at(45.0, 45.0));
+        assert!(close(at(45.0, 135.0), 180.0), "{}", at(45.0, 135.0));
+        // A quarter of the way from C180 to C270: 0.75 * 210 + 0.25 * 260.
+        assert!(close(at(45.0, 202.5), 222.5), "{}", at(45.0, 202.5));
+        // Between C270 and C360 = C0 (the open table wraps to its first column):
+        // (260 + 80) / 2, at 315 degrees and at -45 degrees alike.
+        assert!(close(at(45.0, 315.0), 170.0), "{}", at(45.0, 315.0));
+        assert!(close(at(45.0, -45.0), 170.0), "{}", at(45.0, -45.0));
+        // Bilinear inside a cell: theta 22.5 (half-way from 0 to 45) and C135 (half-way
+        // from C90 to C180): the mean of 200, 150, 300, 210.
+        assert!(close(at(22.5, 135.0), 215.0), "{}", at(22.5, 135.0));
+        // Nothing at 90 degrees in any plane, nothing beyond the table's last angle.
+        assert!(close(at(90.0, 123.0), 0.0));
+        assert_eq!(at(120.0, 0.0), 0.0);
+    }
+}
+
+#[test]
+fn half_and_quarter_tables_mirror_their_planes_into_the_rest_of_the_circle() {
+    let deg = f64::to_radians;
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    // 0-180: C0 80, C90 150, C180 210 at 45 degrees; mirrored about the C0-C180 plane, so
+    // C270 is C90 and C225 is C135 = (150 + 210) / 2.
+    let half = asymmetric("0 90 180", &["100 80 0", "200 150 0", "300 210 0"]);
+    let at = |phi: f64| half.candela(deg(45.0), deg(phi));
+    assert!(close(at(270.0), 150.0), "{}", at(270.0));
+    assert!(close(at(225.0), 180.0), "{}", at(225.0));
+    assert!(close(at(-90.0), 150.0), "{}", at(-90.0));
+    // C300 mirrors to C60: 2/3 of the way from C0 to C90, 80 + (150 - 80) * 2 / 3.
+    assert!(close(at(300.0), 80.0 + 70.0 * 2.0 / 3.0), "{}", at(300.0));
+    // 0-90: C0 80, C45 120, C90 150; mirrored in each quadrant: C135 is C45, C200 is C20
+    // (4/9 of the way from C0 to C45: 80 + 40 * 4 / 9), C330 is C30 (80 + 40 * 2 / 3).
+    let quarter = asymmetric("0 45 90", &["100 80 0", "150 120 0", "200 150 0"]);
+    let at = |phi: f64| quarter.candela(deg(45.0), deg(phi));
+    assert!(close(at(135.0), 120.0), "{}", at(135.0));
+    assert!(close(at(180.0), 80.0), "{}", at(180.0));
+    assert!(close(at(270.0), 150.0), "{}", at(270.0));
+    assert!(close(at(200.0), 80.0 + 40.0 * 4.0 / 9.0), "{}", at(200.0));
+    assert!(close(at(330.0), 80.0 + 40.0 * 2.0 / 3.0), "{}", at(330.0));
+}
