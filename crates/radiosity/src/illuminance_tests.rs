@@ -187,3 +187,54 @@ fn the_grid_picture_colours_cells_by_value_with_a_legend() {
     assert_eq!(lux_label(12.34), "12.3");
     assert_eq!(lux_label(1.234), "1.23");
 }
+
+#[test]
+fn element_illuminance_reads_the_solution_back_and_computes_black_surfaces() {
+    // The glowing box: E = 100, rho = 0.5, B = E / (1 - rho) = 200, so every element
+    // receives H = (B - E) / rho = 200 lux (within the solve's 1 % row sums; 3 % tells it
+    // from a single bounce's 150 or the exitance's 200 + 100).
+    let text = "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 3\nSCENEBEGIN\nBOXBEGIN\n#Room\nFACING IN\n\
+                Er 100\nEg 100\nEb 100\nRr 0.5\nRg 0.5\nRb 0.5\nORIGIN 0 0 0\nSIZE 2 2 2\n\
+                BOXEND\nSCENEEND\n";
+    let (p, s) = solved(text);
+    let lux = element_illuminance(&p, &s);
+    assert_eq!(lux.len(), s.mesh.len());
+    for v in &lux {
+        assert!((v / 200.0 - 1.0).abs() < 0.03, "{v}");
+    }
+    // A black floor (one 100 m^2 element, centroid at the origin) 2 m below a 1000 cd
+    // isotropic light: nothing to read back, so the centroid's I / d^2 = 250 lux.
+    let (p, s) = solved(&black_floor(
+        "LIGHTBEGIN\n#L\nPOSITION 0 0 2\nINTENSITY 1000\nDISTRIBUTION ISOTROPIC\nLIGHTEND",
+    ));
+    let lux = element_illuminance(&p, &s);
+    assert_eq!(lux.len(), 1);
+    assert!((lux[0] - 250.0).abs() < 1e-9, "{}", lux[0]);
+}
+
+#[test]
+fn the_false_colour_picture_colours_pixels_by_lux_on_white_with_a_scale_bar() {
+    // Three pixels: at the top of the scale, at half of it with half coverage (blended
+    // half-way to white), and background.
+    let img = false_colour_picture(&[200.0, 100.0, 0.0], &[1.0, 0.5, 0.0], 3, 1, 200.0);
+    assert_eq!(img.width(), 3 + SCALE_BAR_WIDTH);
+    assert!(img.height() >= 160);
+    assert_eq!(img.get_pixel(0, 0).0, false_colour(1.0));
+    let half = false_colour(0.5).map(|c| ((c as f64 + 255.0) / 2.0).round() as u8);
+    assert_eq!(img.get_pixel(1, 0).0, half);
+    assert_eq!(img.get_pixel(2, 0).0, [255; 3]);
+    // Brighter than the top of the scale: the top colour.
+    let img = false_colour_picture(&[500.0], &[1.0], 1, 1, 200.0);
+    assert_eq!(img.get_pixel(0, 0).0, false_colour(1.0));
+    // The bar: the top colour near its top, the bottom colour near its bottom (the bar is
+    // 18 px wide, 8 px right of the view, from y = 30 to 16 px above the bottom).
+    let (x, h) = (1 + 8 + 9, img.height());
+    assert_eq!(img.get_pixel(x, 30).0, false_colour(1.0));
+    assert_eq!(img.get_pixel(x, h - 17).0, false_colour(0.0));
+    // Black text ("lx" and the values) left of and beside the bar.
+    let inked = (0..img.height())
+        .flat_map(|y| (x + 20..img.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| img.get_pixel(x, y).0 == [0; 3])
+        .count();
+    assert!(inked > 50, "{inked}");
+}
