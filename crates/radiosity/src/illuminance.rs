@@ -606,14 +606,21 @@ pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
             }
         }
     }
-    draw_scale_bar(&mut img, gw + 2 * margin, margin, height - margin - 6, max);
+    draw_scale_bar(&mut img, gw + 2 * margin, margin, height - margin - 6, max, 5);
     img
 }
 
 /// The scale bar of a false-colour picture, `lx` at its top left corner (x, y), the bar
-/// from y + 20 down to `bottom` (top = `max`, bottom = 0), and six values beside it; 90
-/// pixels wide.
-fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: f64) {
+/// from y + 20 down to `bottom` (top = `max`, bottom = 0), and `ticks` + 1 values beside it
+/// (0 and `ticks` equal steps up to `max`); 90 pixels wide.
+fn draw_scale_bar(
+    img: &mut image::RgbImage,
+    bx: i64,
+    y: i64,
+    bottom: i64,
+    max: f64,
+    ticks: usize,
+) {
     let (by0, by1) = (y + 20, bottom);
     draw_text(img, bx, y, 2, "lx", [0; 3]);
     for y in by0..by1 {
@@ -622,8 +629,9 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
             img.put_pixel(x as u32, y as u32, image::Rgb(false_colour(t)));
         }
     }
-    for k in 0..=5 {
-        let t = k as f64 / 5.0;
+    let ticks = ticks.max(1);
+    for k in 0..=ticks {
+        let t = k as f64 / ticks as f64;
         let y = by1 - 1 - ((by1 - by0 - 1) as f64 * t).round() as i64;
         for x in bx + 18..bx + 23 {
             img.put_pixel(x as u32, y as u32, image::Rgb([0; 3]));
@@ -685,6 +693,29 @@ pub fn element_illuminance(prepared: &Prepared, solution: &Solution) -> Vec<f64>
     out
 }
 
+/// A scale for `max` that reads at a glance: the smallest top at or above `max` that is
+/// n steps of 1, 2, 2.5 or 5 times a power of ten, n from 4 to 8 (150.3 lux: 8 steps of
+/// 20 up to 160), and n. `(0, 5)` for a `max` that is not a positive number.
+pub fn nice_scale(max: f64) -> (f64, usize) {
+    if !(max.is_finite() && max > 0.0) {
+        return (0.0, 5);
+    }
+    let e = max.log10().floor() as i32;
+    let mut best = (f64::INFINITY, 5);
+    for k in e - 2..=e + 1 {
+        for m in [1.0, 2.0, 2.5, 5.0] {
+            let step = m * 10f64.powi(k);
+            for n in 4..=8 {
+                let top = step * n as f64;
+                if top >= max * (1.0 - 1e-12) && top < best.0 {
+                    best = (top, n);
+                }
+            }
+        }
+    }
+    best
+}
+
 /// The width in pixels of the scale bar [`false_colour_picture`] adds on the right.
 pub const SCALE_BAR_WIDTH: u32 = 100;
 
@@ -692,14 +723,15 @@ pub const SCALE_BAR_WIDTH: u32 = 100;
 /// top, `width` x `height`), coverage the fraction of the pixel's rays that met a surface
 /// (0 for the background, which stays white; edges blend into it). Each pixel's colour is
 /// [`false_colour`] of its illuminance over `max`, values above `max` in the top colour;
-/// on the right a [`SCALE_BAR_WIDTH`] wide scale bar from 0 to `max` with six values and
-/// the unit `lx`.
+/// on the right a [`SCALE_BAR_WIDTH`] wide scale bar from 0 to `max` with `ticks` + 1
+/// values ([`nice_scale`] gives a `max` and `ticks` that read well) and the unit `lx`.
 pub fn false_colour_picture(
     lux: &[f64],
     coverage: &[f64],
     width: u32,
     height: u32,
     max: f64,
+    ticks: usize,
 ) -> image::RgbImage {
     let total_w = width + SCALE_BAR_WIDTH;
     let total_h = height.max(160);
@@ -724,6 +756,7 @@ pub fn false_colour_picture(
         10,
         total_h as i64 - 16,
         max,
+        ticks,
     );
     img
 }

@@ -216,7 +216,7 @@ fn element_illuminance_reads_the_solution_back_and_computes_black_surfaces() {
 fn the_false_colour_picture_colours_pixels_by_lux_on_white_with_a_scale_bar() {
     // Three pixels: at the top of the scale, at half of it with half coverage (blended
     // half-way to white), and background.
-    let img = false_colour_picture(&[200.0, 100.0, 0.0], &[1.0, 0.5, 0.0], 3, 1, 200.0);
+    let img = false_colour_picture(&[200.0, 100.0, 0.0], &[1.0, 0.5, 0.0], 3, 1, 200.0, 4);
     assert_eq!(img.width(), 3 + SCALE_BAR_WIDTH);
     assert!(img.height() >= 160);
     assert_eq!(img.get_pixel(0, 0).0, false_colour(1.0));
@@ -224,7 +224,7 @@ fn the_false_colour_picture_colours_pixels_by_lux_on_white_with_a_scale_bar() {
     assert_eq!(img.get_pixel(1, 0).0, half);
     assert_eq!(img.get_pixel(2, 0).0, [255; 3]);
     // Brighter than the top of the scale: the top colour.
-    let img = false_colour_picture(&[500.0], &[1.0], 1, 1, 200.0);
+    let img = false_colour_picture(&[500.0], &[1.0], 1, 1, 200.0, 4);
     assert_eq!(img.get_pixel(0, 0).0, false_colour(1.0));
     // The bar: the top colour near its top, the bottom colour near its bottom (the bar is
     // 18 px wide, 8 px right of the view, from y = 30 to 16 px above the bottom).
@@ -237,4 +237,16 @@ fn the_false_colour_picture_colours_pixels_by_lux_on_white_with_a_scale_bar() {
         .filter(|&(x, y)| img.get_pixel(x, y).0 == [0; 3])
         .count();
     assert!(inked > 50, "{inked}");
+}
+
+#[test]
+fn nice_scales_step_in_round_numbers() {
+    // 150.3: 8 steps of 20 (160) is the tightest of 4-8 steps of 1, 2, 2.5, 5 x 10^k.
+    assert_eq!(nice_scale(150.3), (160.0, 8));
+    // A round value is its own top: 100 as 4 steps of 25 (or 5 of 20: the first found).
+    assert_eq!(nice_scale(100.0).0, 100.0);
+    // Small and large values: 0.37 -> 0.4 (4 x 0.1, or 8 x 0.05); 12 345 -> 12 500 (5 x 2500).
+    assert!((nice_scale(0.37).0 - 0.4).abs() < 1e-12);
+    assert_eq!(nice_scale(12_345.0), (12_500.0, 5));
+    assert_eq!(nice_scale(0.0), (0.0, 5));
 }

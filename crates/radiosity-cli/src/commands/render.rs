@@ -212,7 +212,15 @@ fn false_colour(
         .copied()
         .filter(|v| v.is_finite())
         .fold(0.0, f64::max);
-    let max = args.lux_max.unwrap_or(largest);
+    // The top of the scale: the user's, in as many steps as read well (5 when none fits),
+    // or the largest element's illuminance rounded up to a round number of round steps.
+    let (max, ticks) = match args.lux_max {
+        Some(m) => match radiosity::illuminance::nice_scale(m) {
+            (top, n) if (top - m).abs() <= 1e-9 * m => (m, n),
+            _ => (m, 5),
+        },
+        None => radiosity::illuminance::nice_scale(largest),
+    };
     let settings = render::RenderSettings {
         direct_light: false,
         ..settings
@@ -236,7 +244,14 @@ fn false_colour(
             }
         })
         .unzip();
-    let image = false_colour_picture(&pixel_lux, &coverage, camera.width, camera.height, max);
+    let image = false_colour_picture(
+        &pixel_lux,
+        &coverage,
+        camera.width,
+        camera.height,
+        max,
+        ticks,
+    );
     run_stage(reporter, Stage::Write, 0, || render::write_png(&image, output))
         .with_context(|| format!("cannot write {}", output.display()))?;
     reporter.note(&format!(

@@ -132,3 +132,63 @@ fn auto_takes_progressive_refinement_for_a_large_scene_with_point_lights() {
     assert!(err.contains("progressive refinement instead"), "{err}");
     assert!(dir.join("out.csv").exists(), "{err}");
 }
+
+#[test]
+fn render_false_colour_draws_lux_with_a_scale_bar_and_refuses_what_it_cannot_draw() {
+    let dir = scratch_dir("false-colour");
+    let out = radiosity(
+        &[
+            "render",
+            &room(),
+            "--false-colour",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "-o",
+            "fc.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("false colour from 0 to"), "{err}");
+    let png = image::open(dir.join("fc.png")).unwrap().to_rgb8();
+    // The view and a 100 pixel scale bar beside it; the bar's height at least 160.
+    assert_eq!(png.width(), 64 + 100);
+    assert!(png.height() >= 160);
+    // The view is coloured (the ramp has no grey), not shaded grey.
+    let coloured = png
+        .enumerate_pixels()
+        .filter(|(x, y, _)| *x < 64 && *y < 48)
+        .filter(|(_, _, p)| !(p.0[0] == p.0[1] && p.0[1] == p.0[2]))
+        .count();
+    assert!(coloured > 64 * 48 / 2, "{coloured}");
+
+    for (args, expected) in [
+        (vec!["--false-colour", "-o", "fc.exr"], "--false-colour draws a PNG"),
+        (
+            vec!["--false-colour", "--shading", "wireframe", "-o", "w.png"],
+            "--shading smooth or flat",
+        ),
+        (
+            vec!["--false-colour", "--lux-max", "0", "-o", "z.png"],
+            "--lux-max 0",
+        ),
+        (vec!["--lux-max", "100", "-o", "n.png"], "--false-colour"),
+    ] {
+        let mut full = vec!["render", room_ref()];
+        full.extend(args.iter().copied());
+        let out = radiosity(&full, &dir);
+        assert!(!out.status.success(), "{args:?} was accepted");
+        assert!(stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn room_ref() -> &'static str {
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tests/data/downlight_room.scene"
+    )
+}
