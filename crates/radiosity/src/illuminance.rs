@@ -136,7 +136,9 @@ pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint
                 let exitance = if first_done {
                     r.rest
                 } else {
-                    r.rest + r.first_bounce.map_or(0.0, |rho| (rho * lit[r.element]).luminance())
+                    r.rest
+                        + r.first_bounce
+                            .map_or(0.0, |rho| (rho * lit[r.element]).luminance())
                 };
                 if exitance == 0.0 {
                     continue;
@@ -606,21 +608,21 @@ pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
             }
         }
     }
-    draw_scale_bar(&mut img, gw + 2 * margin, margin, height - margin - 6, max, 5);
+    draw_scale_bar(
+        &mut img,
+        gw + 2 * margin,
+        margin,
+        height - margin - 6,
+        max,
+        5,
+    );
     img
 }
 
 /// The scale bar of a false-colour picture, `lx` at its top left corner (x, y), the bar
 /// from y + 20 down to `bottom` (top = `max`, bottom = 0), and `ticks` + 1 values beside it
 /// (0 and `ticks` equal steps up to `max`); 90 pixels wide.
-fn draw_scale_bar(
-    img: &mut image::RgbImage,
-    bx: i64,
-    y: i64,
-    bottom: i64,
-    max: f64,
-    ticks: usize,
-) {
+fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: f64, ticks: usize) {
     let (by0, by1) = (y + 20, bottom);
     draw_text(img, bx, y, 2, "lx", [0; 3]);
     for y in by0..by1 {

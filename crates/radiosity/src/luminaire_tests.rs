@@ -323,8 +323,7 @@ fn asymmetric_ies_light(aim: DVec3) -> Luminaire {
     let text = "IESNA:LM-63-2002\n[TEST] asymmetric\nTILT=NONE\n1 -1 1 3 4 1 2 0 0 0\n1 1 0\n\
                 0 45 90\n0 90 180 270\n100 80 0\n200 150 0\n300 210 0\n400 260 0\n";
     let photometry =
-        crate::photometry::ies::IesPhotometry::parse(text, std::path::Path::new("a.ies"))
-            .unwrap();
+        crate::photometry::ies::IesPhotometry::parse(text, std::path::Path::new("a.ies")).unwrap();
     light(
         Distribution::Ies {
             written: "a.ies".into(),
@@ -350,7 +349,10 @@ fn asymmetric_ies_planes_point_where_the_azimuth_convention_says() {
         (dvec3(0.5, 0.5, -s), 115.0),
     ] {
         let got = down.candela(d);
-        assert!((got - expected).abs() < 1e-9, "{d}: {got} against {expected}");
+        assert!(
+            (got - expected).abs() < 1e-9,
+            "{d}: {got} against {expected}"
+        );
     }
     // Aimed along +x: the smallest rotation taking 0 0 -1 to +x is a quarter turn about y,
     // (x, y, z) -> (-z, y, x), which carries +x (C0 aimed down) onto +z and leaves +y (C90)
@@ -363,7 +365,10 @@ fn asymmetric_ies_planes_point_where_the_azimuth_convention_says() {
         (dvec3(s, -s, 0.0), 260.0),
     ] {
         let got = sideways.candela(d);
-        assert!((got - expected).abs() < 1e-9, "{d}: {got} against {expected}");
+        assert!(
+            (got - expected).abs() < 1e-9,
+            "{d}: {got} against {expected}"
+        );
     }
     // Nothing behind the light (vertical angles end at 90 degrees).
     assert_eq!(sideways.candela(dvec3(-1.0, 0.0, 0.0)), 0.0);

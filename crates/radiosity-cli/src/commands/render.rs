@@ -252,8 +252,10 @@ fn false_colour(
         max,
         ticks,
     );
-    run_stage(reporter, Stage::Write, 0, || render::write_png(&image, output))
-        .with_context(|| format!("cannot write {}", output.display()))?;
+    run_stage(reporter, Stage::Write, 0, || {
+        render::write_png(&image, output)
+    })
+    .with_context(|| format!("cannot write {}", output.display()))?;
     reporter.note(&format!(
         "wrote {} ({} x {} and a {} pixel scale bar; false colour from 0 to {} lx, the \
          largest element illuminance is {} lx; lux = lm/m^2 with scene lengths in metres)",

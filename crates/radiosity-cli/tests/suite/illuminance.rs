@@ -166,7 +166,10 @@ fn render_false_colour_draws_lux_with_a_scale_bar_and_refuses_what_it_cannot_dra
     assert!(coloured > 64 * 48 / 2, "{coloured}");
 
     for (args, expected) in [
-        (vec!["--false-colour", "-o", "fc.exr"], "--false-colour draws a PNG"),
+        (
+            vec!["--false-colour", "-o", "fc.exr"],
+            "--false-colour draws a PNG",
+        ),
         (
             vec!["--false-colour", "--shading", "wireframe", "-o", "w.png"],
             "--shading smooth or flat",
@@ -181,7 +184,11 @@ fn render_false_colour_draws_lux_with_a_scale_bar_and_refuses_what_it_cannot_dra
         full.extend(args.iter().copied());
         let out = radiosity(&full, &dir);
         assert!(!out.status.success(), "{args:?} was accepted");
-        assert!(stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(expected),
+            "{args:?}: {}",
+            stderr(&out)
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
