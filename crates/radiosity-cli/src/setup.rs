@@ -46,7 +46,6 @@ pub fn prepare_solve(
         options,
         prepared.mesh.len(),
         prepared.settings.max_patch_area,
-        prepared.scene.lights.len(),
         reporter,
     )?;
     prepared.check_memory(Some(&solver))?;
@@ -288,13 +287,11 @@ fn far_from_origin(scene: &radiosity::scene::Scene) -> Option<String> {
 }
 
 /// The solver the options ask for; `auto` is decided from the element count `n` and the
-/// memory available (and, where it would pick hierarchical radiosity, which does not take
-/// point luminaires yet, from the `lights` count), and the choice and its reason are noted.
+/// memory available, and the choice and its reason are noted.
 fn solver(
     options: &SolveOptions,
     n: usize,
     max_patch_area: f64,
-    lights: usize,
     reporter: &Reporter,
 ) -> Result<Solver> {
     if let Some(t) = options.tolerance {
@@ -308,16 +305,7 @@ fn solver(
             let choice =
                 radiosity::solve::choose(n, radiosity::form_factor::available_memory_bytes());
             reporter.note(&format!("solver auto: {choice}"));
-            if choice.kind() == SolverKind::Hierarchical && lights > 0 {
-                reporter.note(&format!(
-                    "solver auto: the scene has {lights} point luminaire(s), which hierarchical \
-                     radiosity does not take yet: progressive refinement instead (O(n) memory, \
-                     form factors row by row)"
-                ));
-                SolverKind::Progressive
-            } else {
-                choice.kind()
-            }
+            choice.kind()
         }
         other => other,
     };
