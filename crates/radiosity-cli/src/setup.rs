@@ -41,6 +41,25 @@ pub fn prepare_solve(
     options: &SolveOptions,
     reporter: &Reporter,
 ) -> Result<(Prepared, String, Solver)> {
+    prepare_solve_as(args, options, reporter, false)
+}
+
+/// [`prepare_solve`] for `compare`, whose dense reference uses `--method` whatever the
+/// solver compared: no warning that hierarchical radiosity ignores it.
+pub fn prepare_solve_with_reference(
+    args: &SceneArgs,
+    options: &SolveOptions,
+    reporter: &Reporter,
+) -> Result<(Prepared, String, Solver)> {
+    prepare_solve_as(args, options, reporter, true)
+}
+
+fn prepare_solve_as(
+    args: &SceneArgs,
+    options: &SolveOptions,
+    reporter: &Reporter,
+    method_used_elsewhere: bool,
+) -> Result<(Prepared, String, Solver)> {
     let (prepared, stem) = prepare_scene(args, reporter)?;
     let solver = solver(
         options,
@@ -59,7 +78,11 @@ pub fn prepare_solve(
     if computes && !args.no_work_limit {
         prepared.check_work()?;
     }
-    if let (Solver::Hierarchical(_), Some(method)) = (&solver, method_flag_given(&args.method)) {
+    if let (Solver::Hierarchical(_), Some(method), false) = (
+        &solver,
+        method_flag_given(&args.method),
+        method_used_elsewhere,
+    ) {
         // Printed even with --quiet: the run does not do what the flags say.
         errln!(
             "warning: --method {method} is ignored: hierarchical radiosity computes each \
