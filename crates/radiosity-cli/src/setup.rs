@@ -41,12 +41,30 @@ pub fn prepare_solve(
     options: &SolveOptions,
     reporter: &Reporter,
 ) -> Result<(Prepared, String, Solver)> {
+    prepare_solve_as(args, options, reporter, false)
+}
+
+/// [`prepare_solve`] for `compare`, whose dense reference uses `--method` whatever the
+/// solver compared: no warning that hierarchical radiosity ignores it.
+pub fn prepare_solve_with_reference(
+    args: &SceneArgs,
+    options: &SolveOptions,
+    reporter: &Reporter,
+) -> Result<(Prepared, String, Solver)> {
+    prepare_solve_as(args, options, reporter, true)
+}
+
+fn prepare_solve_as(
+    args: &SceneArgs,
+    options: &SolveOptions,
+    reporter: &Reporter,
+    method_used_elsewhere: bool,
+) -> Result<(Prepared, String, Solver)> {
     let (prepared, stem) = prepare_scene(args, reporter)?;
     let solver = solver(
         options,
         prepared.mesh.len(),
         prepared.settings.max_patch_area,
-        prepared.scene.lights.len(),
         reporter,
     )?;
     prepared.check_memory(Some(&solver))?;
@@ -60,7 +78,11 @@ pub fn prepare_solve(
     if computes && !args.no_work_limit {
         prepared.check_work()?;
     }
-    if let (Solver::Hierarchical(_), Some(method)) = (&solver, method_flag_given(&args.method)) {
+    if let (Solver::Hierarchical(_), Some(method), false) = (
+        &solver,
+        method_flag_given(&args.method),
+        method_used_elsewhere,
+    ) {
         // Printed even with --quiet: the run does not do what the flags say.
         errln!(
             "warning: --method {method} is ignored: hierarchical radiosity computes each \
@@ -288,13 +310,11 @@ fn far_from_origin(scene: &radiosity::scene::Scene) -> Option<String> {
 }
 
 /// The solver the options ask for; `auto` is decided from the element count `n` and the
-/// memory available (and, where it would pick hierarchical radiosity, which does not take
-/// point luminaires yet, from the `lights` count), and the choice and its reason are noted.
+/// memory available, and the choice and its reason are noted.
 fn solver(
     options: &SolveOptions,
     n: usize,
     max_patch_area: f64,
-    lights: usize,
     reporter: &Reporter,
 ) -> Result<Solver> {
     if let Some(t) = options.tolerance {
@@ -308,16 +328,7 @@ fn solver(
             let choice =
                 radiosity::solve::choose(n, radiosity::form_factor::available_memory_bytes());
             reporter.note(&format!("solver auto: {choice}"));
-            if choice.kind() == SolverKind::Hierarchical && lights > 0 {
-                reporter.note(&format!(
-                    "solver auto: the scene has {lights} point luminaire(s), which hierarchical \
-                     radiosity does not take yet: progressive refinement instead (O(n) memory, \
-                     form factors row by row)"
-                ));
-                SolverKind::Progressive
-            } else {
-                choice.kind()
-            }
+            choice.kind()
         }
         other => other,
     };

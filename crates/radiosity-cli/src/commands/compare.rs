@@ -13,11 +13,12 @@ use crate::errors::hint;
 use crate::peak_memory::{peak_memory_bytes, reset_peak_memory};
 use crate::progress_bar::Reporter;
 use crate::report::{self, CompareRow, Peak, Reference};
-use crate::setup::prepare_solve;
+use crate::setup::prepare_solve_with_reference;
 
 pub fn run(args: CompareArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    let (prepared, stem, solver) =
+        prepare_solve_with_reference(&args.scene, &args.solve, &reporter)?;
     let reset = reset_peak_memory();
     let start = std::time::Instant::now();
     let (solution, _) = solve_scene(

@@ -101,16 +101,6 @@ pub enum SolveError {
     /// There is nothing to solve.
     #[error("the scene has no surfaces")]
     NoSurfaces,
-    /// Hierarchical radiosity does not take point luminaires yet: their first bounce varies
-    /// within its patches, which carry one emission per input surface.
-    #[error(
-        "hierarchical radiosity does not take point luminaires (LIGHTBEGIN) yet; the scene has \
-         {lights}: solve it with a matrix solver or progressive refinement"
-    )]
-    PointLightsUnsupported {
-        /// How many lights the scene has.
-        lights: usize,
-    },
     /// An input vector does not have one entry per row of the form-factor matrix.
     #[error("{what} has {len} entries but the form-factor matrix has {n} rows")]
     LengthMismatch {

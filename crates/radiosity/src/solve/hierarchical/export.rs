@@ -72,10 +72,12 @@ pub(super) fn energy_account(
         ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
     for &l in leaf_ids {
         let n = &solver.nodes[l as usize];
-        let s = n.surface as usize;
+        let (s, e) = (n.surface as usize, solver.self_exitance(l));
         let h = h_of.get(&l).copied().unwrap_or([0.0; 3]);
         for k in 0..3 {
-            emitted_leaves[k] += n.area * solver.emission[s][k];
+            // The point luminaires' first bounce counts as emitted, as in the dense
+            // solvers' account (`crate::solve::energy_balance`).
+            emitted_leaves[k] += n.area * e[k];
             leaving[k] += n.area * solver.b[l as usize][k];
             carried[k] += n.area * h[k];
             absorbed[k] += n.area * (1.0 - solver.rho[s][k]) * h[k];

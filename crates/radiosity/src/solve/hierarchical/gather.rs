@@ -355,10 +355,7 @@ impl Solver<'_> {
         let emitted: [f64; 3] = std::array::from_fn(|k| {
             leaves
                 .iter()
-                .map(|&l| {
-                    let n = &self.nodes[l as usize];
-                    n.area * self.emission[n.surface as usize][k]
-                })
+                .map(|&l| self.nodes[l as usize].area * self.self_exitance(l)[k])
                 .sum()
         });
         // The terms, kept while they fit in the memory left (chunk by chunk).
@@ -411,9 +408,8 @@ impl Solver<'_> {
             let mut change = [0.0; 3];
             for (&l, hl) in leaves.iter().zip(&h) {
                 let n = &self.nodes[l as usize];
-                let s = n.surface as usize;
-                let new: [f64; 3] =
-                    std::array::from_fn(|k| self.emission[s][k] + self.rho[s][k] * hl[k]);
+                let (s, e) = (n.surface as usize, self.self_exitance(l));
+                let new: [f64; 3] = std::array::from_fn(|k| e[k] + self.rho[s][k] * hl[k]);
                 for k in 0..3 {
                     change[k] += n.area * (new[k] - self.b[l as usize][k]).abs();
                 }
@@ -450,9 +446,11 @@ impl Solver<'_> {
         let terms = self.leaf_terms(&leaves, &parent, walk);
         let h = self.evaluate(&terms, &from_clusters);
         for (&l, hl) in leaves.iter().zip(h) {
-            let s = self.nodes[l as usize].surface as usize;
-            self.b[l as usize] =
-                std::array::from_fn(|k| self.emission[s][k] + self.rho[s][k] * hl[k]);
+            let (s, e) = (
+                self.nodes[l as usize].surface as usize,
+                self.self_exitance(l),
+            );
+            self.b[l as usize] = std::array::from_fn(|k| e[k] + self.rho[s][k] * hl[k]);
             h_of.insert(l, hl);
         }
     }

@@ -306,11 +306,6 @@ pub fn solve_hierarchical(
     if scene.surfaces.is_empty() {
         return Err(SolveError::NoSurfaces);
     }
-    if !scene.lights.is_empty() {
-        return Err(SolveError::PointLightsUnsupported {
-            lights: scene.lights.len(),
-        });
-    }
     let start = Instant::now();
     let mut solver = Solver {
         nodes: Vec::new(),
@@ -324,6 +319,8 @@ pub fn solve_hierarchical(
         normal: Vec::new(),
         rho: Vec::new(),
         emission: Vec::new(),
+        lights: &scene.lights,
+        direct: Vec::new(),
         occluders,
         settings: *settings,
         rays: 0,
@@ -381,12 +378,16 @@ pub fn solve_hierarchical(
         .map(|s| geometry::polygon_area(&s.vertices) * s.reflectance.max_band())
         .sum::<f64>()
         / total_area;
+    // The surfaces' emission and the point luminaires' first bounce (on the roots).
     let emitted: [f64; 3] = std::array::from_fn(|k| {
         scene
             .surfaces
             .iter()
             .map(|s| geometry::polygon_area(&s.vertices) * s.emission.0[k])
-            .sum()
+            .sum::<f64>()
+            + (0..solver.root_count)
+                .filter_map(|r| Some(solver.nodes[r].area * solver.direct.get(r)?[k]))
+                .sum::<f64>()
     });
 
     let (rounds, iterations, initial_links, residual, gathered) =

@@ -8,6 +8,7 @@ use glam::DVec3;
 use super::link::Link;
 use super::tree::{Cluster, ClusterSample, Node, CLUSTER_SAMPLES};
 use super::HierarchicalSettings;
+use crate::luminaire::Luminaire;
 use crate::visibility::PolygonBvh;
 
 /// The largest of three bands.
@@ -34,6 +35,12 @@ pub(super) struct Solver<'a> {
     pub(super) normal: Vec<DVec3>,
     pub(super) rho: Vec<[f64; 3]>,
     pub(super) emission: Vec<[f64; 3]>,
+    /// The scene's point luminaires.
+    pub(super) lights: &'a [Luminaire],
+    /// Per node, the light of the point luminaires it reflects at first bounce: rho times
+    /// its mean direct illuminance (see [`Solver::point_light_bounce`]); zero for clusters.
+    /// Empty when the scene has no point luminaire.
+    pub(super) direct: Vec<[f64; 3]>,
     pub(super) occluders: &'a PolygonBvh,
     pub(super) settings: HierarchicalSettings,
     pub(super) rays: u64,
@@ -61,10 +68,21 @@ pub(super) const FRONTIER_PAIR_BYTES: u64 =
 const PER_NODE_BYTES: usize = 24 + 16 + 4;
 
 impl Solver<'_> {
+    /// What leaf or patch `n` sends of itself, before what it reflects of the scene's
+    /// light: its surface's emission plus the point luminaires' first bounce.
+    pub(super) fn self_exitance(&self, n: u32) -> [f64; 3] {
+        let e = self.emission[self.nodes[n as usize].surface as usize];
+        match self.direct.get(n as usize) {
+            Some(d) => std::array::from_fn(|k| e[k] + d[k]),
+            None => e,
+        }
+    }
+
     /// Bytes held by nodes, clusters and links (links with the slack of their vectors).
     /// The refinement adds its frontier's [`FRONTIER_PAIR_BYTES`] per pair while it runs.
     pub(super) fn memory_bytes(&self) -> u64 {
         (self.nodes.len() * (std::mem::size_of::<Node>() + PER_NODE_BYTES)
+            + self.direct.len() * 24
             + self.clusters.len()
                 * (std::mem::size_of::<Cluster>()
                     + CLUSTER_SAMPLES * std::mem::size_of::<ClusterSample>())

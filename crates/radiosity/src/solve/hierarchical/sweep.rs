@@ -99,9 +99,8 @@ impl Solver<'_> {
             return [0.0; 3];
         }
         if node.child_count == 0 {
-            let s = node.surface as usize;
-            let new: [f64; 3] =
-                std::array::from_fn(|k| self.emission[s][k] + self.rho[s][k] * h[k]);
+            let (s, e) = (node.surface as usize, self.self_exitance(n));
+            let new: [f64; 3] = std::array::from_fn(|k| e[k] + self.rho[s][k] * h[k]);
             let area = node.area;
             if let Some(out) = arriving {
                 out.push((n, h));

@@ -169,10 +169,45 @@ impl Solver<'_> {
             buried: false,
             straddles: false,
         });
+        let b = if self.lights.is_empty() {
+            b
+        } else {
+            let d = self.point_light_bounce(surface, poly);
+            self.direct.push(d);
+            std::array::from_fn(|k| b[k] + d[k])
+        };
         self.b.push(b);
         self.b_span.push((max3(b), max3(b)));
         self.cluster_of.push(NONE);
         self.nodes.len() as u32 - 1
+    }
+
+    /// The first bounce of the point luminaires on the piece `poly` of `surface`: its
+    /// reflectance times its mean illuminance from them, with shadow rays through the
+    /// scene's surfaces (the same quadrature as the dense solvers' elements,
+    /// [`crate::luminaire::power_onto`] at [`crate::luminaire::ELEMENT_SUBDIVISION`]).
+    pub(super) fn point_light_bounce(&mut self, surface: u32, poly: &[DVec3]) -> [f64; 3] {
+        let area = geometry::polygon_area(poly);
+        if area <= 0.0 {
+            return [0.0; 3];
+        }
+        let occ = self.occluders;
+        let rays = std::cell::Cell::new(0u64);
+        let mut power = crate::light::Rgb::BLACK;
+        for l in self.lights {
+            power += crate::luminaire::power_onto(
+                l,
+                poly,
+                crate::luminaire::ELEMENT_SUBDIVISION,
+                |x, y| {
+                    rays.set(rays.get() + 1);
+                    occ.segment_blocked(x, y)
+                },
+            );
+        }
+        self.rays += rays.get();
+        let rho = self.rho[surface as usize];
+        std::array::from_fn(|k| rho[k] * power.0[k] / area)
     }
 
     /// Builds the cluster tree over `items` (patch roots); returns its top node.
@@ -277,6 +312,9 @@ impl Solver<'_> {
             straddles: false,
         });
         self.b.push([0.0; 3]);
+        if !self.lights.is_empty() {
+            self.direct.push([0.0; 3]);
+        }
         self.b_span.push((0.0, 0.0));
         self.cluster_of.push(self.clusters.len() as u32 - 1);
         self.nodes.len() as u32 - 1
@@ -296,7 +334,12 @@ impl Solver<'_> {
         if node.child_count > 0 {
             return node.children().to_vec();
         }
-        let (surface, b) = (node.surface, self.b[n as usize]);
+        // Children start with the parent's B, less the parent's own first bounce of the
+        // point luminaires (each adds its own).
+        let (surface, mut b) = (node.surface, self.b[n as usize]);
+        if let Some(d) = self.direct.get(n as usize) {
+            b = std::array::from_fn(|k| b[k] - d[k]);
+        }
         let p = node.corners;
         let [cu, cv] = node.grid;
         // (corners, grid) of each child.
