@@ -20,7 +20,7 @@ fi
 
 seconds=${FUZZ_SECONDS:-60}
 ./build.sh
-for target in scene_file form_factor_file obj gltf vrml dxf ies points; do
+for target in scene_file form_factor_file obj gltf vrml dxf ies points checkpoint; do
     echo "fuzzing $target for $seconds s"
     # libFuzzer's progress lines are many; its final statistics and any crash report are
     # what CI needs, so the log is kept and shown in full only on failure.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one fuzz target for a bounded time: fuzz/run.sh TARGET SECONDS [libFuzzer options...]
 #
-# TARGET is scene_file, form_factor_file, obj, gltf, vrml, dxf or ies. The binary must have been built by build.sh
+# TARGET is scene_file, form_factor_file, obj, gltf, vrml, dxf, ies, points or checkpoint. The binary must have been built by build.sh
 # (same CARGO_TARGET_DIR). The target grows its corpus in fuzz/work/TARGET (ignored by git),
 # starting from the seeds in fuzz/corpus/TARGET, which it only reads; a crashing input is
 # written to fuzz/artifacts/TARGET/ and the script exits non-zero.
@@ -19,7 +19,8 @@ case "$target" in
     dxf) options=(-dict=dxf.dict -max_len=8192) ;;
     ies) options=(-dict=ies.dict -max_len=8192) ;;
     points) options=(-max_len=4096) ;;
-    *) echo "unknown target $target (scene_file, form_factor_file, obj, gltf, vrml, dxf, ies or points)" >&2; exit 2 ;;
+    checkpoint) options=(-dict=checkpoint.dict -max_len=4096) ;;
+    *) echo "unknown target $target (scene_file, form_factor_file, obj, gltf, vrml, dxf, ies, points or checkpoint)" >&2; exit 2 ;;
 esac
 host=$(rustc -vV | sed -n "s/^host: //p")
 binary="${CARGO_TARGET_DIR:-target}/$host/release/$target"

@@ -449,3 +449,132 @@ pub fn points(data: &[u8]) {
         }
     }
 }
+
+/// Where a `checkpoint` input's block files start: the bytes before the first such line are
+/// the manifest; each `%%BLOCK NAME` line starts a file NAME holding the bytes up to the
+/// next (a name of letters, digits, `.`, `-`, `_`, 80 at most, else the section is dropped).
+pub const BLOCK_SEPARATOR: &[u8] = b"\n%%BLOCK ";
+
+/// The job the `checkpoint` target resumes: 5 elements, one fingerprint, one method (the
+/// seeds' manifests and blocks are this job's).
+pub fn checkpoint_job() -> radiosity_mpi::checkpoint::JobIdentity {
+    radiosity_mpi::checkpoint::JobIdentity {
+        scene: "fuzz.scene".into(),
+        elements: 5,
+        fingerprint: 0x0123_4567_89ab_cdef,
+        method: "area k=2".into(),
+    }
+}
+
+/// The checkpoint directory of `radiosity-mpi --resume` (`radiosity_mpi::checkpoint`) on
+/// arbitrary bytes: the manifest and block files of [`BLOCK_SEPARATOR`] are written into a
+/// directory of this process's own, which is opened for resuming [`checkpoint_job`]. Each
+/// input runs as it is and again with every block's CRC-32 (its last 4 bytes) recomputed, so
+/// that mutated headers get past the checksum as a forged file would.
+///
+/// A refusal must name the directory or the manifest; an accepted checkpoint's blocks must
+/// be sorted, disjoint and within the mesh's rows, each must load with its rows' entries
+/// (what the program writes into the output), every refused file must say why, and the
+/// dealer must cover the rows the blocks leave, once each.
+pub fn checkpoint(data: &[u8]) {
+    init();
+    let (manifest, blocks) = split_checkpoint(data);
+    resume_checkpoint(manifest, &blocks);
+    let fixed: Vec<(&str, Vec<u8>)> = blocks
+        .iter()
+        .map(|(name, bytes)| {
+            let mut bytes = bytes.clone();
+            if let Some(at) = bytes.len().checked_sub(4) {
+                let crc = crc32fast::hash(&bytes[..at]);
+                bytes[at..].copy_from_slice(&crc.to_le_bytes());
+            }
+            (*name, bytes)
+        })
+        .collect();
+    if fixed != blocks {
+        resume_checkpoint(manifest, &fixed);
+    }
+}
+
+/// The manifest and the named block files of a `checkpoint` input.
+pub fn split_checkpoint(data: &[u8]) -> (&[u8], Vec<(&str, Vec<u8>)>) {
+    let mut sections = split_on(data, BLOCK_SEPARATOR);
+    let manifest = sections.remove(0);
+    let blocks = sections
+        .into_iter()
+        .filter_map(|section| {
+            let end = section.iter().position(|&b| b == b'\n')?;
+            let name = std::str::from_utf8(&section[..end]).ok()?;
+            let usable = !name.is_empty()
+                && name.len() <= 80
+                && name != "manifest"
+                && !name.starts_with('.')
+                && name
+                    .bytes()
+                    .all(|b| b.is_ascii_alphanumeric() || b"._-".contains(&b));
+            usable.then(|| (name, section[end + 1..].to_vec()))
+        })
+        .collect();
+    (manifest, blocks)
+}
+
+fn split_on<'a>(data: &'a [u8], separator: &[u8]) -> Vec<&'a [u8]> {
+    let mut out = Vec::new();
+    let mut rest = data;
+    while let Some(at) = rest.windows(separator.len()).position(|w| w == separator) {
+        out.push(&rest[..at]);
+        rest = &rest[at + separator.len()..];
+    }
+    out.push(rest);
+    out
+}
+
+fn resume_checkpoint(manifest: &[u8], blocks: &[(&str, Vec<u8>)]) {
+    use radiosity_mpi::checkpoint::Checkpoint;
+    use radiosity_mpi::deal::Dealer;
+    let job = checkpoint_job();
+    let dir = scratch_file("checkpoint");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("creating the scratch directory");
+    std::fs::write(dir.join("manifest"), manifest).expect("writing the scratch manifest");
+    for (name, bytes) in blocks {
+        std::fs::write(dir.join(name), bytes).expect("writing a scratch block");
+    }
+    let result = Checkpoint::open(&dir, &job, true);
+    let (cp, found) = match result {
+        Ok(opened) => opened,
+        Err(error) => {
+            let message = error.to_string();
+            assert!(
+                message.contains(dir.to_str().unwrap()),
+                "the message names neither the directory nor its manifest: {message}"
+            );
+            let _ = std::fs::remove_dir_all(&dir);
+            return;
+        }
+    };
+    let n = job.elements;
+    for pair in found.blocks.windows(2) {
+        assert!(pair[0].end <= pair[1].start, "blocks overlap: {:?}", found.blocks);
+    }
+    for rows in &found.blocks {
+        assert!(rows.start < rows.end && rows.end <= n, "block {rows:?} of {n} rows");
+        let data = cp.load(rows).expect("a block open accepted loads");
+        assert_eq!(data.len(), rows.len() * n);
+    }
+    for (path, why) in &found.refused {
+        assert!(!why.is_empty(), "{} refused without a reason", path.display());
+    }
+    // What the program deals next: the rows no accepted block holds, once each.
+    let mut dealer = Dealer::new(n, 2, &found.blocks);
+    let mut covered = vec![0u32; n];
+    for rows in &found.blocks {
+        rows.clone().for_each(|r| covered[r] += 1);
+    }
+    while let Some(rows) = dealer.deal(0) {
+        rows.clone().for_each(|r| covered[r] += 1);
+        dealer.finish(0);
+    }
+    assert!(covered.iter().all(|&c| c == 1), "rows covered {covered:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -33,6 +33,11 @@ const BLOCK_MAGIC: [u8; 8] = *b"RADBLK\0\0";
 /// Bytes of a block file besides its entries: magic, four u64, the CRC.
 const BLOCK_FIXED_BYTES: u64 = 8 + 4 * 8 + 4;
 
+/// The most bytes of a manifest read: this program writes five short lines (the scene's
+/// path is the only long one), so a longer file is not one of its manifests, and reading
+/// it whole (a hostile or misplaced file of gigabytes) would only cost memory.
+pub const MANIFEST_MAX_BYTES: u64 = 64 * 1024;
+
 /// What a checkpoint belongs to: a job with another identity cannot use it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct JobIdentity {
@@ -75,6 +80,17 @@ pub enum CheckpointError {
     NothingToResume {
         /// The directory.
         dir: PathBuf,
+    },
+    /// The manifest is longer than any this program writes.
+    #[error(
+        "checkpoint manifest {path} is over {limit} bytes: not a manifest this program wrote \
+         (it writes five short lines)"
+    )]
+    ManifestTooLong {
+        /// The manifest file.
+        path: PathBuf,
+        /// `MANIFEST_MAX_BYTES`.
+        limit: u64,
     },
     /// The manifest is not one this program writes.
     #[error("checkpoint manifest {path} line {line}: expected {expected}, found `{found}`")]
@@ -221,6 +237,10 @@ impl Checkpoint {
         let mut files = checkpoint.block_files()?;
         files.sort_by_key(|(rows, _)| (rows.start, rows.end));
         for (rows, path) in files {
+            if rows.end > identity.elements {
+                result.refused.push((path, beyond(&rows, identity.elements)));
+                continue;
+            }
             if result
                 .blocks
                 .last()
@@ -281,26 +301,59 @@ impl Checkpoint {
     }
 
     /// Reads a finished block back; `Err` says why the file cannot be used.
+    ///
+    /// No more bytes are read than a block of `rows` has, plus one to see that the file is
+    /// longer: a block file replaced by something endless (a link to `/dev/zero`, a pipe)
+    /// or huge is refused without being read whole.
     pub fn load(&self, rows: &Range<usize>) -> Result<Vec<f32>, String> {
+        let n = self.identity.elements;
+        if rows.end > n {
+            return Err(beyond(rows, n));
+        }
+        let expected = block_bytes(rows, n).ok_or_else(|| beyond(rows, n))?;
         let path = self.block_path(rows);
-        let bytes = std::fs::read(&path).map_err(|e| e.to_string())?;
-        decode_block(
-            &bytes,
-            self.identity.fingerprint,
-            self.identity.elements,
-            rows,
-        )
+        let bytes = read_at_most(&path, expected.saturating_add(1)).map_err(|e| e.to_string())?;
+        decode_block(&bytes, self.identity.fingerprint, n, rows)
     }
 }
 
-/// `rows-START-END.blk` to START..END (END > START).
+/// Why a block of `rows` is not one of an `n`-element job's.
+fn beyond(rows: &Range<usize>, n: usize) -> String {
+    format!(
+        "its rows {}..{} lie beyond the mesh's {n} elements",
+        rows.start, rows.end
+    )
+}
+
+/// The bytes of a block file of `rows` of `n` entries; `None` past u64.
+fn block_bytes(rows: &Range<usize>, n: usize) -> Option<u64> {
+    (rows.len() as u64)
+        .checked_mul(n as u64)?
+        .checked_mul(4)?
+        .checked_add(BLOCK_FIXED_BYTES)
+}
+
+/// The first `limit` bytes of the file at `path` (all of it if shorter).
+fn read_at_most(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit)
+        .read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
+/// `rows-START-END.blk` to START..END (END > START), for the names this program writes
+/// only (START and END of 10 digits or more, without sign): another spelling of the same
+/// rows (`rows-0-2.blk`, `rows-+0-2.blk`) would be a second file for one block, and
+/// [`Checkpoint::load`] reads the name it writes.
 fn parse_block_name(name: &str) -> Option<Range<usize>> {
     let (start, end) = name
         .strip_prefix("rows-")?
         .strip_suffix(".blk")?
         .split_once('-')?;
-    let (start, end) = (start.parse().ok()?, end.parse().ok()?);
-    (end > start).then_some(start..end)
+    let (start, end): (usize, usize) = (start.parse().ok()?, end.parse().ok()?);
+    (end > start && name == format!("rows-{start:010}-{end:010}.blk")).then_some(start..end)
 }
 
 /// The bytes of a block file.
@@ -323,14 +376,17 @@ fn decode_block(
     n: usize,
     rows: &Range<usize>,
 ) -> Result<Vec<f32>, String> {
-    let entries = rows.len() as u64 * n as u64;
-    let expected = BLOCK_FIXED_BYTES + 4 * entries;
+    let expected = block_bytes(rows, n).ok_or_else(|| beyond(rows, n))?;
     if bytes.len() as u64 != expected {
+        // `load` reads at most one byte more than a block has.
+        let length = if bytes.len() as u64 > expected {
+            "more than that".to_string()
+        } else {
+            format!("{} bytes", bytes.len())
+        };
         return Err(format!(
-            "{} bytes, but rows {}..{} of {n} entries make {expected}",
-            bytes.len(),
-            rows.start,
-            rows.end
+            "{length}, but rows {}..{} of {n} entries make {expected}",
+            rows.start, rows.end
         ));
     }
     let (body, crc) = bytes.split_at(bytes.len() - 4);
@@ -363,10 +419,29 @@ fn decode_block(
 
 /// A manifest's fields.
 fn read_manifest(path: &Path) -> Result<JobIdentity, CheckpointError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CheckpointError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes =
+        read_at_most(path, MANIFEST_MAX_BYTES + 1).map_err(|source| CheckpointError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    if bytes.len() as u64 > MANIFEST_MAX_BYTES {
+        return Err(CheckpointError::ManifestTooLong {
+            path: path.to_path_buf(),
+            limit: MANIFEST_MAX_BYTES,
+        });
+    }
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let good = &bytes[..e.valid_up_to()];
+            return Err(CheckpointError::BadManifest {
+                path: path.to_path_buf(),
+                line: 1 + good.iter().filter(|&&b| b == b'\n').count(),
+                expected: "UTF-8 text",
+                found: format!("the byte 0x{:02x}", bytes[e.valid_up_to()]),
+            });
+        }
+    };
     let mut lines = text.lines();
     let bad =
         |line: usize, expected: &'static str, found: Option<&str>| CheckpointError::BadManifest {
@@ -538,6 +613,102 @@ mod tests {
             format!(
                 "checkpoint manifest {} line 3: expected `elements N` with N a whole number, \
                  found `five`",
+                path.display()
+            )
+        );
+    }
+
+    /// A block file whose rows end past the mesh (its header forged to match) is refused,
+    /// so the resumed job never writes rows the matrix does not have.
+    #[test]
+    fn a_block_beyond_the_mesh_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let (cp, _) = Checkpoint::open(dir.path(), &identity(), false).unwrap();
+        cp.save(&(4..7), &[0.25; 15]).unwrap();
+        // Names whose rows overflow any byte count: refused the same way, no overflow.
+        let huge = format!("rows-0000000001-{}.blk", usize::MAX);
+        std::fs::write(dir.path().join(&huge), b"RADBLK").unwrap();
+        let (cp, found) = Checkpoint::open(dir.path(), &identity(), true).unwrap();
+        assert!(found.blocks.is_empty());
+        let mut why: Vec<&str> = found.refused.iter().map(|(_, w)| w.as_str()).collect();
+        why.sort();
+        assert_eq!(
+            why,
+            [
+                format!("its rows 1..{} lie beyond the mesh's 5 elements", usize::MAX),
+                "its rows 4..7 lie beyond the mesh's 5 elements".to_string(),
+            ]
+        );
+        assert_eq!(
+            cp.load(&(1..usize::MAX)).unwrap_err(),
+            format!("its rows 1..{} lie beyond the mesh's 5 elements", usize::MAX)
+        );
+    }
+
+    /// A block file that never ends (a link to /dev/zero) is refused after reading one
+    /// byte more than its block has, not read until memory runs out.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn an_endless_block_file_is_refused_without_reading_it_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        Checkpoint::open(dir.path(), &identity(), false).unwrap();
+        let link = dir.path().join("rows-0000000000-0000000002.blk");
+        std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+        let (_, found) = Checkpoint::open(dir.path(), &identity(), true).unwrap();
+        assert!(found.blocks.is_empty());
+        // 2 rows x 5 entries x 4 bytes + 44 fixed bytes.
+        assert_eq!(
+            found.refused[0].1,
+            "more than that, but rows 0..2 of 5 entries make 84"
+        );
+    }
+
+    /// Only the names this program writes are blocks: another spelling of the same rows is
+    /// left alone (it would be a second file for one block, and `load` reads the first).
+    #[test]
+    fn block_names_of_another_spelling_are_not_blocks() {
+        assert_eq!(
+            parse_block_name("rows-0000000000-0000000002.blk"),
+            Some(0..2)
+        );
+        for name in [
+            "rows-0-2.blk",
+            "rows-+000000000-0000000002.blk",
+            "rows-0000000002-0000000002.blk",
+            "rows-0000000000-0000000002.blk.tmp",
+        ] {
+            assert_eq!(parse_block_name(name), None, "{name}");
+        }
+    }
+
+    /// A manifest that is not text, or far longer than one: refused saying which, and the
+    /// long one without being read whole.
+    #[test]
+    fn a_manifest_of_bytes_or_of_any_length_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("manifest");
+        std::fs::write(&path, b"radiosity-mpi checkpoint 1\nscene \xff\n").unwrap();
+        let err = Checkpoint::open(dir.path(), &identity(), true)
+            .err()
+            .unwrap();
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "checkpoint manifest {} line 2: expected UTF-8 text, found `the byte 0xff`",
+                path.display()
+            )
+        );
+        let mut long = b"radiosity-mpi checkpoint 1\nscene ".to_vec();
+        long.resize(MANIFEST_MAX_BYTES as usize + 1, b'a');
+        std::fs::write(&path, &long).unwrap();
+        let err = Checkpoint::open(dir.path(), &identity(), true)
+            .err()
+            .unwrap();
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "checkpoint manifest {} is over 65536 bytes: not a manifest this program \
+                 wrote (it writes five short lines)",
                 path.display()
             )
         );
