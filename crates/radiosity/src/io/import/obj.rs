@@ -171,8 +171,11 @@ pub fn parse(
         let defaults = default_settings(&scene);
         MeshSettings {
             // In the file's units, as the scene file's: scaled with the coordinates.
+            // (A product that leaves the f64 range falls back to the default.)
             max_patch_area: max_patch_area
-                .map_or(defaults.max_patch_area, |a| a * options.scale * options.scale),
+                .map(|a| a * options.scale * options.scale)
+                .filter(|a| *a > 0.0 && a.is_finite())
+                .unwrap_or(defaults.max_patch_area),
             integral_steps: integral_steps.unwrap_or(defaults.integral_steps),
         }
     });
