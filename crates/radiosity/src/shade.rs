@@ -61,7 +61,9 @@ pub const CREASE_DEGREES: f64 = 60.0;
 /// (`ball.12` is a facet of `ball`, as the scene reader names a `SPHEREBEGIN` block's
 /// faces and the importers an object's faces); `None` for a name without one.
 pub fn object_of(name: &str) -> Option<&str> {
-    name.rfind('.').map(|i| &name[..i]).filter(|o| !o.is_empty())
+    name.rfind('.')
+        .map(|i| &name[..i])
+        .filter(|o| !o.is_empty())
 }
 
 /// Makes smooth shading continuous across the facets of one curved object, in place:
@@ -154,21 +156,21 @@ pub fn smooth_objects(scene: &Scene, mesh: &Mesh, vertex_b: &mut [[f64; 3]]) {
             }
         }
         let mut sums: HashMap<usize, ([f64; 3], f64, usize)> = HashMap::new();
-        for i in 0..n {
+        for (i, &v) in members.iter().enumerate() {
             let r = root(&mut parent, i);
-            let v = members[i] as usize;
+            let v = v as usize;
             let entry = sums.entry(r).or_insert(([0.0; 3], 0.0, 0));
-            for k in 0..3 {
-                entry.0[k] += ring_area[v] * vertex_b[v][k];
+            for (s, b) in entry.0.iter_mut().zip(vertex_b[v]) {
+                *s += ring_area[v] * b;
             }
             entry.1 += ring_area[v];
             entry.2 += 1;
         }
-        for i in 0..n {
+        for (i, &v) in members.iter().enumerate() {
             let r = root(&mut parent, i);
             let (sum, area, count) = sums[&r];
             if count > 1 && area > 0.0 {
-                vertex_b[members[i] as usize] = sum.map(|x| x / area);
+                vertex_b[v as usize] = sum.map(|x| x / area);
             }
         }
     }
@@ -574,15 +576,25 @@ mod tests {
         surfaces.push(surface(
             "plate.0",
             0.0,
-            vec![dvec3(1., 0., 0.), dvec3(2., 0., 0.), dvec3(2., 0., 1.), dvec3(1., 0., 1.)]
-                .into_iter()
-                .rev()
-                .collect(),
+            vec![
+                dvec3(1., 0., 0.),
+                dvec3(2., 0., 0.),
+                dvec3(2., 0., 1.),
+                dvec3(1., 0., 1.),
+            ]
+            .into_iter()
+            .rev()
+            .collect(),
         ));
         surfaces.push(surface(
             "box.light",
             3.0,
-            vec![dvec3(1., 1., 0.), dvec3(1., 1., 1.), dvec3(2., 1., 1.), dvec3(2., 1., 0.)],
+            vec![
+                dvec3(1., 1., 0.),
+                dvec3(1., 1., 1.),
+                dvec3(2., 1., 1.),
+                dvec3(2., 1., 0.),
+            ],
         ));
         let s = scene(surfaces);
         let mesh = mesh_scene(&s, 0.05).unwrap();

@@ -301,11 +301,18 @@ impl FaceSoup {
         let canonical: Vec<u32> = vertices
             .iter()
             .enumerate()
-            .map(|(i, v)| *first_at.entry(v.to_array().map(f64::to_bits)).or_insert(i as u32))
+            .map(|(i, v)| {
+                *first_at
+                    .entry(v.to_array().map(f64::to_bits))
+                    .or_insert(i as u32)
+            })
             .collect();
         let mut groups: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
         for (f, face) in self.faces.iter().enumerate() {
-            groups.entry((face.object, face.material)).or_default().push(f);
+            groups
+                .entry((face.object, face.material))
+                .or_default()
+                .push(f);
         }
         let mut out: Vec<(usize, Option<Vec<u32>>)> = Vec::with_capacity(self.faces.len());
         for faces in groups.values() {
@@ -332,9 +339,10 @@ impl FaceSoup {
                 // Kept as given (also one whose indices are wrong, for its error).
                 let as_given = self.indices.get(range).is_none_or(|ix| {
                     ix.len() == poly.len()
-                        && ix.iter().zip(&poly).all(|(&b, &a)| {
-                            canonical.get(b as usize).copied().unwrap_or(b) == a
-                        })
+                        && ix
+                            .iter()
+                            .zip(&poly)
+                            .all(|(&b, &a)| canonical.get(b as usize).copied().unwrap_or(b) == a)
                 });
                 out.push((f, (!as_given).then_some(poly)));
             }

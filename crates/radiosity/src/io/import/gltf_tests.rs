@@ -920,10 +920,8 @@ fn exported_glb_reads_back_with_the_scenes_geometry_and_colours() {
             got.surfaces.len(),
             "every imported surface comes from one original"
         );
-        for ((group, want), &want_area) in groups
-            .iter()
-            .zip(&ex.scene.surfaces)
-            .zip(&ex.surface_area)
+        for ((group, want), &want_area) in
+            groups.iter().zip(&ex.scene.surfaces).zip(&ex.surface_area)
         {
             // Geometry: the pieces cover the surface's meshed part (the floor under the
             // boxes is buried and not meshed, so not exported). Positions went through f32
@@ -1003,7 +1001,11 @@ fn unlit_export_without_its_colours_reads_as_the_baked_light() {
     let imported = read_any_scene(&ex.gltf, &ImportOptions::default()).unwrap();
     let got = &imported.file.scene;
     let groups = groups_by_name(got, &ex.scene);
-    for ((group, want), colour) in groups.iter().zip(&ex.scene.surfaces).zip(&ex.surface_colour) {
+    for ((group, want), colour) in groups
+        .iter()
+        .zip(&ex.scene.surfaces)
+        .zip(&ex.surface_colour)
+    {
         for &i in group {
             let s = &got.surfaces[i];
             assert_eq!(s.reflectance.0, [0.0; 3], "{}", s.name);

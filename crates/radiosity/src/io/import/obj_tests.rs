@@ -293,7 +293,10 @@ fn exported_obj_reads_back_with_its_meshing_settings() {
     )
     .unwrap();
     let area = scaled.file.settings.max_patch_area;
-    assert!((area - 1234.5e-6).abs() <= 1e-15 * 1234.5e-6 * 4.0, "{area}");
+    assert!(
+        (area - 1234.5e-6).abs() <= 1e-15 * 1234.5e-6 * 4.0,
+        "{area}"
+    );
     assert_eq!(scaled.file.settings.integral_steps, 3);
     // Given settings win over the file's.
     let given = crate::MeshSettings {

@@ -452,9 +452,12 @@ fn coplanar_adjacent_faces_of_one_object_are_joined_before_meshing() {
 #[test]
 fn faces_of_two_objects_or_two_materials_or_a_bend_stay_apart() {
     // Two objects.
-    let (scene, _) = soup(&unit_square(), &[("A", &[&[0, 1, 2]]), ("B", &[&[0, 2, 3]])])
-        .to_scene(1.0)
-        .unwrap();
+    let (scene, _) = soup(
+        &unit_square(),
+        &[("A", &[&[0, 1, 2]]), ("B", &[&[0, 2, 3]])],
+    )
+    .to_scene(1.0)
+    .unwrap();
     assert_eq!(scene.surfaces.len(), 2);
     // Two materials.
     let mut s = soup(&unit_square(), &[("A", &[&[0, 1, 2], &[0, 2, 3]])]);
