@@ -288,6 +288,7 @@ pub fn check(
 ) {
     let scene = &prepared.scene;
     outln!("scene             {stem}");
+    outln!("unit              {}", crate::setup::scene_unit());
     outln!("surfaces          {}", scene.surfaces.len());
     outln!("elements          {}", solution.mesh.len());
     outln!("total area        {:.6}", solution.mesh.total_area());

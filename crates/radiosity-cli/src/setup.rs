@@ -234,6 +234,25 @@ pub fn refuse_overwriting_inputs(output: &Path, inputs: &[(&str, Option<&Path>)]
     Ok(())
 }
 
+/// The length unit of the scene [`load_scene`] read last, in the reader's words (with
+/// `--scale`), for the reports that give lengths or areas.
+static SCENE_UNIT: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// The length unit of the scene read ([`SCENE_UNIT`]); `scene units` before one is read.
+pub fn scene_unit() -> String {
+    SCENE_UNIT
+        .lock()
+        .ok()
+        .and_then(|u| u.clone())
+        .unwrap_or_else(|| "scene units".to_string())
+}
+
+fn note_unit(unit: &str) {
+    if let Ok(mut u) = SCENE_UNIT.lock() {
+        *u = Some(unit.to_string());
+    }
+}
+
 /// The scene file at `path` (any format [`radiosity::io::import`] reads, by extension; every
 /// coordinate times `scale`), or the built-in Cornell box, with a short name for default
 /// outputs ("cornell", or the file's stem). The reader's warnings are printed (even with
@@ -250,6 +269,7 @@ pub fn load_scene(
                     "--scale applies to a scene file; the built-in Cornell box is in millimetres"
                 );
             }
+            note_unit("millimetres (the built-in Cornell box)");
             Ok((
                 run_stage(reporter, Stage::Parse, 0, scene::cornell_box),
                 "cornell".to_string(),
@@ -270,6 +290,7 @@ pub fn load_scene(
                 imported.format,
                 imported.unit
             ));
+            note_unit(&imported.unit);
             if let Some(w) = far_from_origin(&imported.file.scene) {
                 errln!("{}: warning: {w}", path.display());
             }

@@ -614,7 +614,8 @@ impl ViewerApp {
                     self.colours_dirty = true;
                 }
                 if self.colours_dirty {
-                    let vertex_b = shade::vertex_radiosity(mesh, &self.element_b);
+                    let mut vertex_b = shade::vertex_radiosity(mesh, &self.element_b);
+                    shade::smooth_objects(&self.modeller.scene, mesh, &mut vertex_b);
                     let colours = colour_vertices(mesh, &self.element_b, &vertex_b);
                     gpu.renderer.set_colours(&rs.device, &rs.queue, &colours);
                     self.colours_dirty = false;

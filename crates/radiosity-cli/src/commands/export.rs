@@ -64,7 +64,9 @@ pub fn run(args: ExportArgs) -> Result<()> {
     let b = solution.element_rgb();
     let scale = args.exposure.scale(&prepared.scene, &solution.mesh, b);
     let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(&solution.mesh, b)
+        let mut vertex_b = shade::vertex_radiosity(&solution.mesh, b);
+        shade::smooth_objects(&prepared.scene, &solution.mesh, &mut vertex_b);
+        vertex_b
     });
     let bake = Bake {
         scene: &prepared.scene,

@@ -49,9 +49,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     });
     write(&args, &points, &lux)?;
     reporter.note(&format!(
-        "wrote {} ({} points; lux = lm/m^2 with scene lengths in metres)",
+        "wrote {} ({} points; lux = lm/m^2 with scene lengths in metres; the scene's unit: {})",
         args.output.display(),
-        points.len()
+        points.len(),
+        crate::setup::scene_unit()
     ));
     if let (Some(png), Some(dims)) = (&args.png, dims) {
         let totals: Vec<f64> = lux.iter().map(|l| l.total).collect();

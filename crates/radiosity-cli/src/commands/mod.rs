@@ -141,7 +141,9 @@ pub fn shade_and_render(
     reporter: &Reporter,
 ) -> Result<RgbImage, radiosity::render::NonFiniteImage> {
     let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(mesh, element_b)
+        let mut vertex_b = shade::vertex_radiosity(mesh, element_b);
+        shade::smooth_objects(&prepared.scene, mesh, &mut vertex_b);
+        vertex_b
     });
     let settings = RenderSettings {
         exposure_scale,
@@ -163,7 +165,9 @@ pub fn shade_and_render_linear(
     reporter: &Reporter,
 ) -> Result<Option<Vec<[f64; 3]>>, radiosity::render::NonFiniteImage> {
     let vertex_b = run_stage(reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(mesh, element_b)
+        let mut vertex_b = shade::vertex_radiosity(mesh, element_b);
+        shade::smooth_objects(&prepared.scene, mesh, &mut vertex_b);
+        vertex_b
     });
     let renderer = Renderer::for_settings(mesh, &prepared.scene, &settings);
     radiosity::render::render_linear(&renderer, camera, element_b, &vertex_b, &settings, reporter)

@@ -156,7 +156,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     let solution = solve_as_asked(prepared, *solver, &args.solve, &reporter)?;
     let b = solution.element_rgb();
     let vertex_b = run_stage(&reporter, Stage::Shade, 0, || {
-        shade::vertex_radiosity(&solution.mesh, b)
+        let mut vertex_b = shade::vertex_radiosity(&solution.mesh, b);
+        shade::smooth_objects(scene, &solution.mesh, &mut vertex_b);
+        vertex_b
     });
     let render_settings = setup::ray_settings(&args.rays, args.shading);
     let renderer = Renderer::for_settings(&solution.mesh, scene, &render_settings);

@@ -53,13 +53,15 @@ pub fn run(args: SolveArgs) -> Result<()> {
                 &prepared.scene,
                 &solution.mesh,
                 solution.element_rgb(),
+                &crate::setup::scene_unit(),
             )
         })
         .with_context(|| format!("cannot write {}", report.display()))?;
         reporter.note(&format!(
-            "wrote {} ({} surfaces; radiosity in the scene's emission units)",
+            "wrote {} ({} surfaces; radiosity in the scene's emission units; lengths in {})",
             report.display(),
-            prepared.scene.surfaces.len()
+            prepared.scene.surfaces.len(),
+            crate::setup::scene_unit()
         ));
     }
     reporter.print_timings();

@@ -103,6 +103,11 @@ fn solve_writes_csv_with_exact_header_and_one_row_per_element() {
         .and_then(|n| n.parse().ok())
         .expect("check prints the element count");
     assert_eq!(lines.count(), elements);
+    // And the length unit (a .scene file states none).
+    assert!(
+        text.lines().any(|l| l == "unit              scene units"),
+        "{text}"
+    );
 
     // The same solution as JSON.
     let out = radiosity(

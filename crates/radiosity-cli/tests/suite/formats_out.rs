@@ -193,6 +193,11 @@ fn solve_report_has_one_row_per_surface_at_the_closed_form() {
             lines[0].starts_with("# radiosity in the scene's emission units"),
             "{text}"
         );
+        // The length unit, as the reader gives it (a .scene file states none).
+        assert!(
+            lines[0].contains("the scene's unit of length being scene units;"),
+            "{text}"
+        );
         assert_eq!(
             lines[1],
             "surface,area,mean_r,mean_g,mean_b,min_r,min_g,min_b,max_r,max_g,max_b,mean_luminance"

@@ -1,7 +1,7 @@
 //! The per-surface report (`solve --report report.csv`): one row per input surface with its
 //! area and the radiosity over its elements, for a spreadsheet or a lighting check.
 //!
-//! The file starts with one comment line giving the units ([`UNIT_COMMENT`]), then the
+//! The file starts with one comment line giving the units ([`unit_comment`]), then the
 //! header line [`HEADER`] (a contract: scripts key on these names), then one row per
 //! surface of the scene, in scene order:
 //!
@@ -28,10 +28,16 @@ use crate::scene::Scene;
 pub const HEADER: &str =
     "surface,area,mean_r,mean_g,mean_b,min_r,min_g,min_b,max_r,max_g,max_b,mean_luminance";
 
-/// The comment line on top of the file (without its line ending).
-pub const UNIT_COMMENT: &str = "# radiosity in the scene's emission units (W/m^2 or lm/m^2, \
-     as the scene gives E); area in scene units^2; mean over each surface's elements \
-     weighted by area; luminance with Rec. 709 weights";
+/// The comment line on top of the file (without its line ending), `length_unit` the
+/// scene's length unit in words (as the importers give it, e.g. `metres (glTF's unit)`;
+/// `scene units` where none is known).
+pub fn unit_comment(length_unit: &str) -> String {
+    format!(
+        "# radiosity in the scene's emission units (W/m^2 or lm/m^2, as the scene gives E); \
+         area in scene units^2, the scene's unit of length being {length_unit}; mean over \
+         each surface's elements weighted by area; luminance with Rec. 709 weights"
+    )
+}
 
 /// One surface's row.
 #[derive(Clone, Debug, PartialEq)]
@@ -99,8 +105,8 @@ pub fn surface_records(scene: &Scene, mesh: &Mesh, element_b: &[[f64; 3]]) -> Ve
         .collect()
 }
 
-/// Writes the report of `mesh` (cut from `scene`) with radiosities `element_b` to `path`
-/// (module documentation).
+/// Writes the report of `mesh` (cut from `scene`, whose length unit is `length_unit`) with
+/// radiosities `element_b` to `path` (module documentation).
 ///
 /// Returns an `InvalidInput` error, writing nothing, when `element_b` does not have one
 /// entry per element of `mesh`.
@@ -109,6 +115,7 @@ pub fn write_surface_report(
     scene: &Scene,
     mesh: &Mesh,
     element_b: &[[f64; 3]],
+    length_unit: &str,
 ) -> io::Result<()> {
     crate::io::solution::one_per_element(mesh, element_b)?;
     let rows = surface_records(scene, mesh, element_b);
@@ -118,7 +125,7 @@ pub fn write_surface_report(
         })
     };
     crate::io::write_atomically(path, |w| {
-        writeln!(w, "{UNIT_COMMENT}")?;
+        writeln!(w, "{}", unit_comment(length_unit))?;
         writeln!(w, "{HEADER}")?;
         for r in &rows {
             let mut fields = vec![csv_name(&r.surface), r.area.to_string()];
@@ -196,10 +203,15 @@ mod tests {
         ];
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("report.csv");
-        write_surface_report(&path, &scene, &mesh, &b).unwrap();
+        write_surface_report(&path, &scene, &mesh, &b, "metres (glTF's unit)").unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines[0], UNIT_COMMENT);
+        assert!(lines[0].starts_with('#'), "{}", lines[0]);
+        assert!(
+            lines[0].contains("unit of length being metres (glTF's unit);"),
+            "{}",
+            lines[0]
+        );
         assert_eq!(
             lines[1],
             "surface,area,mean_r,mean_g,mean_b,min_r,min_g,min_b,max_r,max_g,max_b,mean_luminance"
@@ -219,7 +231,7 @@ mod tests {
         assert_eq!(lines.len(), 4);
         // A wrong radiosity count is refused, writing nothing.
         let other = dir.path().join("bad.csv");
-        let err = write_surface_report(&other, &scene, &mesh, &b[..3]).unwrap_err();
+        let err = write_surface_report(&other, &scene, &mesh, &b[..3], "m").unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
         assert!(!other.exists());
     }

@@ -19,14 +19,20 @@
 //!   s, how it was chosen and the largest s B before clamping are in
 //!   `asset.extras.radiosity` (`exposureScale`, `exposure`, `maxExposedValue`); where
 //!   `COLOR_0` is below 1, B = `COLOR_0` / s in the scene's emission units;
-//! * one material, white, `KHR_materials_unlit` (declared in `extensionsUsed`), single
-//!   sided as the scene's surfaces are (their backs are black in the solution);
+//! * one material per distinct pair of reflectance and emission (named after the first
+//!   surface with it), white, `KHR_materials_unlit` (declared in `extensionsUsed`), single
+//!   sided as the scene's surfaces are (their backs are black in the solution), so that a
+//!   viewer shows `COLOR_0` as it is; the surfaces' own reflectance and emission (scene
+//!   units, full precision) are in the material's `extras.radiosity` (`reflectance`,
+//!   `emission`), which the glTF reader takes back, so that `export` then import keeps
+//!   the scene's colours, not only its picture (`crate::io::import::gltf`);
 //! * a perspective camera node for the given view (`render`'s camera for the same flags).
 //!
 //! The JSON is written with `serde_json`: the document is one mesh per surface and four
 //! buffer views, small enough that the typed builder of `gltf-json` would add a dependency
 //! tree and no safety that the round-trip test (read back with the `gltf` crate) does not.
 
+use std::collections::HashMap;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -75,6 +81,10 @@ pub fn document(bake: &Bake, uri: Option<&str>) -> (Value, Vec<u8>) {
     let (mut accessors, mut meshes, mut nodes) = (Vec::new(), Vec::new(), Vec::new());
     let mut max_exposed = 0.0f64;
     let mut local = vec![u32::MAX; mesh.vertices.len()];
+    // One material per distinct (reflectance, emission), in first use: white and unlit for
+    // the viewers, the scene's colours in its extras for the way back in.
+    let mut materials: Vec<Value> = Vec::new();
+    let mut material_of: HashMap<[u64; 6], usize> = HashMap::new();
     for (s, surface) in scene.surfaces.iter().enumerate() {
         let Some(elements) = mesh.surface_elements.get(s) else {
             continue;
@@ -127,12 +137,27 @@ pub fn document(bake: &Bake, uri: Option<&str>) -> (Value, Vec<u8>) {
             "bufferView": 2, "byteOffset": first_index * 4, "componentType": UNSIGNED_INT,
             "count": indices.len() - first_index, "type": "SCALAR",
         }));
+        let (r, e) = (surface.reflectance.0, surface.emission.0);
+        let key = [r[0], r[1], r[2], e[0], e[1], e[2]].map(f64::to_bits);
+        let material = *material_of.entry(key).or_insert_with(|| {
+            materials.push(json!({
+                "name": surface.name,
+                "pbrMetallicRoughness": {
+                    "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": 1.0,
+                },
+                "extensions": { "KHR_materials_unlit": {} },
+                "extras": { "radiosity": { "reflectance": r, "emission": e } },
+            }));
+            materials.len() - 1
+        });
         meshes.push(json!({
             "name": surface.name,
             "primitives": [{
                 "attributes": { "POSITION": a, "COLOR_0": a + 1 },
                 "indices": a + 2,
-                "material": 0,
+                "material": material,
                 "mode": 4,
             }],
         }));
@@ -196,15 +221,7 @@ pub fn document(bake: &Bake, uri: Option<&str>) -> (Value, Vec<u8>) {
         "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
         "nodes": nodes,
         "meshes": meshes,
-        "materials": [{
-            "name": "radiosity (unlit, vertex colours)",
-            "pbrMetallicRoughness": {
-                "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
-                "metallicFactor": 0.0,
-                "roughnessFactor": 1.0,
-            },
-            "extensions": { "KHR_materials_unlit": {} },
-        }],
+        "materials": materials,
         "cameras": [{
             "type": "perspective",
             "perspective": {
@@ -221,7 +238,7 @@ pub fn document(bake: &Bake, uri: Option<&str>) -> (Value, Vec<u8>) {
     if bin.is_empty() {
         // No geometry: no buffer (glTF forbids a buffer of length 0).
         let obj = doc.as_object_mut().expect("an object");
-        for key in ["buffers", "bufferViews", "accessors", "meshes"] {
+        for key in ["buffers", "bufferViews", "accessors", "meshes", "materials"] {
             obj.remove(key);
         }
     }

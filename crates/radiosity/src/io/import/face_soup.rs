@@ -2,8 +2,11 @@
 //! into one vertex array, a material per face) into checked scene surfaces. The rules are
 //! in the [parent module's documentation](super).
 
+use std::collections::HashMap;
+
 use glam::DVec3;
 
+use super::merge::join_coplanar_polygons;
 use super::{ImportError, ImportWarning};
 use crate::geometry::{self, PolygonError};
 use crate::io::scene_file::duplicate_surfaces;
@@ -94,8 +97,9 @@ impl FaceSoup {
         let mut degenerate = Vec::new();
         let mut triangulated = (0usize, 0usize);
         let mut lost_pieces = 0usize;
-        for (f, face) in self.faces.iter().enumerate() {
-            let corners = self.corners(f, face, &vertices)?;
+        for (f, joined) in self.joined_faces(&vertices) {
+            let face = &self.faces[f];
+            let corners = self.corners(f, face, joined.as_deref(), &vertices)?;
             let push = |pieces: &mut Vec<Piece>, vertices: Vec<DVec3>| {
                 pieces.push(Piece {
                     object: face.object,
@@ -284,16 +288,81 @@ impl FaceSoup {
         Ok(out)
     }
 
-    /// Face `f`'s corners, with consecutive repeats (the same point twice in a row, also
-    /// last to first) taken out; its indices checked.
+    /// The faces to make surfaces of, in file order, each by its first face: coplanar
+    /// faces of one object and material that share an edge (the same corners, by
+    /// position, run in opposite directions) and together make a flat convex polygon are
+    /// joined into it ([`super::merge`]), so that a quad given as two triangles, or a
+    /// floor given as tiles, meshes as one polygon. `Some(indices)` for a face that
+    /// absorbed others (its outline; indices into `vertices`), `None` for one kept as
+    /// given.
+    fn joined_faces(&self, vertices: &[DVec3]) -> Vec<(usize, Option<Vec<u32>>)> {
+        // One index per position, so faces that repeat their corners (3DFACE) connect.
+        let mut first_at: HashMap<[u64; 3], u32> = HashMap::new();
+        let canonical: Vec<u32> = vertices
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                *first_at
+                    .entry(v.to_array().map(f64::to_bits))
+                    .or_insert(i as u32)
+            })
+            .collect();
+        let mut groups: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+        for (f, face) in self.faces.iter().enumerate() {
+            groups
+                .entry((face.object, face.material))
+                .or_default()
+                .push(f);
+        }
+        let mut out: Vec<(usize, Option<Vec<u32>>)> = Vec::with_capacity(self.faces.len());
+        for faces in groups.values() {
+            if faces.len() == 1 {
+                out.push((faces[0], None));
+                continue;
+            }
+            let polygons: Vec<Vec<u32>> = faces
+                .iter()
+                .map(|&f| {
+                    let face = &self.faces[f];
+                    let range = face.first..face.first.saturating_add(face.count as usize);
+                    self.indices.get(range).map_or_else(Vec::new, |ix| {
+                        ix.iter()
+                            .map(|&i| canonical.get(i as usize).copied().unwrap_or(i))
+                            .collect()
+                    })
+                })
+                .collect();
+            for (k, poly) in join_coplanar_polygons(vertices, polygons) {
+                let f = faces[k];
+                let face = &self.faces[f];
+                let range = face.first..face.first.saturating_add(face.count as usize);
+                // Kept as given (also one whose indices are wrong, for its error).
+                let as_given = self.indices.get(range).is_none_or(|ix| {
+                    ix.len() == poly.len()
+                        && ix
+                            .iter()
+                            .zip(&poly)
+                            .all(|(&b, &a)| canonical.get(b as usize).copied().unwrap_or(b) == a)
+                });
+                out.push((f, (!as_given).then_some(poly)));
+            }
+        }
+        out.sort_unstable_by_key(|(f, _)| *f);
+        out
+    }
+
+    /// Face `f`'s corners (or those of the joined outline `joined`), with consecutive
+    /// repeats (the same point twice in a row, also last to first) taken out; its indices
+    /// checked.
     fn corners(
         &self,
         f: usize,
         face: &SoupFace,
+        joined: Option<&[u32]>,
         vertices: &[DVec3],
     ) -> Result<Vec<DVec3>, ImportError> {
         let range = face.first..face.first.saturating_add(face.count as usize);
-        let Some(indices) = self.indices.get(range) else {
+        let Some(indices) = joined.or_else(|| self.indices.get(range)) else {
             return Err(ImportError::Syntax {
                 file: self.file.clone(),
                 line: face.line,

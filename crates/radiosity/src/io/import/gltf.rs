@@ -22,13 +22,24 @@
 //!   default white) is taken as [`MAX_REFLECTANCE`] with a warning, since the scene
 //!   format needs it below 1. Emission is `emissiveFactor` times
 //!   `KHR_materials_emissive_strength` (1 without it), taken as the exitance in the
-//!   scene's emission units, as OBJ's `Ke` is.
+//!   scene's emission units, as OBJ's `Ke` is;
+//! * a material with `extras.radiosity` (`reflectance` and `emission`, three numbers
+//!   each, as `radiosity export` writes them) has exactly those, and nothing above is
+//!   read for it: an exported scene read back has its own colours and lights;
+//! * an unlit material (`KHR_materials_unlit`) without them holds baked light, not a
+//!   reflectance: what it shows is what it sends out. It is taken as an emitter that
+//!   reflects nothing, its emission the base colour (times the texture mean) times the
+//!   mean of the primitive's `COLOR_0` (over the vertices its triangles use; floats or
+//!   normalized bytes or shorts), divided by the exposure the file says it applied
+//!   (`asset.extras.radiosity.exposureScale` of a radiosity export; 1 in other files),
+//!   so that solving it gives back the light it shows, a primitive's mean for each
+//!   primitive (colours clamped at 1 when baked, such as lights, stay clamped).
 //!
 //! Each node with a mesh is one object: its surfaces are named after the node (or its
 //! mesh, or `node N`). Unit: metres, glTF's unit, times [`super::ImportOptions::scale`].
 //!
 //! Ignored: cameras and lights (`KHR_lights_punctual`), normals, UVs beyond the texture
-//! mean, vertex colours, the emissive texture, metallic-roughness, alpha and
+//! mean, vertex colours on lit materials, the emissive texture, metallic-roughness, alpha and
 //! `doubleSided` (every surface is one-sided: it reflects on its front only), morph
 //! targets and skins, animations. Sparse accessors and quantized positions
 //! (`KHR_mesh_quantization`) are refused with an error.
@@ -83,6 +94,9 @@ pub fn parse(
         dir,
         warnings: Vec::new(),
         buffers: Vec::new(),
+        baked: Vec::new(),
+        exposure_scale: 1.0,
+        derived: Vec::new(),
     };
     let (soup, format) = reader.soup(bytes)?;
     let (scene, mut warnings) = soup.to_scene(options.scale)?;
@@ -103,7 +117,20 @@ struct Reader<'a> {
     warnings: Vec<ImportWarning>,
     /// Every buffer's bytes, in the document's order.
     buffers: Vec<Vec<u8>>,
+    /// Per material of the file: `Some(colour)` where it is unlit without the scene's own
+    /// colours (`extras.radiosity`), so that it is taken as baked light: its emission
+    /// before a primitive's `COLOR_0` mean multiplies it.
+    baked: Vec<Option<[f64; 3]>>,
+    /// The exposure a radiosity export applied (`asset.extras.radiosity.exposureScale`),
+    /// 1 in other files.
+    exposure_scale: f64,
+    /// Materials made for single primitives (baked light times their `COLOR_0` mean),
+    /// numbered [`DERIVED`] + k in the faces until they are placed after the file's own.
+    derived: Vec<SoupMaterial>,
 }
+
+/// The bit that marks a face's material as one of [`Reader::derived`] during the walk.
+const DERIVED: u32 = 1 << 31;
 
 /// What counts warn about, summed over the file.
 #[derive(Default)]
@@ -155,6 +182,7 @@ impl Reader<'_> {
             file: self.file.clone(),
             ..FaceSoup::default()
         };
+        self.exposure_scale = exposure_scale(doc);
         let materials: Vec<SoupMaterial> = doc
             .materials()
             .map(|m| self.material(doc, &m))
@@ -223,6 +251,13 @@ impl Reader<'_> {
         if default_used {
             soup.materials.push(self.default_material());
         }
+        let first_derived = soup.materials.len() as u32;
+        for face in &mut soup.faces {
+            if face.material & DERIVED != 0 {
+                face.material = first_derived + (face.material & !DERIVED);
+            }
+        }
+        soup.materials.append(&mut self.derived);
         if counts.converted > 0 {
             self.warn(format!(
                 "{} triangle strip or fan primitive{} converted to triangles",
@@ -393,6 +428,15 @@ impl Reader<'_> {
             || format!("material {}", m.index().unwrap_or(0)),
             str::to_string,
         );
+        if let Some((reflectance, emission)) = self.scene_colours(&name, m)? {
+            self.baked.push(None);
+            return Ok(SoupMaterial {
+                name,
+                reflectance: Rgb(reflectance),
+                emission: Rgb(emission),
+                defined_at: None,
+            });
+        }
         let pbr = m.pbr_metallic_roughness();
         let factor = pbr.base_color_factor();
         let mut reflectance = [0.0; 3];
@@ -412,6 +456,19 @@ impl Reader<'_> {
                 )),
             }
         }
+        if m.unlit() {
+            // Baked light: what the surface shows is what it sends out.
+            let s = self.exposure_scale;
+            let emission = reflectance.map(|c| c / s);
+            self.baked.push(Some(emission));
+            return Ok(SoupMaterial {
+                name,
+                reflectance: Rgb([0.0; 3]),
+                emission: Rgb(emission),
+                defined_at: None,
+            });
+        }
+        self.baked.push(None);
         if reflectance.iter().any(|&r| r >= 1.0) {
             self.warn(format!(
                 "material \"{name}\": a base colour of 1 or more is taken as reflectance \
@@ -429,6 +486,104 @@ impl Reader<'_> {
             emission: Rgb(emission),
             defined_at: None,
         })
+    }
+
+    /// The scene's own reflectance and emission where a radiosity export wrote them in the
+    /// material's `extras.radiosity`; `None` where the material has no such extras.
+    #[allow(clippy::type_complexity)]
+    fn scene_colours(
+        &self,
+        name: &str,
+        m: &gltf::Material,
+    ) -> Result<Option<([f64; 3], [f64; 3])>, ImportError> {
+        let Some(raw) = m.extras() else {
+            return Ok(None);
+        };
+        let Ok(extras) = serde_json::from_str::<serde_json::Value>(raw.get()) else {
+            return Ok(None);
+        };
+        let Some(colours) = extras.get("radiosity") else {
+            return Ok(None);
+        };
+        let band = |key: &str| -> Result<[f64; 3], ImportError> {
+            let value = &colours[key];
+            let numbers: Option<Vec<f64>> = value
+                .as_array()
+                .map(|a| a.iter().map(serde_json::Value::as_f64).collect())
+                .and_then(|v: Option<Vec<f64>>| v);
+            match numbers.as_deref() {
+                Some(&[r, g, b]) => Ok([r, g, b]),
+                _ => Err(self.error(format!(
+                    "material \"{name}\": extras.radiosity.{key} must be three numbers (red, \
+                     green, blue), as `radiosity export` writes it; found {value}"
+                ))),
+            }
+        };
+        Ok(Some((band("reflectance")?, band("emission")?)))
+    }
+
+    /// The mean of a primitive's `COLOR_0` over the vertices its triangles use (RGB; alpha
+    /// ignored), or `None` where it has none. Floats, and normalized unsigned bytes and
+    /// shorts, as the specification allows.
+    fn colour_mean(
+        &self,
+        prim: &gltf::Primitive,
+        place: &str,
+        used: &[bool],
+    ) -> Result<Option<[f64; 3]>, ImportError> {
+        let Some(acc) = prim.get(&gltf::Semantic::Colors(0)) else {
+            return Ok(None);
+        };
+        let components = match acc.dimensions() {
+            gltf::accessor::Dimensions::Vec3 => 3,
+            gltf::accessor::Dimensions::Vec4 => 4,
+            other => {
+                return Err(self.error(format!(
+                    "{place}: COLOR_0 (accessor {}) must be VEC3 or VEC4, found {other:?}",
+                    acc.index()
+                )))
+            }
+        };
+        let (size, read): (usize, fn(&[u8]) -> f64) = match acc.data_type() {
+            gltf::accessor::DataType::F32 => (4, |b| f32_at(b, 0)),
+            gltf::accessor::DataType::U8 => (1, |b| f64::from(b[0]) / 255.0),
+            gltf::accessor::DataType::U16 => {
+                (2, |b| f64::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0)
+            }
+            other => {
+                return Err(self.error(format!(
+                    "{place}: COLOR_0 (accessor {}) must be floats or normalized unsigned \
+                     bytes or shorts, found {other:?}",
+                    acc.index()
+                )))
+            }
+        };
+        let elements = self.accessor_elements(&acc, size * components, "COLOR_0")?;
+        if elements.len() < used.len() {
+            return Err(self.error(format!(
+                "{place}: COLOR_0 (accessor {}) has {} values for {} positions",
+                acc.index(),
+                elements.len(),
+                used.len()
+            )));
+        }
+        let (mut sum, mut n) = ([0.0f64; 3], 0usize);
+        for (e, _) in elements.iter().zip(used).filter(|(_, &u)| u) {
+            for (k, s) in sum.iter_mut().enumerate() {
+                let c = read(&e[k * size..]);
+                if !c.is_finite() {
+                    return Err(ImportError::NotFinite {
+                        file: self.file.clone(),
+                        line: 0,
+                        element: format!("{place}, COLOR_0"),
+                        value: c,
+                    });
+                }
+                *s += c;
+            }
+            n += 1;
+        }
+        Ok((n > 0).then(|| sum.map(|s| s / n as f64)))
     }
 
     /// The mean linear colour of a texture's image, or why it cannot be had. The image is
@@ -546,7 +701,7 @@ impl Reader<'_> {
     /// One primitive's triangles into the soup; returns how many.
     #[allow(clippy::too_many_arguments)]
     fn primitive(
-        &self,
+        &mut self,
         prim: &gltf::Primitive,
         node: &gltf::Node,
         global: &DMat4,
@@ -701,6 +856,23 @@ impl Reader<'_> {
             }
         }
         let n = triangles.len();
+        let mut material = material;
+        if let Some(&Some(emission)) = self.baked.get(material as usize) {
+            // Baked light with vertex colours: the colours' mean multiplies the material's
+            // emission, for this primitive alone (a material of its own).
+            let used: Vec<bool> = remap.iter().map(|&r| r != u32::MAX).collect();
+            if let Some(mean) = self.colour_mean(prim, &place, &used)? {
+                let base = &soup.materials[material as usize];
+                let derived = SoupMaterial {
+                    name: format!("{} ({place})", base.name),
+                    reflectance: base.reflectance,
+                    emission: Rgb([0, 1, 2].map(|k| emission[k] * mean[k])),
+                    defined_at: None,
+                };
+                material = DERIVED | self.derived.len() as u32;
+                self.derived.push(derived);
+            }
+        }
         for poly in join_coplanar(&points, &triangles) {
             soup.faces.push(SoupFace {
                 object,
@@ -714,6 +886,19 @@ impl Reader<'_> {
         soup.vertices.extend(points);
         Ok(n)
     }
+}
+
+/// The exposure scale a radiosity export applied to its `COLOR_0`
+/// (`asset.extras.radiosity.exposureScale`, finite and positive), else 1.
+fn exposure_scale(doc: &gltf::Document) -> f64 {
+    doc.as_json()
+        .asset
+        .extras
+        .as_ref()
+        .and_then(|raw| serde_json::from_str::<serde_json::Value>(raw.get()).ok())
+        .and_then(|v| v["radiosity"]["exposureScale"].as_f64())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .unwrap_or(1.0)
 }
 
 /// How many triangles the nodes under `roots` ask for, from their accessors' counts,

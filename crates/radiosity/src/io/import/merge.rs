@@ -27,24 +27,51 @@ const COPLANAR: f64 = 1e-6;
 /// the order of their first triangle. Triangles with a repeated index are passed through
 /// alone.
 pub(crate) fn join_coplanar(points: &[DVec3], triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
+    let polygons: Vec<Vec<u32>> = triangles.iter().map(|t| t.to_vec()).collect();
+    join_coplanar_polygons(points, polygons)
+        .into_iter()
+        .map(|(_, p)| p)
+        .collect()
+}
+
+/// [`join_coplanar`] for polygons of any size: a polygon of more than three corners takes
+/// part only if it is itself a usable flat convex polygon (others, to be triangulated
+/// later, and those with a repeated or out-of-range index pass through alone). Each
+/// polygon comes with the index of the input polygon it grew from.
+pub(crate) fn join_coplanar_polygons(
+    points: &[DVec3],
+    polygons: Vec<Vec<u32>>,
+) -> Vec<(usize, Vec<u32>)> {
+    let mut polygons = polygons;
     let mut alive = vec![true; polygons.len()];
-    let joinable = |t: &[u32; 3]| {
-        t[0] != t[1]
-            && t[1] != t[2]
-            && t[0] != t[2]
-            && t.iter().all(|&i| (i as usize) < points.len())
-    };
+    let joinable: Vec<bool> = polygons
+        .iter()
+        .map(|t| {
+            if t.len() < 3
+                || t.len() > MAX_CORNERS
+                || !t.iter().all(|&i| (i as usize) < points.len())
+            {
+                return false;
+            }
+            let mut sorted = t.clone();
+            sorted.sort_unstable();
+            if sorted.windows(2).any(|w| w[0] == w[1]) {
+                return false;
+            }
+            t.len() == 3 || acceptable(points, t)
+        })
+        .collect();
     let mut edges: HashMap<(u32, u32), usize> = HashMap::new();
-    for (p, t) in triangles.iter().enumerate() {
-        if joinable(t) {
-            for k in 0..3 {
-                edges.insert((t[k], t[(k + 1) % 3]), p);
+    for (p, t) in polygons.iter().enumerate() {
+        if joinable[p] {
+            let n = t.len();
+            for k in 0..n {
+                edges.insert((t[k], t[(k + 1) % n]), p);
             }
         }
     }
     for p in 0..polygons.len() {
-        if !joinable(&triangles[p]) {
+        if !joinable[p] {
             continue;
         }
         'grow: loop {
@@ -80,7 +107,8 @@ pub(crate) fn join_coplanar(points: &[DVec3], triangles: &[[u32; 3]]) -> Vec<Vec
     polygons
         .into_iter()
         .zip(alive)
-        .filter_map(|(poly, a)| a.then_some(poly))
+        .enumerate()
+        .filter_map(|(i, (poly, a))| a.then_some((i, poly)))
         .collect()
 }
 

@@ -28,6 +28,15 @@
 //! OBJ states no unit: the numbers are taken as metres, times
 //! [`ImportOptions::scale`](super::ImportOptions::scale).
 //!
+//! # Meshing settings
+//!
+//! OBJ has no place for them; `radiosity export -o out.obj` writes the scene's as comment
+//! lines `# MAX_PATCH_AREA a` and `# INTEGRAL_STEPS n`, and this reader takes them back
+//! (a comment with exactly that keyword first and one valid value; `a` in the file's
+//! units squared, so scaled with the coordinates), so that scene -> OBJ -> scene keeps
+//! the meshing. A setting the file does not give is [`super::default_settings`]'s, and
+//! [`ImportOptions::settings`](super::ImportOptions::settings) overrides both.
+//!
 //! # Why not the `tobj` crate
 //!
 //! tobj 4.0 (MIT) was looked at first: its `LoadError` (e.g. "face vertex index out of
@@ -48,6 +57,7 @@ use super::{
 };
 use crate::io::scene_file::SceneFile;
 use crate::light::Rgb;
+use crate::mesh::MeshSettings;
 
 /// The reflectance of a face without a material, or whose material is missing.
 pub const DEFAULT_REFLECTANCE: f64 = 0.5;
@@ -106,6 +116,8 @@ pub fn parse(
         warnings: Vec::new(),
         ignored: HashMap::new(),
         missing: Vec::new(),
+        max_patch_area: None,
+        integral_steps: None,
     };
     for (i, raw) in text.lines().enumerate() {
         reader.line(i + 1, raw, load_mtl)?;
@@ -115,6 +127,8 @@ pub fn parse(
         mut warnings,
         ignored,
         missing,
+        max_patch_area,
+        integral_steps,
         ..
     } = reader;
     if soup.faces.is_empty() {
@@ -153,7 +167,18 @@ pub fn parse(
         });
     }
     warnings.extend(more);
-    let settings = options.settings.unwrap_or_else(|| default_settings(&scene));
+    let settings = options.settings.unwrap_or_else(|| {
+        let defaults = default_settings(&scene);
+        MeshSettings {
+            // In the file's units, as the scene file's: scaled with the coordinates.
+            // (A product that leaves the f64 range falls back to the default.)
+            max_patch_area: max_patch_area
+                .map(|a| a * options.scale * options.scale)
+                .filter(|a| *a > 0.0 && a.is_finite())
+                .unwrap_or(defaults.max_patch_area),
+            integral_steps: integral_steps.unwrap_or(defaults.integral_steps),
+        }
+    });
     Ok(Imported {
         file: SceneFile { settings, scene },
         warnings,
@@ -186,6 +211,9 @@ struct Reader {
     ignored: HashMap<String, usize>,
     /// `usemtl` names no MTL file defines, with the first line naming each.
     missing: Vec<(String, usize)>,
+    /// The meshing settings in `# MAX_PATCH_AREA a` and `# INTEGRAL_STEPS n` comments.
+    max_patch_area: Option<f64>,
+    integral_steps: Option<u32>,
 }
 
 /// Statements read silently for what they are: ignored by design (see the module
@@ -193,6 +221,41 @@ struct Reader {
 const QUIET: [&str; 4] = ["vt", "vn", "s", "vp"];
 
 impl Reader {
+    /// A comment line `# MAX_PATCH_AREA a` or `# INTEGRAL_STEPS n` (as `radiosity export
+    /// -o out.obj` writes them) gives that meshing setting; a value that is not one is left
+    /// out with a warning (it is a comment: the file is still good OBJ). Other comments
+    /// are comments.
+    fn setting_comment(&mut self, n: usize, comment: &str) {
+        let mut words = comment.split_whitespace();
+        let (key, value) = (words.next(), words.next());
+        let extra = words.next().is_some();
+        let problem = match key {
+            Some("MAX_PATCH_AREA") => match value.and_then(|v| v.parse::<f64>().ok()) {
+                Some(a) if a > 0.0 && a.is_finite() && !extra => {
+                    self.max_patch_area = Some(a);
+                    return;
+                }
+                _ => "MAX_PATCH_AREA needs one number greater than 0 (e.g. \"# MAX_PATCH_AREA 1000\")",
+            },
+            Some("INTEGRAL_STEPS") => match value.and_then(|v| v.parse::<u32>().ok()) {
+                Some(k) if k >= 1 && !extra => {
+                    self.integral_steps = Some(k);
+                    return;
+                }
+                _ => "INTEGRAL_STEPS needs one whole number of at least 1 (e.g. \"# INTEGRAL_STEPS 2\")",
+            },
+            _ => return,
+        };
+        self.warnings.push(ImportWarning {
+            file: self.soup.file.clone(),
+            line: n,
+            message: format!(
+                "the comment \"#{}\" is left out: {problem}; the default is used",
+                comment.trim_end()
+            ),
+        });
+    }
+
     fn syntax(&self, line: usize, message: String) -> ImportError {
         ImportError::Syntax {
             file: self.soup.file.clone(),
@@ -202,6 +265,10 @@ impl Reader {
     }
 
     fn line(&mut self, n: usize, raw: &str, load_mtl: &mut MtlLoader) -> Result<(), ImportError> {
+        if let Some(comment) = raw.trim_start().strip_prefix('#') {
+            self.setting_comment(n, comment);
+            return Ok(());
+        }
         let code = raw.split('#').next().unwrap_or("");
         let mut words = code.split_whitespace();
         let Some(key) = words.next() else {

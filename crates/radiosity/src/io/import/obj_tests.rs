@@ -267,3 +267,67 @@ fn object_and_group_names_name_surfaces() {
     // The two `o Table` runs are one object; the group is its own.
     assert_eq!(names, ["Table.0", "Table top", "Table.1"]);
 }
+
+#[test]
+fn exported_obj_reads_back_with_its_meshing_settings() {
+    let scene_file = read_scene(&repo("examples/cornell_box.scene")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box.obj");
+    // Settings that are not the importer's defaults (total area / 1000 and 2 steps).
+    let settings = crate::MeshSettings {
+        max_patch_area: 1234.5,
+        integral_steps: 3,
+    };
+    crate::io::export::obj::write_obj(&path, &scene_file.scene, Some(settings)).unwrap();
+    let back = read_any_scene(&path, &ImportOptions::default()).unwrap();
+    assert!(back.warnings.is_empty(), "{:?}", back.warnings);
+    assert_eq!(back.file.settings, settings);
+    // Scaled, the area is in the new units as the coordinates are: 1234.5 mm^2 read
+    // with --scale 0.001 is 1234.5e-6 m^2 (to f64 rounding of the product).
+    let scaled = read_any_scene(
+        &path,
+        &ImportOptions {
+            scale: 0.001,
+            settings: None,
+        },
+    )
+    .unwrap();
+    let area = scaled.file.settings.max_patch_area;
+    assert!(
+        (area - 1234.5e-6).abs() <= 1e-15 * 1234.5e-6 * 4.0,
+        "{area}"
+    );
+    assert_eq!(scaled.file.settings.integral_steps, 3);
+    // Given settings win over the file's.
+    let given = crate::MeshSettings {
+        max_patch_area: 10.0,
+        integral_steps: 1,
+    };
+    let overridden = read_any_scene(
+        &path,
+        &ImportOptions {
+            scale: 1.0,
+            settings: Some(given),
+        },
+    )
+    .unwrap();
+    assert_eq!(overridden.file.settings, given);
+}
+
+#[test]
+fn a_bad_setting_comment_is_left_out_with_a_warning_at_its_line() {
+    let obj = format!("# MAX_PATCH_AREA -3\n# INTEGRAL_STEPS 2\n# a comment\n{SQUARE}f 1 2 3 4\n");
+    let imported = read_text(&obj, &[]).unwrap();
+    assert_eq!(imported.warnings.len(), 1, "{:?}", imported.warnings);
+    let w = &imported.warnings[0];
+    assert_eq!(w.line, 1);
+    assert!(
+        w.message
+            .contains("MAX_PATCH_AREA needs one number greater than 0"),
+        "{}",
+        w.message
+    );
+    // The area is the default's (the unit square's area / 1000); the steps the file's.
+    assert_eq!(imported.file.settings.max_patch_area, 1e-3);
+    assert_eq!(imported.file.settings.integral_steps, 2);
+}

@@ -61,9 +61,11 @@ fn planar_convex_face_is_kept_whole_with_its_object_name() {
 
 #[test]
 fn faces_of_one_object_are_numbered_in_file_order() {
+    // The second face leans up from the first's edge (coplanar adjacent faces of one
+    // object would be joined into one).
     let mut v = unit_square();
-    v.push(dvec3(2.0, 0.0, 0.0));
-    v.push(dvec3(2.0, 1.0, 0.0));
+    v.push(dvec3(2.0, 0.0, 1.0));
+    v.push(dvec3(2.0, 1.0, 1.0));
     let (scene, _) = soup(
         &v,
         &[
@@ -422,4 +424,57 @@ fn sliver_that_flattening_makes_degenerate_is_dropped() {
             s.name
         );
     }
+}
+
+#[test]
+fn coplanar_adjacent_faces_of_one_object_are_joined_before_meshing() {
+    // A unit square given as two triangles (the diagonal 0-2 run both ways): one quad,
+    // named after the object alone since it is its only surface.
+    let (scene, warnings) = soup(&unit_square(), &[("Quad", &[&[0, 1, 2], &[0, 2, 3]])])
+        .to_scene(1.0)
+        .unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(scene.surfaces.len(), 1);
+    assert_eq!(scene.surfaces[0].name, "Quad");
+    assert_eq!(scene.surfaces[0].vertices, unit_square());
+
+    // As a DXF gives them: each triangle with its own copies of the corners (found by
+    // position).
+    let mut v = unit_square();
+    v.extend([unit_square()[0], unit_square()[2]]);
+    let (scene, _) = soup(&v, &[("Quad", &[&[0, 1, 2], &[4, 5, 3]])])
+        .to_scene(1.0)
+        .unwrap();
+    assert_eq!(scene.surfaces.len(), 1);
+    assert!((crate::geometry::polygon_area(&scene.surfaces[0].vertices) - 1.0).abs() < 1e-15);
+}
+
+#[test]
+fn faces_of_two_objects_or_two_materials_or_a_bend_stay_apart() {
+    // Two objects.
+    let (scene, _) = soup(
+        &unit_square(),
+        &[("A", &[&[0, 1, 2]]), ("B", &[&[0, 2, 3]])],
+    )
+    .to_scene(1.0)
+    .unwrap();
+    assert_eq!(scene.surfaces.len(), 2);
+    // Two materials.
+    let mut s = soup(&unit_square(), &[("A", &[&[0, 1, 2], &[0, 2, 3]])]);
+    s.materials.push(SoupMaterial {
+        name: "red".into(),
+        reflectance: Rgb([0.6, 0.1, 0.1]),
+        ..GREY
+    });
+    s.faces[1].material = 1;
+    let (scene, _) = s.to_scene(1.0).unwrap();
+    assert_eq!(scene.surfaces.len(), 2);
+    assert_eq!(scene.surfaces[1].reflectance, Rgb([0.6, 0.1, 0.1]));
+    // A fold of 1 % of the diagonal: two planes.
+    let mut bent = unit_square();
+    bent[3].z = 0.01;
+    let (scene, _) = soup(&bent, &[("A", &[&[0, 1, 2], &[0, 2, 3]])])
+        .to_scene(1.0)
+        .unwrap();
+    assert_eq!(scene.surfaces.len(), 2);
 }
