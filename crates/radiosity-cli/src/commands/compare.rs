@@ -47,6 +47,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 hint(&e).unwrap_or_default()
             )),
             Ok(()) => {
+                reporter.solving_with(&dense);
                 let start = std::time::Instant::now();
                 let exact = pipeline::solve(
                     &prepared,
@@ -55,7 +56,6 @@ pub fn run(args: CompareArgs) -> Result<()> {
                     &reporter,
                 )?;
                 let seconds = start.elapsed().as_secs_f64();
-                let n = prepared.mesh.len() as u64;
                 let emission = prepared.light.emission();
                 let difference = radiosity::compare::compare(
                     &prepared.mesh,
@@ -66,7 +66,9 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 )?;
                 reference = Some(Reference {
                     seconds,
-                    matrix_bytes: 4 * n * n,
+                    matrix_bytes: radiosity::form_factor::FormFactorMatrix::bytes_for(
+                        prepared.mesh.len(),
+                    ),
                     difference,
                 });
             }
