@@ -232,8 +232,7 @@ fn escaped_meaning(percent: f64) -> String {
 
 /// Where light that reaches no element goes: one wording for the energy note, `check`'s
 /// energy line and its list of surfaces (QA of issue #16: they said it three ways).
-const ESCAPED: &str = "through openings, into gaps and contacts or the backs of faces, where \
-                       the form factors' rows sum below 1";
+const ESCAPED: &str = "through openings, into gaps and contacts or onto the backs of faces";
 
 /// What a row of form factors above 1 does, in the same places.
 const COUNTED_TWICE: &str = "light counted twice where the form factors' rows sum above 1 \
@@ -322,8 +321,9 @@ pub fn check(
             radiosity::mesh::CONTACT_MAX_ELEMENTS
         );
     } else {
+        // One wording with hierarchical radiosity's "leaf contacts" below (QA of issue #16).
         outln!(
-            "contacts          {} elements split, {} dropped, {:.6} buried area left out (of the grid's elements)",
+            "contacts          {} elements split, {} dropped whole; buried and left out: {:.4e} area (of the grid's elements)",
             contacts.split,
             contacts.dropped,
             contacts.buried_area
@@ -399,10 +399,13 @@ pub fn check(
                 report.elapsed.as_secs_f64()
             );
             if report.contacts_skipped {
-                outln!("leaf contacts     not refined (more elements than the contact refinement takes)");
+                outln!(
+                    "leaf contacts     not refined: more than {} elements",
+                    radiosity::mesh::CONTACT_MAX_ELEMENTS
+                );
             } else {
                 outln!(
-                    "leaf contacts     {} buried pieces dropped, {:.4e} area",
+                    "leaf contacts     {} patches (whole cells and pieces) dropped; buried and left out: {:.4e} area",
                     report.buried_patches,
                     report.buried_area
                 );
@@ -452,10 +455,14 @@ pub fn check(
     }
     match (escaped_by_surface, band) {
         (Some(by_surface), Some(k)) => where_escaped(scene, by_surface, b.emitted[k], k),
-        (None, Some(_)) if !matches!(solution.report, SolutionReport::Progressive(_)) => {
+        (None, Some(_)) => {
             outln!(
-                "escaped from      not traced to surfaces: {solver} keeps no form-factor rows \
-                 (a dense solver's `check`, --solver gauss-seidel, lists them)"
+                "escaped from      not traced to surfaces: {} keeps no form-factor rows (a \
+                 dense solver's `check`, --solver gauss-seidel, lists them)",
+                match solution.report {
+                    SolutionReport::Progressive(_) => "progressive refinement",
+                    _ => "hierarchical radiosity",
+                }
             );
         }
         _ => {}
@@ -486,10 +493,10 @@ fn account_error_reason(method: FormFactorMethod, solution: &Solution) -> Option
     match solution.report {
         SolutionReport::Matrix(_) => Some(match not_reciprocal(method) {
             Some(_) => format!(
-                "relative error: the account counts the power reaching each element by the \
-                 other elements' rows, the solve by the element's own row, and with {method} \
-                 they differ (A_i F_ij != A_j F_ji: the reciprocity error above), so the two \
-                 sides of the account differ too"
+                "relative error: {method}'s form factors are not reciprocal (A_i F_ij != A_j \
+                 F_ji, the reciprocity error above); the account counts the power reaching \
+                 each element by the other elements' rows, the solve by the element's own \
+                 row, so its two sides differ"
             ),
             None => "relative error: the form factors are reciprocal, so it is the solve's \
                      residual or rounding of the f32 matrix"
@@ -539,7 +546,8 @@ fn where_escaped(
         .map(|&(share, s)| format!("{:.2} % {}", -100.0 * share, name(s)))
         .collect();
     outln!(
-        "escaped from      {} (of emitted; {ESCAPED})",
+        "escaped from      {} (of emitted, by the surface it left, where its rows of form \
+         factors sum below 1: {ESCAPED})",
         if lost.is_empty() { "no surface".to_string() } else { lost.join(", ") }
     );
     if !twice.is_empty() {

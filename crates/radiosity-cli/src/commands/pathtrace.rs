@@ -75,8 +75,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
         if !ignored.is_empty() {
             errln!(
-                "warning: {} ignored: they set the radiosity solve of --compare; the path \
-                 tracer traces the scene's polygons",
+                "warning: {} ignored without --compare: the path tracer traces the scene's \
+                 polygons (the meshing, form-factor and solver flags set the radiosity solve \
+                 --compare adds)",
                 ignored.join(", ")
             );
         }
