@@ -445,9 +445,9 @@ pub fn check(
     );
     if band.is_some() {
         outln!(
-            "                  ({}: the band emitting most; escaped: {})",
-            BAND_NAMES[k],
-            escaped_meaning(100.0 * b.escaped[k] / b.emitted[k])
+            "                  (escaped: {}; {} is the band emitting most)",
+            escaped_meaning(100.0 * b.escaped[k] / b.emitted[k]),
+            BAND_NAMES[k]
         );
         if let Some(why) = account_error_reason(prepared.method(), solution) {
             outln!("                  ({why})");
