@@ -120,15 +120,46 @@ pub struct MethodArgs {
     // hierarchical radiosity, which ignores the method, warns about any given.
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
-    /// Hemicube resolution: cells across the top face.
-    #[arg(long, default_value_t = 128, value_name = "CELLS")]
+    /// Hemicube resolution: cells across the top face (--method hemicube only).
+    #[arg(long, default_value_t = MethodArgs::RESOLUTION, value_name = "CELLS")]
     pub resolution: u32,
-    /// Monte Carlo rays per element.
-    #[arg(long, default_value_t = 1024, value_name = "N")]
+    /// Monte Carlo rays per element (--method montecarlo only).
+    #[arg(long, default_value_t = MethodArgs::SAMPLES, value_name = "N")]
     pub samples: u32,
-    /// Monte Carlo generator seed (the same seed gives the same numbers).
-    #[arg(long, default_value_t = 1)]
+    /// Monte Carlo generator seed (the same seed gives the same numbers; --method
+    /// montecarlo only).
+    #[arg(long, default_value_t = MethodArgs::SEED)]
     pub seed: u64,
+}
+
+impl MethodArgs {
+    /// `--resolution`'s default.
+    pub const RESOLUTION: u32 = 128;
+    /// `--samples`'s default.
+    pub const SAMPLES: u32 = 1024;
+    /// `--seed`'s default.
+    pub const SEED: u64 = 1;
+
+    /// These flags with those the method does not use at their defaults (what the run
+    /// does; see [`crate::setup::ignored_method_flags`]).
+    pub fn without_unused(&self) -> MethodArgs {
+        let method = self.method.unwrap_or(MethodArg::Area);
+        MethodArgs {
+            method: self.method,
+            resolution: match method {
+                MethodArg::Hemicube => self.resolution,
+                _ => Self::RESOLUTION,
+            },
+            samples: match method {
+                MethodArg::Montecarlo => self.samples,
+                _ => Self::SAMPLES,
+            },
+            seed: match method {
+                MethodArg::Montecarlo => self.seed,
+                _ => Self::SEED,
+            },
+        }
+    }
 }
 
 /// Options of commands that solve.
@@ -235,7 +266,7 @@ impl std::fmt::Display for SolverArg {
     }
 }
 
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ShadingArg {
     /// Vertex radiosities interpolated across elements (paper plate 2).
     Smooth,
@@ -253,6 +284,11 @@ pub enum DirectLightArg {
     Gather,
     /// Interpolated from the mesh with the rest of the light (the paper's smooth shading).
     Mesh,
+}
+
+impl RayArgs {
+    /// `--adaptive-contrast`'s default.
+    pub const ADAPTIVE_CONTRAST: f64 = 0.02;
 }
 
 /// Exposure and gamma: the flags `render` and `pathtrace` share.
@@ -302,10 +338,12 @@ pub struct RayArgs {
     /// 2 is adaptive (see --adaptive-contrast); 1 casts one ray through each pixel centre.
     #[arg(long, default_value_t = 8, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
     pub supersample: u32,
-    /// Adaptive antialiasing: a pixel gets all N x N rays only where its first four see
-    /// different surfaces or luminances apart by more than this fraction of the brightest;
-    /// elsewhere four rays. 0 casts all N x N everywhere.
-    #[arg(long, default_value_t = 0.02, value_name = "FRACTION", value_parser = parse_fraction)]
+    /// Adaptive antialiasing (an even --supersample N above 2, smooth or flat shading): each
+    /// pixel casts four rays first; where they see different surfaces (an object's edge) it
+    /// casts all N x N, where their luminances spread by more than this fraction of the
+    /// brightest of them (a shadow edge) N/2 x N/2, elsewhere the four are the pixel. 0
+    /// casts all N x N everywhere.
+    #[arg(long, default_value_t = RayArgs::ADAPTIVE_CONTRAST, value_name = "FRACTION", value_parser = parse_fraction)]
     pub adaptive_contrast: f64,
     /// Smooth shading's direct light: gathered per ray, or from the mesh.
     #[arg(long, value_enum, default_value_t = DirectLightArg::Gather)]
@@ -335,8 +373,8 @@ pub struct RenderArgs {
     /// --snapshot-every shots (with the ambient term added for display).
     #[arg(long, value_name = "DIR")]
     pub snapshots: Option<PathBuf>,
-    /// Progressive: shots between snapshots.
-    #[arg(long, default_value_t = 10, value_name = "N")]
+    /// Progressive: shots between snapshots (with --snapshots).
+    #[arg(long, default_value_t = RenderArgs::SNAPSHOT_EVERY, value_name = "N")]
     pub snapshot_every: usize,
     /// Draw the illuminance (lux) on the surfaces in false colour, dark blue at 0 to red at
     /// the top of the scale, with a scale bar (values and unit) on the right, instead of
@@ -347,6 +385,11 @@ pub struct RenderArgs {
     /// largest on any element); brighter surfaces take the top colour.
     #[arg(long, value_name = "LUX", requires = "false_colour")]
     pub lux_max: Option<f64>,
+}
+
+impl RenderArgs {
+    /// `--snapshot-every`'s default.
+    pub const SNAPSHOT_EVERY: usize = 10;
 }
 
 #[derive(Args)]
@@ -636,7 +679,8 @@ pub struct ViewArgs {
     /// Triangles of the large frame-time scene (0 skips it).
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     pub bench_triangles: usize,
-    /// Element counts for edit-to-picture timing (comma-separated).
+    /// Element counts for edit-to-picture timing (comma-separated): the Cornell box is
+    /// meshed to about each (the table gives the count reached).
     #[arg(
         long,
         value_delimiter = ',',

@@ -49,6 +49,7 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
                 Some("; use fewer steps (--steps) or larger elements (--max-area)".into())
             }
             PipelineError::FormFactorFile(e) => hint(e),
+            PipelineError::FormFactorsForAnotherMesh { source, .. } => hint(source),
             PipelineError::TooMuchWork(e) => hint(e),
             PipelineError::FormFactorsUnused { .. } => {
                 Some(" (--form-factors applies to --solver gauss-seidel and lu only)".into())
@@ -197,6 +198,8 @@ mod tests {
         let recompute = "; recompute it with `radiosity formfactors`";
         let stale = FormFactorFileError::Stale {
             path: path.clone(),
+            elements: 10,
+            method: "area k=2".into(),
             found: 1,
             expected: 2,
         };

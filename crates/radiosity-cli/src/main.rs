@@ -47,7 +47,9 @@ enum Command {
     /// reciprocity, energy balance and stage times.
     Check(CheckArgs),
     /// Time the whole pipeline (parse, mesh, BVH, form factors, solve, shade, render) and
-    /// print one Markdown table row per MAX_PATCH_AREA with the median time of each stage.
+    /// print one Markdown table row per MAX_PATCH_AREA with the median time of each stage;
+    /// "other" is the end-to-end time less those stages (contact refinement, the memory
+    /// and work checks, the exposure, and the renderer's own BVH built before the render).
     Bench(BenchArgs),
     /// Solve a scene with one solver and with the dense reference (Gauss-Seidel on the
     /// form factors of --method and --steps; for a reference more accurate than the default

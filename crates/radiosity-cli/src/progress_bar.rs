@@ -18,12 +18,59 @@ struct Ticker {
     thread: std::thread::JoinHandle<()>,
 }
 
+/// What a stage of unknown length counts, and why it gives no time left: a solver that
+/// stops when it has converged cannot say in advance after how many steps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Counting {
+    /// The steps counted, plural: "sweeps".
+    pub unit: &'static str,
+    /// When the steps end: "it sweeps until the change falls below --tolerance".
+    pub until: &'static str,
+}
+
+impl Counting {
+    /// What the solve stage of `solver` counts; `None` for LU, whose total is known.
+    pub fn solve(solver: &radiosity::solve::Solver) -> Option<Counting> {
+        use radiosity::solve::{DenseSolver, Solver};
+        Some(match solver {
+            Solver::Dense(DenseSolver::GaussSeidel(_)) => Counting {
+                unit: "sweeps",
+                until: "Gauss-Seidel sweeps until the change falls below --tolerance",
+            },
+            Solver::Progressive(_) => Counting {
+                unit: "shots",
+                until: "progressive refinement shoots until the unshot power falls below \
+                        --tolerance",
+            },
+            Solver::Hierarchical(_) => Counting {
+                unit: "refinement rounds",
+                until: "hierarchical radiosity refines until a round changes almost no \
+                        links, then gathers",
+            },
+            _ => return None,
+        })
+    }
+}
+
 /// "form factors: 12.5 % (1250 of 10000) after 30 s, about 3.5 min left", or without a
-/// total "solve: 1250 steps after 30 s".
-pub fn progress_line(stage: &str, done: u64, total: u64, elapsed: Duration) -> String {
+/// total "solve: 1250 steps after 30 s", with what the steps are and why no time left is
+/// given when `counting` says so.
+pub fn progress_line(
+    stage: &str,
+    done: u64,
+    total: u64,
+    elapsed: Duration,
+    counting: Option<Counting>,
+) -> String {
     let secs = elapsed.as_secs_f64();
     if total < 2 {
-        return format!("{stage}: {done} steps after {secs:.0} s");
+        return match counting {
+            Some(c) => format!(
+                "{stage}: {done} {} after {secs:.0} s (no time left can be estimated: {})",
+                c.unit, c.until
+            ),
+            None => format!("{stage}: {done} steps after {secs:.0} s"),
+        };
     }
     let fraction = done as f64 / total as f64;
     let left = if done > 0 {
@@ -56,6 +103,8 @@ pub struct Reporter {
     bar: Mutex<Option<ProgressBar>>,
     timings: Mutex<Vec<(Stage, Duration)>>,
     quiet: bool,
+    /// What the solve stage counts (see [`Reporter::solving_with`]).
+    solve_counting: Mutex<Option<Counting>>,
 }
 
 impl Reporter {
@@ -69,7 +118,54 @@ impl Reporter {
             bar: Mutex::new(None),
             timings: Mutex::new(Vec::new()),
             quiet,
+            solve_counting: Mutex::new(None),
         }
+    }
+
+    /// Progress (bars or lines) unless `quiet`, but no notes or timings: for `check`, which
+    /// prints its own report.
+    pub fn progress_only(quiet: bool) -> Reporter {
+        let terminal = std::io::stderr().is_terminal();
+        Reporter {
+            bars_enabled: !quiet && terminal,
+            lines_enabled: !quiet && !terminal,
+            ..Reporter::new(true)
+        }
+    }
+
+    /// The solve stages from now on are `solver`'s: their progress lines say what they
+    /// count and why they give no time left.
+    pub fn solving_with(&self, solver: &radiosity::solve::Solver) {
+        *self.solve_counting.lock().unwrap() = Counting::solve(solver);
+    }
+
+    /// Stage timings with distinct labels: a stage that ran more than once (the solves of
+    /// adaptive subdivision, the files a command writes) is numbered, "solve #2".
+    pub fn labelled_timings(&self) -> Vec<(String, Duration)> {
+        let timings = self.timings();
+        let mut seen: Vec<(Stage, usize)> = Vec::new();
+        timings
+            .iter()
+            .map(|&(stage, d)| {
+                let runs = timings.iter().filter(|t| t.0 == stage).count();
+                let label = if runs > 1 {
+                    let k = match seen.iter_mut().find(|s| s.0 == stage) {
+                        Some(s) => {
+                            s.1 += 1;
+                            s.1
+                        }
+                        None => {
+                            seen.push((stage, 1));
+                            1
+                        }
+                    };
+                    format!("{} #{k}", stage.name())
+                } else {
+                    stage.name().to_string()
+                };
+                (label, d)
+            })
+            .collect()
     }
 
     /// Stage timings in the order the stages finished.
@@ -92,11 +188,11 @@ impl Reporter {
         if self.quiet {
             return;
         }
-        let timings = self.timings();
+        let timings = self.labelled_timings();
         let total: Duration = timings.iter().map(|t| t.1).sum();
         let parts: Vec<String> = timings
             .iter()
-            .map(|(s, d)| format!("{} {}", s.name(), format_duration(*d)))
+            .map(|(s, d)| format!("{s} {}", format_duration(*d)))
             .collect();
         errln!(
             "timings: {}; total {}",
@@ -114,6 +210,10 @@ impl Reporter {
         let done = Arc::new(AtomicU64::new(0));
         let stop = Arc::new((Mutex::new(false), Condvar::new()));
         let (d, st) = (done.clone(), stop.clone());
+        let counting = match stage {
+            Stage::Solve => *self.solve_counting.lock().unwrap(),
+            _ => None,
+        };
         let started = Instant::now();
         let spawned = std::thread::Builder::new()
             .name("progress".into())
@@ -134,6 +234,7 @@ impl Reporter {
                             d.load(Ordering::Relaxed),
                             total,
                             started.elapsed(),
+                            counting,
                         );
                         errln!("{line}");
                     }
@@ -214,17 +315,62 @@ mod tests {
     fn progress_lines_say_how_far_and_how_long_is_left() {
         // A quarter done after 30 s: 90 s left at the same rate.
         assert_eq!(
-            progress_line("form factors", 250, 1000, Duration::from_secs(30)),
+            progress_line("form factors", 250, 1000, Duration::from_secs(30), None),
             "form factors: 25.0 % (250 of 1000) after 30 s, about 90 s left"
         );
         // 1 % after 60 s: 99 minutes left.
         assert_eq!(
-            progress_line("render", 1, 100, Duration::from_secs(60)),
+            progress_line("render", 1, 100, Duration::from_secs(60), None),
             "render: 1.0 % (1 of 100) after 60 s, about 99.0 min left"
         );
         assert_eq!(
-            progress_line("solve", 17, 0, Duration::from_secs(10)),
+            progress_line("solve", 17, 0, Duration::from_secs(10), None),
             "solve: 17 steps after 10 s"
         );
+    }
+
+    #[test]
+    fn a_solve_of_unknown_length_says_what_it_counts_and_why_no_time_left() {
+        // QA of issue #16: hierarchical radiosity's "solve: 17 steps after 30 s" said
+        // neither what a step is nor why no time left was given.
+        let hierarchical = radiosity::solve::Solver::Hierarchical(
+            radiosity::solve::HierarchicalSettings::defaults_for(1.0),
+        );
+        let line = progress_line(
+            "solve",
+            17,
+            0,
+            Duration::from_secs(30),
+            Counting::solve(&hierarchical),
+        );
+        assert!(
+            line.starts_with("solve: 17 refinement rounds after 30 s (no time left can be estimated: "),
+            "{line}"
+        );
+        // LU knows its total: it gets the percentage and the time left instead.
+        assert_eq!(Counting::solve(&radiosity::solve::Solver::LU), None);
+    }
+
+    #[test]
+    fn checks_reporter_shows_progress_but_no_notes() {
+        // QA of issue #16: `check` reported through a quiet reporter, so its 40 s
+        // form-factor stage on building_small printed no progress at all.
+        let r = Reporter::progress_only(false);
+        assert!(r.bars_enabled || r.lines_enabled);
+        assert!(r.quiet, "its notes are in the report");
+        let q = Reporter::progress_only(true);
+        assert!(!q.bars_enabled && !q.lines_enabled);
+    }
+
+    #[test]
+    fn repeated_stages_get_distinct_labels() {
+        // QA of issue #16: the timings of adaptive subdivision read "solve 1 s, ..., solve
+        // 2 s", of pathtrace --compare "write ..., write ...".
+        let reporter = Reporter::new(true);
+        for stage in [Stage::Parse, Stage::Solve, Stage::Adapt, Stage::Solve, Stage::Write] {
+            reporter.finish(stage, Duration::from_millis(1));
+        }
+        let labels: Vec<String> = reporter.labelled_timings().into_iter().map(|t| t.0).collect();
+        assert_eq!(labels, ["parse", "solve #1", "adapt", "solve #2", "write"]);
     }
 }

@@ -9,7 +9,7 @@ use radiosity::mesh::Mesh;
 use radiosity::pathtrace::{FilmComparison, PathTraceSettings, PathTraced};
 use radiosity::pipeline::{AdaptReport, FormFactorStats, Prepared, Solution, SolutionReport};
 use radiosity::scene::{BuildingParams, Scene};
-use radiosity::solve::{Solver, SolverKind};
+use radiosity::solve::{EnergyBalance, Solver, SolverKind};
 
 use crate::progress_bar::{format_duration, Reporter};
 
@@ -179,22 +179,38 @@ fn over_rows_text(
     ))
 }
 
-/// Notes where the emitted power went (the largest band's share): absorbed, and escaped
-/// (light that reached no element: through openings, into gaps and the backs of faces, or
-/// counted twice where negative), so every solve says how far its light can be trusted.
-/// `check` prints the same account in full and says where the escaped part goes.
+/// The band the energy account is given in, by every command alike: the one that emits
+/// most (the first of equals); `None` when nothing emits.
+pub fn energy_band(b: &EnergyBalance) -> Option<usize> {
+    (0..3)
+        .filter(|&k| b.emitted[k] > 0.0)
+        .max_by(|&x, &y| b.emitted[x].total_cmp(&b.emitted[y]).then(y.cmp(&x)))
+}
+
+/// The bands' names, as the energy account labels them.
+const BAND_NAMES: [&str; 3] = ["R", "G", "B"];
+
+/// Notes where the emitted power went (in the band that emits most, as `check` gives it):
+/// absorbed, and escaped (light that reached no element: through openings, into gaps and
+/// the backs of faces, or counted twice where negative), so every solve says how far its
+/// light can be trusted. `check` prints the same account in full and, for a matrix solve,
+/// says through which surfaces the escaped part goes.
 pub fn energy_note(solution: &Solution, reporter: &Reporter) {
     let b = &solution.balance;
-    let Some(band) = (0..3)
-        .filter(|&k| b.emitted[k] > 0.0)
-        .max_by(|&x, &y| b.emitted[x].total_cmp(&b.emitted[y]))
-    else {
+    let Some(band) = energy_band(b) else {
         return;
     };
     let share = |x: f64| 100.0 * x / b.emitted[band];
     let escaped = share(b.escaped[band]);
+    // Only a matrix solve's rows say through which surfaces the light escapes.
+    let where_ = match solution.report {
+        SolutionReport::Matrix(_) => "; `check` says where",
+        _ => "",
+    };
     let mut text = format!(
-        "energy: of the emitted power {:.2} % absorbed, {:.2} % escaped ({}; `check` says where)",
+        "energy ({}, the band emitting most): of the emitted power {:.2} % absorbed, {:.2} % \
+         escaped ({}{where_})",
+        BAND_NAMES[band],
         share(b.absorbed[band]),
         escaped,
         escaped_meaning(escaped)
@@ -206,14 +222,21 @@ pub fn energy_note(solution: &Solution, reporter: &Reporter) {
 }
 
 /// What an escaped share (percent of the emitted power) means, for the energy notes.
-fn escaped_meaning(percent: f64) -> &'static str {
+fn escaped_meaning(percent: f64) -> String {
     if percent < 0.0 {
-        "negative: rows of form factors summing above 1 made light"
+        format!("negative: {COUNTED_TWICE}")
     } else {
-        "light that reached no element: through openings, into gaps and contacts, or lost to \
-         the form factors' rows summing below 1"
+        format!("light that reached no element: {ESCAPED}")
     }
 }
+
+/// Where light that reaches no element goes: one wording for the energy note, `check`'s
+/// energy line and its list of surfaces (QA of issue #16: they said it three ways).
+const ESCAPED: &str = "through openings, into gaps and contacts or onto the backs of faces";
+
+/// What a row of form factors above 1 does, in the same places.
+const COUNTED_TWICE: &str = "light counted twice where the form factors' rows sum above 1 \
+                             (near pairs' visibility misjudged)";
 
 /// Notes what adaptive subdivision did, round by round.
 pub fn adapt(report: &AdaptReport, reporter: &Reporter) {
@@ -299,8 +322,9 @@ pub fn check(
             radiosity::mesh::CONTACT_MAX_ELEMENTS
         );
     } else {
+        // One wording with hierarchical radiosity's "leaf contacts" below (QA of issue #16).
         outln!(
-            "contacts          {} elements split, {} dropped, {:.6} buried area left out (of the grid's elements)",
+            "contacts          {} elements split, {} dropped whole; buried and left out: {:.4e} area (of the grid's elements)",
             contacts.split,
             contacts.dropped,
             contacts.buried_area
@@ -376,10 +400,13 @@ pub fn check(
                 report.elapsed.as_secs_f64()
             );
             if report.contacts_skipped {
-                outln!("leaf contacts     not refined (more elements than the contact refinement takes)");
+                outln!(
+                    "leaf contacts     not refined: more than {} elements",
+                    radiosity::mesh::CONTACT_MAX_ELEMENTS
+                );
             } else {
                 outln!(
-                    "leaf contacts     {} buried pieces dropped, {:.4e} area",
+                    "leaf contacts     {} patches (whole cells and pieces) dropped; buried and left out: {:.4e} area",
                     report.buried_patches,
                     report.buried_area
                 );
@@ -397,30 +424,49 @@ pub fn check(
         }
     }
     let b = &solution.balance;
+    // The band the other commands' energy note gives (R when nothing emits).
+    let band = energy_band(b);
+    let k = band.unwrap_or(0);
     let share = |x: f64| {
-        if b.emitted[0] > 0.0 {
-            format!(" ({:.2} %)", 100.0 * x / b.emitted[0])
+        if band.is_some() {
+            format!(" ({:.2} %)", 100.0 * x / b.emitted[k])
         } else {
             String::new()
         }
     };
     outln!(
-        "energy (R)        emitted {:.6e} = absorbed {:.6e}{} + escaped {:.6e}{} (relative error {:.1e})",
-        b.emitted[0],
-        b.absorbed[0],
-        share(b.absorbed[0]),
-        b.escaped[0],
-        share(b.escaped[0]),
+        "energy ({})        emitted {:.6e} = absorbed {:.6e}{} + escaped {:.6e}{} (relative error {:.1e})",
+        BAND_NAMES[k],
+        b.emitted[k],
+        b.absorbed[k],
+        share(b.absorbed[k]),
+        b.escaped[k],
+        share(b.escaped[k]),
         b.relative_error()
     );
-    if b.emitted[0] > 0.0 {
+    if band.is_some() {
         outln!(
-            "                  (escaped: {})",
-            escaped_meaning(100.0 * b.escaped[0] / b.emitted[0])
+            "                  (escaped: {}; {} is the band emitting most)",
+            escaped_meaning(100.0 * b.escaped[k] / b.emitted[k]),
+            BAND_NAMES[k]
         );
+        if let Some(why) = account_error_reason(prepared.method(), solution) {
+            outln!("                  ({why})");
+        }
     }
-    if let (Some(by_surface), true) = (escaped_by_surface, b.emitted[0] > 0.0) {
-        where_escaped(scene, by_surface, b.emitted[0]);
+    match (escaped_by_surface, band) {
+        (Some(by_surface), Some(k)) => where_escaped(scene, by_surface, b.emitted[k], k),
+        (None, Some(_)) => {
+            outln!(
+                "escaped from      not traced to surfaces: {} keeps no form-factor rows (a \
+                 dense solver's `check`, --solver gauss-seidel, lists them)",
+                match solution.report {
+                    SolutionReport::Progressive(_) => "progressive refinement",
+                    _ => "hierarchical radiosity",
+                }
+            );
+        }
+        _ => {}
     }
     if let SolutionReport::Progressive(_) = solution.report {
         outln!(
@@ -428,19 +474,54 @@ pub fn check(
         );
     }
     outln!("stage times:");
-    for (stage, d) in reporter.timings() {
-        outln!("  {:<14}{}", stage.name(), format_duration(d));
+    for (stage, d) in reporter.labelled_timings() {
+        outln!("  {:<14}{}", stage, format_duration(d));
     }
 }
 
-/// The surfaces through which most power escapes (red band, as the energy line), or is
+/// Above this relative error the energy account gets its reason beside it.
+const ACCOUNT_ERROR_EXPLAINED: f64 = 1e-3;
+
+/// Why emitted = absorbed + escaped does not hold, where it is off by more than
+/// [`ACCOUNT_ERROR_EXPLAINED`] for a reason known: a matrix solve's account weighs each
+/// element's incoming power by the other elements' rows (A_i B_i F_ij), the solve by its own
+/// row (A_j F_ji B_i), which agree only where the form factors are reciprocal (QA of issue
+/// #16: Monte Carlo's 3.5 % came with no reason).
+fn account_error_reason(method: FormFactorMethod, solution: &Solution) -> Option<String> {
+    if solution.balance.relative_error() <= ACCOUNT_ERROR_EXPLAINED {
+        return None;
+    }
+    match solution.report {
+        SolutionReport::Matrix(_) => Some(match not_reciprocal(method) {
+            Some(_) => format!(
+                "relative error: {method}'s form factors are not reciprocal (A_i F_ij != A_j \
+                 F_ji, the reciprocity error above); the account counts the power reaching \
+                 each element by the other elements' rows, the solve by the element's own \
+                 row, so its two sides differ"
+            ),
+            None => "relative error: the form factors are reciprocal, so it is the solve's \
+                     residual or rounding of the f32 matrix"
+                .to_string(),
+        }),
+        // Progressive: the unshot power, said on its own line; hierarchical: its account
+        // is its own (the leaves' B against their gathered irradiance).
+        SolutionReport::Progressive(_) | SolutionReport::Hierarchical(_) => None,
+    }
+}
+
+/// The surfaces through which most power escapes (in `band`, as the energy line), or is
 /// counted twice where rows sum above 1: the five largest of each sign, as shares of the
 /// emitted power.
-fn where_escaped(scene: &radiosity::scene::Scene, by_surface: &[[f64; 3]], emitted: f64) {
+fn where_escaped(
+    scene: &radiosity::scene::Scene,
+    by_surface: &[[f64; 3]],
+    emitted: f64,
+    band: usize,
+) {
     let mut ranked: Vec<(f64, usize)> = by_surface
         .iter()
         .enumerate()
-        .map(|(s, e)| (e[0] / emitted, s))
+        .map(|(s, e)| (e[band] / emitted, s))
         .filter(|(share, _)| share.abs() >= 1e-4)
         .collect();
     ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
@@ -466,12 +547,13 @@ fn where_escaped(scene: &radiosity::scene::Scene, by_surface: &[[f64; 3]], emitt
         .map(|&(share, s)| format!("{:.2} % {}", -100.0 * share, name(s)))
         .collect();
     outln!(
-        "escaped from      {} (of emitted; rows below 1: light into gaps, openings or the backs of faces)",
+        "escaped from      {} (of emitted, by the surface it left, where its rows of form \
+         factors sum below 1: {ESCAPED})",
         if lost.is_empty() { "no surface".to_string() } else { lost.join(", ") }
     );
     if !twice.is_empty() {
         outln!(
-            "counted twice by  {} (of emitted; rows above 1: near pairs' visibility misjudged)",
+            "counted twice by  {} (of emitted; {COUNTED_TWICE})",
             twice.join(", ")
         );
     }
@@ -568,14 +650,7 @@ pub fn compare(row: &CompareRow) {
     let (time, peak, rms, max, mean) = match &row.reference {
         Some(r) => (
             format!("{:.2}", r.seconds),
-            {
-                let m = r.matrix_bytes as f64 / (1024.0 * 1024.0);
-                if m < 10.0 {
-                    format!("{m:.2}")
-                } else {
-                    format!("{m:.0}")
-                }
-            },
+            radiosity::form_factor::format_mib(r.matrix_bytes),
             format!("{:.2}", 100.0 * r.difference.rms),
             format!("{:.1}", 100.0 * r.difference.max),
             format!("{:+.2}", 100.0 * r.difference.bias),
@@ -605,6 +680,11 @@ fn mib(peak: &Peak) -> String {
     }
 }
 
+/// What the `bench` table's "other" column holds: the work of a run outside the stages it
+/// lists (QA of issue #16: the column was unexplained).
+pub const BENCH_OTHER: &str = "contact refinement, the memory and work checks, the exposure, \
+                               and the renderer's own BVH built before the render";
+
 /// Prints the note (stderr, unless `quiet`) and the header of the `bench` table.
 pub fn bench_header(repeat: usize, size: u32, supersample: u32, solver: SolverKind, quiet: bool) {
     let solver_name = match solver {
@@ -619,7 +699,8 @@ pub fn bench_header(repeat: usize, size: u32, supersample: u32, solver: SolverKi
     };
     if !quiet {
         errln!(
-            "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}",
+            "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}; \
+             other: end to end less the stages listed ({BENCH_OTHER})",
             repeat, size, supersample
         );
     }

@@ -16,7 +16,7 @@ use radiosity::scene::{self, Scene, SceneFile};
 use radiosity::solve::{GaussSeidelSettings, ProgressiveSettings, Solver, SolverKind};
 
 use crate::args::{
-    CameraArgs, DirectLightArg, MethodArg, RayArgs, RenderArgs, SceneArgs, ShadingArg,
+    CameraArgs, DirectLightArg, MethodArg, MethodArgs, RayArgs, RenderArgs, SceneArgs, ShadingArg,
     SolveOptions, ToneArgs,
 };
 use crate::progress_bar::Reporter;
@@ -68,6 +68,7 @@ fn prepare_solve_as(
         reporter,
     )?;
     prepared.check_memory(Some(&solver))?;
+    reporter.solving_with(&solver);
     // The form factors are computed by the dense solvers (unless read from a file) and,
     // row by row, by progressive refinement; hierarchical radiosity computes its own.
     let computes = match solver {
@@ -96,14 +97,8 @@ fn prepare_solve_as(
 
 /// The method `--method` names when it was given (an explicit `--method area` too), which
 /// every solver but hierarchical radiosity uses.
-fn method_flag_given(args: &crate::args::MethodArgs) -> Option<&'static str> {
-    Some(match args.method? {
-        MethodArg::Area => "area",
-        MethodArg::Contour => "contour",
-        MethodArg::Analytic => "analytic",
-        MethodArg::Hemicube => "hemicube",
-        MethodArg::Montecarlo => "montecarlo",
-    })
+fn method_flag_given(args: &MethodArgs) -> Option<&'static str> {
+    Some(method_name(args.method?))
 }
 
 /// The scene loaded, meshed with its file's settings overridden by the flags, and its
@@ -129,6 +124,17 @@ pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared,
         e => e.into(),
     })?;
     let m = &args.method;
+    let ignored = ignored_method_flags(m, args.steps.is_some());
+    if !ignored.is_empty() {
+        // Printed even with --quiet: the run does not do what the flags say.
+        errln!(
+            "warning: {} ignored: the form-factor method is {} (--steps applies to the area, \
+             contour and analytic methods, --resolution to hemicube, --samples and --seed to \
+             montecarlo)",
+            ignored.join(", "),
+            method_name(m.method.unwrap_or(MethodArg::Area))
+        );
+    }
     let steps = prepared.settings.integral_steps;
     prepared.method = match m.method.unwrap_or(MethodArg::Area) {
         MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
@@ -156,6 +162,43 @@ pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared,
         }
     };
     Ok((prepared, stem))
+}
+
+/// The form-factor flags given (told from their defaults, as a flag at its default value
+/// cannot be told from one left out) that the method `--method` chooses does not use:
+/// `--resolution` but for the hemicube, `--samples` and `--seed` but for Monte Carlo,
+/// `--steps` (`steps_given`) for those two (QA of issue #16: they were dropped without a
+/// word).
+pub fn ignored_method_flags(m: &MethodArgs, steps_given: bool) -> Vec<&'static str> {
+    let method = m.method.unwrap_or(MethodArg::Area);
+    let mut ignored = Vec::new();
+    // The area, contour and analytic methods take INTEGRAL_STEPS; the other two do not.
+    if matches!(method, MethodArg::Hemicube | MethodArg::Montecarlo) && steps_given {
+        ignored.push("--steps");
+    }
+    if !matches!(method, MethodArg::Hemicube) && m.resolution != MethodArgs::RESOLUTION {
+        ignored.push("--resolution");
+    }
+    if !matches!(method, MethodArg::Montecarlo) {
+        if m.samples != MethodArgs::SAMPLES {
+            ignored.push("--samples");
+        }
+        if m.seed != MethodArgs::SEED {
+            ignored.push("--seed");
+        }
+    }
+    ignored
+}
+
+/// The name `--method` gives `method`.
+pub fn method_name(method: MethodArg) -> &'static str {
+    match method {
+        MethodArg::Area => "area",
+        MethodArg::Contour => "contour",
+        MethodArg::Analytic => "analytic",
+        MethodArg::Hemicube => "hemicube",
+        MethodArg::Montecarlo => "montecarlo",
+    }
 }
 
 /// Where the MAX_PATCH_AREA in force came from: `--max-area`, the scene file's line
@@ -294,9 +337,39 @@ pub fn load_scene(
             if let Some(w) = far_from_origin(&imported.file.scene) {
                 errln!("{}: warning: {w}", path.display());
             }
+            if let Some(w) = no_emitter(&imported.file.scene, imported.format) {
+                errln!("{}: warning: {w}", path.display());
+            }
             Ok((imported.file, stem_of(Some(path))))
         }
     }
+}
+
+/// A warning when nothing in `scene` emits light (QA of issue #16: such a scene rendered
+/// black without a word): no surface emits in any band and there is no point luminaire,
+/// with what would emit in a file of `format`.
+pub fn no_emitter(scene: &Scene, format: Format) -> Option<String> {
+    let emits = scene
+        .surfaces
+        .iter()
+        .any(|s| s.emission.0.iter().any(|&e| e > 0.0))
+        || !scene.lights.is_empty();
+    if emits || scene.surfaces.is_empty() {
+        return None;
+    }
+    let would_emit = match format {
+        Format::Scene => {
+            "a surface with Er, Eg or Eb above 0, LUMINANCE or FLUX, or a LIGHTBEGIN block"
+        }
+        Format::Obj => "a material with Ke above 0 in the MTL file",
+        Format::Gltf | Format::Glb => "a material with an emissiveFactor above 0",
+        Format::Dxf => "a layer with an emission above 0 in NAME.materials.toml",
+        Format::Vrml => "a Material with an emissiveColor above 0",
+    };
+    Some(format!(
+        "nothing in the scene emits light, so every radiosity is 0 and pictures are black; \
+         give it {would_emit}"
+    ))
 }
 
 /// How far, in units of its own size, a scene may lie from the origin before precision runs
@@ -496,6 +569,15 @@ pub fn check_render_budget(
 /// The render settings `--supersample`, `--adaptive-contrast`, `--direct-light` and
 /// `--shading` ask for (exposure and gamma at their defaults).
 pub fn ray_settings(rays: &RayArgs, shading_arg: ShadingArg) -> RenderSettings {
+    let n = rays.supersample;
+    let adaptive = n > 2 && n % 2 == 0 && shading_arg != ShadingArg::Wireframe;
+    if !adaptive && rays.adaptive_contrast != RayArgs::ADAPTIVE_CONTRAST {
+        // Printed even with --quiet: the run does not do what the flags say.
+        errln!(
+            "warning: --adaptive-contrast ignored: adaptive antialiasing takes an even \
+             --supersample above 2 (given {n}) and smooth or flat shading"
+        );
+    }
     RenderSettings {
         shading: shading(shading_arg),
         supersample: rays.supersample,

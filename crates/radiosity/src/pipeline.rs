@@ -74,6 +74,24 @@ pub enum PipelineError {
     /// The work would exceed a limit of [`crate::budget`].
     #[error(transparent)]
     TooMuchWork(#[from] crate::budget::TooMuchWork),
+    /// A form-factor file was made for another mesh ([`FormFactorFileError::Stale`]), with
+    /// the settings of this run's mesh beside what the file records.
+    #[error(
+        "{source}; this run's mesh has {elements} elements (MAX_PATCH_AREA {max_patch_area}, \
+         INTEGRAL_STEPS {integral_steps}, method `{method}`)"
+    )]
+    FormFactorsForAnotherMesh {
+        /// The reader's error (a [`FormFactorFileError::Stale`]).
+        source: FormFactorFileError,
+        /// Elements of this run's mesh.
+        elements: usize,
+        /// This run's MAX_PATCH_AREA.
+        max_patch_area: f64,
+        /// This run's INTEGRAL_STEPS.
+        integral_steps: u32,
+        /// This run's method.
+        method: FormFactorMethod,
+    },
     /// A form-factor file holds a matrix of another size than the mesh.
     #[error("form-factor file {path} holds {found} rows, but the mesh has {expected} elements")]
     FormFactorSizeMismatch {
@@ -468,6 +486,16 @@ impl Prepared {
     ) -> Result<FormFactorMatrix, PipelineError> {
         let matrix = run_stage(progress, Stage::FormFactors, 0, || {
             read_form_factors(path, self.fingerprint(), Some(self.method()))
+        })
+        .map_err(|e| match e {
+            e @ FormFactorFileError::Stale { .. } => PipelineError::FormFactorsForAnotherMesh {
+                source: e,
+                elements: self.mesh.len(),
+                max_patch_area: self.settings.max_patch_area,
+                integral_steps: self.settings.integral_steps,
+                method: self.method(),
+            },
+            e => e.into(),
         })?;
         // The fingerprint covers n, but a forged file could carry this mesh's fingerprint.
         if matrix.n() != self.mesh.len() {

@@ -40,6 +40,15 @@ pub fn run(args: BenchArgs) -> Result<()> {
     } else {
         args.max_area.iter().copied().map(Some).collect()
     };
+    // Flags the method does not use, said once here, not once per run.
+    let ignored = crate::setup::ignored_method_flags(&args.method, args.steps.is_some());
+    if !ignored.is_empty() {
+        errln!(
+            "warning: {} ignored: the form-factor method is {}",
+            ignored.join(", "),
+            crate::setup::method_name(args.method.method.unwrap_or(crate::args::MethodArg::Area))
+        );
+    }
     report::bench_header(
         args.repeat,
         args.size,
@@ -109,8 +118,12 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         scene: args.scene.clone(),
         scale: args.scale,
         max_area,
-        steps: args.steps,
-        method: args.method.clone(),
+        // Hemicube and Monte Carlo take no INTEGRAL_STEPS (warned about above).
+        steps: match args.method.method {
+            Some(crate::args::MethodArg::Hemicube | crate::args::MethodArg::Montecarlo) => None,
+            _ => args.steps,
+        },
+        method: args.method.without_unused(),
         quiet: true,
         // A benchmark measures what it is asked to, however long.
         no_work_limit: true,

@@ -36,8 +36,10 @@ pub fn run(args: CheckArgs) -> Result<()> {
         report::method_accuracy(max_area, args.scene.quiet);
         return Ok(());
     }
-    // `check` always prints its report; --quiet only silences the progress bars.
-    let reporter = Reporter::new(true);
+    // `check` always prints its report (the notes of the other commands are in it); --quiet
+    // only silences the progress bars or lines (QA of issue #16: there were none, so a 40 s
+    // form-factor stage was silent).
+    let reporter = Reporter::progress_only(args.scene.quiet);
     let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let (solution, stats, escaped) = if solver.needs_matrix() {
         let (f, stats) = match args.solve.form_factors.as_deref() {

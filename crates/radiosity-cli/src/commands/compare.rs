@@ -48,6 +48,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 hint(&e).unwrap_or_default()
             )),
             Ok(()) => {
+                reporter.solving_with(&dense);
                 let start = std::time::Instant::now();
                 let exact = pipeline::solve(
                     &prepared,
@@ -56,7 +57,6 @@ pub fn run(args: CompareArgs) -> Result<()> {
                     &reporter,
                 )?;
                 let seconds = start.elapsed().as_secs_f64();
-                let n = prepared.mesh.len() as u64;
                 let emission = prepared.light.emission();
                 let difference = radiosity::compare::compare(
                     &prepared.mesh,
@@ -67,7 +67,9 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 )?;
                 reference = Some(Reference {
                     seconds,
-                    matrix_bytes: 4 * n * n,
+                    matrix_bytes: radiosity::form_factor::FormFactorMatrix::bytes_for(
+                        prepared.mesh.len(),
+                    ),
                     difference,
                 });
             }

@@ -58,6 +58,29 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     let prepared = if args.compare {
         Some(prepare_solve(&args.scene, &args.solve, &reporter)?)
     } else {
+        // The radiosity flags set the solve --compare adds (QA of issue #16: without it they
+        // were dropped without a word). Printed even with --quiet.
+        let s = &args.scene;
+        let given = [
+            ("--max-area", s.max_area.is_some()),
+            ("--steps", s.steps.is_some()),
+            ("--method", s.method.method.is_some()),
+            (
+                "--solver",
+                args.solve.solver.0 != radiosity::solve::SolverKind::Auto,
+            ),
+            ("--tolerance", args.solve.tolerance.is_some()),
+            ("--form-factors", args.solve.form_factors.is_some()),
+        ];
+        let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+        if !ignored.is_empty() {
+            errln!(
+                "warning: {} ignored without --compare: the path tracer traces the scene's \
+                 polygons (the meshing, form-factor and solver flags set the radiosity solve \
+                 --compare adds)",
+                ignored.join(", ")
+            );
+        }
         None
     };
     let loaded;

@@ -61,9 +61,17 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
+    if args.snapshots.is_none() && args.snapshot_every != RenderArgs::SNAPSHOT_EVERY {
+        // Printed even with --quiet: the run does not do what the flags say.
+        errln!("warning: --snapshot-every ignored: no --snapshots DIR to write snapshots to");
+    }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
-    if args.snapshots.is_some() && solver.needs_matrix() {
-        bail!("--snapshots needs --solver progressive");
+    if args.snapshots.is_some() && !matches!(solver, radiosity::solve::Solver::Progressive(_)) {
+        bail!(
+            "--snapshots needs --solver progressive (the solver is {}, which has no shots to \
+             take pictures of)",
+            solver.kind().name()
+        );
     }
     let camera = camera(&args.camera, &prepared.scene)?;
     let exposure = args.tone.exposure;

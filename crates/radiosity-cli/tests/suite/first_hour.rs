@@ -337,3 +337,229 @@ fn flags_of_another_solver_are_said_to_be_ignored() {
     assert!(err.contains("--adapt-rounds ignored"), "{err}");
     assert!(!err.contains("--epsilon ignored"), "{err}");
 }
+
+/// A 1 m floor lit from 1 m above by a lamp of emission `e` (Er Eg Eb) facing down; the
+/// floor reflects the bands differently (0.1, 0.5, 0.9), so each band's share absorbed
+/// differs, and most of the light escapes past the floor's edges.
+fn lamp_over_floor(e: [f64; 3]) -> String {
+    format!(
+        "MAX_PATCH_AREA 0.25\nINTEGRAL_STEPS 2\nSCENEBEGIN\n\
+         PATCHBEGIN\n#Floor\nVERTICES 4\nEr 0\nEg 0\nEb 0\nRr 0.1\nRg 0.5\nRb 0.9\n\
+         VERTEX0 1 0 0\nVERTEX1 0 0 0\nVERTEX2 0 0 1\nVERTEX3 1 0 1\nPATCHEND\n\
+         PATCHBEGIN\n#Lamp\nVERTICES 4\nEr {}\nEg {}\nEb {}\nRr 0\nRg 0\nRb 0\n\
+         VERTEX0 1 1 1\nVERTEX1 0 1 1\nVERTEX2 0 1 0\nVERTEX3 1 1 0\nPATCHEND\nSCENEEND\n",
+        e[0], e[1], e[2]
+    )
+}
+
+#[test]
+fn flags_the_method_or_command_does_not_use_are_said_to_be_ignored() {
+    // QA of issue #16: --samples with the area method, --snapshot-every without
+    // --snapshots and --adaptive-contrast with --supersample 1 were dropped without a word.
+    let dir = scratch_dir("ignored-method-flags");
+    let out = radiosity(
+        &["solve", "--max-area", "20000", "--samples", "64", "-o", "a.csv"],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: --samples ignored: the form-factor method is area"),
+        "{err}"
+    );
+    // The method that takes them: nothing said.
+    let out = radiosity(
+        &[
+            "solve",
+            "--max-area",
+            "20000",
+            "--method",
+            "montecarlo",
+            "--samples",
+            "64",
+            "-o",
+            "b.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("ignored"), "{err}");
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--snapshot-every",
+            "5",
+            "--adaptive-contrast",
+            "0.1",
+            "--supersample",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "-o",
+            "c.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning: --snapshot-every ignored"), "{err}");
+    assert!(err.contains("warning: --adaptive-contrast ignored"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_scene_that_emits_nothing_is_said_to_render_black() {
+    // QA of issue #16: it rendered black without a word.
+    let dir = scratch_dir("no-emitter");
+    std::fs::write(dir.join("dark.scene"), lamp_over_floor([0.0; 3])).unwrap();
+    let out = radiosity(&["solve", "dark.scene", "-o", "dark.csv"], &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("dark.scene: warning: nothing in the scene emits light")
+            && err.contains("Er, Eg or Eb above 0, LUMINANCE or FLUX, or a LIGHTBEGIN block"),
+        "{err}"
+    );
+    // A lit scene: nothing said.
+    std::fs::write(dir.join("lit.scene"), lamp_over_floor([1.0; 3])).unwrap();
+    let out = radiosity(&["solve", "lit.scene", "-o", "lit.csv"], &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("emits light"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The number before `marker` in `text`, as the last whitespace-separated word ending
+/// there (a "(" before it dropped).
+fn number_before(text: &str, marker: &str) -> f64 {
+    let at = text.find(marker).unwrap_or_else(|| panic!("{marker:?} in {text}"));
+    let word = text[..at].split_whitespace().last().unwrap();
+    word.trim_start_matches('(').parse().unwrap()
+}
+
+#[test]
+fn check_and_solve_give_the_energy_of_the_same_band() {
+    // QA of issue #16: `solve` and `render` gave the energy account of the band emitting
+    // most, `check` the red band's, so the same scene showed two different figures. The
+    // lamp emits most in blue, and the floor reflects the bands differently, so the
+    // blue and red shares absorbed differ.
+    let dir = scratch_dir("energy-band");
+    std::fs::write(dir.join("lamp.scene"), lamp_over_floor([1.0, 1.0, 3.0])).unwrap();
+    let out = radiosity(&["solve", "lamp.scene", "-o", "lamp.csv"], &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let note = err
+        .lines()
+        .find(|l| l.starts_with("energy (B, the band emitting most)"))
+        .unwrap_or_else(|| panic!("{err}"));
+    let solve_absorbed = number_before(note, "% absorbed");
+    let out = radiosity(&["check", "lamp.scene"], &dir);
+    let text = crate::fixtures::stdout(&out);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("energy (B)"))
+        .unwrap_or_else(|| panic!("{text}"));
+    let after = &line[line.find("absorbed").unwrap()..];
+    let check_absorbed = number_before(after, "%)");
+    // Both print two decimals of the same number.
+    assert_eq!(solve_absorbed, check_absorbed, "{note}\n{line}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn hierarchical_energy_notes_do_not_promise_what_check_cannot_say() {
+    // QA of issue #16: the energy note said "`check` says where" the light escapes, but
+    // for hierarchical radiosity `check` lists no surfaces (it keeps no form-factor rows).
+    let dir = scratch_dir("hierarchical-where");
+    let out = radiosity(
+        &["solve", "--max-area", "20000", "--solver", "hierarchical", "-o", "h.csv"],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("energy (") && !err.contains("says where"), "{err}");
+    let out = radiosity(
+        &["check", "--max-area", "20000", "--solver", "hierarchical"],
+        &dir,
+    );
+    let text = crate::fixtures::stdout(&out);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(text.contains("escaped from      not traced to surfaces"), "{text}");
+    // The dense solve does say where, and check lists the surfaces.
+    let out = radiosity(&["solve", "--max-area", "20000", "-o", "d.csv"], &dir);
+    assert!(stderr(&out).contains("`check` says where"), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn check_gives_the_reason_for_a_non_reciprocal_energy_account() {
+    // QA of issue #16: Monte Carlo form factors' account was off by 3.5 % with no reason.
+    // 64 rays per element leave the rows' estimates of a pair far apart from its two ends.
+    let dir = scratch_dir("account-reason");
+    let out = radiosity(
+        &[
+            "check",
+            "--max-area",
+            "20000",
+            "--method",
+            "montecarlo",
+            "--samples",
+            "64",
+        ],
+        &dir,
+    );
+    let text = crate::fixtures::stdout(&out);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        text.contains("(relative error: montecarlo samples=64 seed=1's form factors are not reciprocal"),
+        "{text}"
+    );
+    // One wording for escaped light on the energy line and the list of surfaces.
+    let escaped = text
+        .lines()
+        .filter(|l| l.contains("through openings, into gaps and contacts or onto the backs of faces"))
+        .count();
+    assert_eq!(escaped, 2, "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_form_factor_file_for_another_mesh_says_both_meshes_settings() {
+    // QA of issue #16: the refusal gave two fingerprints and no settings.
+    let dir = scratch_dir("stale-settings");
+    let out = radiosity(&["formfactors", "--max-area", "20000", "-o", "c.ff"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = radiosity(
+        &["solve", "--max-area", "10000", "--form-factors", "c.ff", "-o", "c.csv"],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("elements, made with method `area k=2`"), "{err}");
+    assert!(
+        err.contains("this run's mesh has") && err.contains("(MAX_PATCH_AREA 10000, INTEGRAL_STEPS 2"),
+        "{err}"
+    );
+    assert!(err.contains("recompute it with `radiosity formfactors`"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bench_says_what_its_other_column_holds() {
+    // QA of issue #16: the "other" column was unexplained.
+    let dir = scratch_dir("bench-other");
+    let out = radiosity(
+        &["bench", "--max-area", "20000", "--repeat", "1", "--size", "8"],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("other: end to end less the stages listed"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -208,7 +208,24 @@ pub struct RowSums {
 /// the most a closed surround can give (f32 rounding of a row stays near 1e-6).
 pub const ROW_SUM_OVER: f64 = 1.01;
 
+/// `bytes` in MiB (2^20 bytes) as the reports of the dense matrix give them: two decimals
+/// below 10 MiB, none above.
+pub fn format_mib(bytes: u64) -> String {
+    let m = bytes as f64 / (1u64 << 20) as f64;
+    if m < 10.0 {
+        format!("{m:.2}")
+    } else {
+        format!("{m:.0}")
+    }
+}
+
 impl FormFactorMatrix {
+    /// Bytes of the entries of an `n` x `n` matrix: 4 n^2 (f32). The one figure every
+    /// report of the dense matrix's size gives (`auto`'s choice, `compare`).
+    pub fn bytes_for(n: usize) -> u64 {
+        4 * (n as u64) * (n as u64)
+    }
+
     /// An n x n matrix of zeros, refused with [`OutOfMemory`] if it would not fit.
     pub fn zeros(n: usize) -> Result<FormFactorMatrix, OutOfMemory> {
         check_dense_fits(

@@ -144,13 +144,19 @@ pub enum FormFactorFileError {
         computed: u32,
     },
     /// The file was computed for a different mesh (other scene, area limit or geometry).
+    /// The file records its element count and method, not the scene or MAX_PATCH_AREA.
     #[error(
-        "form-factor file {path} was computed for a different mesh (fingerprint \
-         {found:016x}, this mesh is {expected:016x})"
+        "form-factor file {path} was computed for a different mesh: it holds {elements} \
+         elements, made with method `{method}` (fingerprint {found:016x}, this mesh is \
+         {expected:016x}; the file records no MAX_PATCH_AREA)"
     )]
     Stale {
         /// The file.
         path: PathBuf,
+        /// The element count in the file.
+        elements: u64,
+        /// The method tag in the file, as written.
+        method: String,
         /// The fingerprint in the file.
         found: u64,
         /// The fingerprint of the current mesh.
@@ -625,6 +631,8 @@ fn read_with_memory(
     if fingerprint != expected_fingerprint {
         return Err(FormFactorFileError::Stale {
             path: p(),
+            elements: n as u64,
+            method,
             found: fingerprint,
             expected: expected_fingerprint,
         });

@@ -297,7 +297,10 @@ pub enum AutoReason {
 pub struct AutoChoice {
     /// Elements of the mesh.
     pub elements: usize,
-    /// Bytes the f32 form-factor matrix would take, with 10 % headroom.
+    /// Bytes the f32 form-factor matrix would take ([`FormFactorMatrix::bytes_for`]; the
+    /// choice allows 10 % headroom on top).
+    ///
+    /// [`FormFactorMatrix::bytes_for`]: crate::form_factor::FormFactorMatrix::bytes_for
     pub matrix_bytes: f64,
     /// Bytes of memory available.
     pub available_bytes: u64,
@@ -310,10 +313,10 @@ pub struct AutoChoice {
 /// [`AUTO_DENSE_MAX_ELEMENTS`] elements and the matrix takes at most half the memory,
 /// hierarchical radiosity otherwise.
 pub fn choose(elements: usize, available: u64) -> AutoChoice {
-    let matrix_bytes = 4.0 * (elements as f64).powi(2) * 1.1;
+    let matrix_bytes = crate::form_factor::FormFactorMatrix::bytes_for(elements) as f64;
     let reason = if elements > AUTO_DENSE_MAX_ELEMENTS {
         AutoReason::TooManyElements
-    } else if matrix_bytes > 0.5 * available as f64 {
+    } else if 1.1 * matrix_bytes > 0.5 * available as f64 {
         AutoReason::MatrixTooLarge
     } else {
         AutoReason::Fits
@@ -341,13 +344,15 @@ impl AutoChoice {
         }
     }
 
-    /// "N elements; the dense form-factor matrix needs X MiB of the Y MiB available".
+    /// "N elements; the dense form-factor matrix needs X MiB of the Y MiB available" (the
+    /// matrix alone, as `compare` reports it; MiB = 2^20 bytes).
     pub fn estimate(&self) -> String {
         let mib = |b: f64| b / (1u64 << 20) as f64;
         format!(
-            "{} elements; the dense form-factor matrix needs {:.0} MiB of the {:.0} MiB available",
+            "{} elements; the dense form-factor matrix (f32, 4 n^2 bytes) needs {} MiB of \
+             the {:.0} MiB available (MiB = 2^20 bytes)",
             self.elements,
-            mib(self.matrix_bytes),
+            crate::form_factor::format_mib(self.matrix_bytes as u64),
             mib(self.available_bytes as f64)
         )
     }
@@ -389,6 +394,15 @@ mod tests {
             choose(9_805, 16 * gib).to_string().contains("MiB"),
             "the reason states the estimate"
         );
+    }
+
+    #[test]
+    fn auto_states_the_matrix_size_compare_reports() {
+        // QA of issue #16: `render` said 26 MiB (4 n^2 with 10 % headroom) where `compare`
+        // said 24 MiB (4 n^2) for the same matrix. 2,560 elements: 4 * 2560^2 bytes =
+        // 26,214,400 = 25.0 MiB exactly.
+        let text = choose(2_560, 16 << 30).estimate();
+        assert!(text.contains("needs 25 MiB"), "{text}");
     }
 
     #[test]
