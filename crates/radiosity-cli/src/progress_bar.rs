@@ -344,7 +344,9 @@ mod tests {
             Counting::solve(&hierarchical),
         );
         assert!(
-            line.starts_with("solve: 17 refinement rounds after 30 s (no time left can be estimated: "),
+            line.starts_with(
+                "solve: 17 refinement rounds after 30 s (no time left can be estimated: "
+            ),
             "{line}"
         );
         // LU knows its total: it gets the percentage and the time left instead.
@@ -367,10 +369,20 @@ mod tests {
         // QA of issue #16: the timings of adaptive subdivision read "solve 1 s, ..., solve
         // 2 s", of pathtrace --compare "write ..., write ...".
         let reporter = Reporter::new(true);
-        for stage in [Stage::Parse, Stage::Solve, Stage::Adapt, Stage::Solve, Stage::Write] {
+        for stage in [
+            Stage::Parse,
+            Stage::Solve,
+            Stage::Adapt,
+            Stage::Solve,
+            Stage::Write,
+        ] {
             reporter.finish(stage, Duration::from_millis(1));
         }
-        let labels: Vec<String> = reporter.labelled_timings().into_iter().map(|t| t.0).collect();
+        let labels: Vec<String> = reporter
+            .labelled_timings()
+            .into_iter()
+            .map(|t| t.0)
+            .collect();
         assert_eq!(labels, ["parse", "solve #1", "adapt", "solve #2", "write"]);
     }
 }

@@ -549,7 +549,11 @@ fn where_escaped(
     outln!(
         "escaped from      {} (of emitted, by the surface it left, where its rows of form \
          factors sum below 1: {ESCAPED})",
-        if lost.is_empty() { "no surface".to_string() } else { lost.join(", ") }
+        if lost.is_empty() {
+            "no surface".to_string()
+        } else {
+            lost.join(", ")
+        }
     );
     if !twice.is_empty() {
         outln!(

@@ -238,7 +238,9 @@ impl Checkpoint {
         files.sort_by_key(|(rows, _)| (rows.start, rows.end));
         for (rows, path) in files {
             if rows.end > identity.elements {
-                result.refused.push((path, beyond(&rows, identity.elements)));
+                result
+                    .refused
+                    .push((path, beyond(&rows, identity.elements)));
                 continue;
             }
             if result
@@ -635,13 +637,19 @@ mod tests {
         assert_eq!(
             why,
             [
-                format!("its rows 1..{} lie beyond the mesh's 5 elements", usize::MAX),
+                format!(
+                    "its rows 1..{} lie beyond the mesh's 5 elements",
+                    usize::MAX
+                ),
                 "its rows 4..7 lie beyond the mesh's 5 elements".to_string(),
             ]
         );
         assert_eq!(
             cp.load(&(1..usize::MAX)).unwrap_err(),
-            format!("its rows 1..{} lie beyond the mesh's 5 elements", usize::MAX)
+            format!(
+                "its rows 1..{} lie beyond the mesh's 5 elements",
+                usize::MAX
+            )
         );
     }
 

@@ -143,7 +143,11 @@ pub fn cornell_max_area_for(target: usize) -> f64 {
     let occluders = radiosity::form_factor::occluder_bvh(&scene);
     let count = |a: f64| {
         mesh_scene(&scene, a)
-            .map(|grid| radiosity::mesh::refine_contacts(&grid, &scene, &occluders).0.len())
+            .map(|grid| {
+                radiosity::mesh::refine_contacts(&grid, &scene, &occluders)
+                    .0
+                    .len()
+            })
             .unwrap_or(usize::MAX)
     };
     // The count moves in steps (whole rows of elements, contact splits), so the iteration

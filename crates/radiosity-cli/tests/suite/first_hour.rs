@@ -358,7 +358,15 @@ fn flags_the_method_or_command_does_not_use_are_said_to_be_ignored() {
     // --snapshots and --adaptive-contrast with --supersample 1 were dropped without a word.
     let dir = scratch_dir("ignored-method-flags");
     let out = radiosity(
-        &["solve", "--max-area", "20000", "--samples", "64", "-o", "a.csv"],
+        &[
+            "solve",
+            "--max-area",
+            "20000",
+            "--samples",
+            "64",
+            "-o",
+            "a.csv",
+        ],
         &dir,
     );
     let err = stderr(&out);
@@ -408,7 +416,10 @@ fn flags_the_method_or_command_does_not_use_are_said_to_be_ignored() {
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("warning: --snapshot-every ignored"), "{err}");
-    assert!(err.contains("warning: --adaptive-contrast ignored"), "{err}");
+    assert!(
+        err.contains("warning: --adaptive-contrast ignored"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -437,7 +448,9 @@ fn a_scene_that_emits_nothing_is_said_to_render_black() {
 /// The number before `marker` in `text`, as the last whitespace-separated word ending
 /// there (a "(" before it dropped).
 fn number_before(text: &str, marker: &str) -> f64 {
-    let at = text.find(marker).unwrap_or_else(|| panic!("{marker:?} in {text}"));
+    let at = text
+        .find(marker)
+        .unwrap_or_else(|| panic!("{marker:?} in {text}"));
     let word = text[..at].split_whitespace().last().unwrap();
     word.trim_start_matches('(').parse().unwrap()
 }
@@ -478,22 +491,40 @@ fn hierarchical_energy_notes_do_not_promise_what_check_cannot_say() {
     // for hierarchical radiosity `check` lists no surfaces (it keeps no form-factor rows).
     let dir = scratch_dir("hierarchical-where");
     let out = radiosity(
-        &["solve", "--max-area", "20000", "--solver", "hierarchical", "-o", "h.csv"],
+        &[
+            "solve",
+            "--max-area",
+            "20000",
+            "--solver",
+            "hierarchical",
+            "-o",
+            "h.csv",
+        ],
         &dir,
     );
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
-    assert!(err.contains("energy (") && !err.contains("says where"), "{err}");
+    assert!(
+        err.contains("energy (") && !err.contains("says where"),
+        "{err}"
+    );
     let out = radiosity(
         &["check", "--max-area", "20000", "--solver", "hierarchical"],
         &dir,
     );
     let text = crate::fixtures::stdout(&out);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(text.contains("escaped from      not traced to surfaces"), "{text}");
+    assert!(
+        text.contains("escaped from      not traced to surfaces"),
+        "{text}"
+    );
     // The dense solve does say where, and check lists the surfaces.
     let out = radiosity(&["solve", "--max-area", "20000", "-o", "d.csv"], &dir);
-    assert!(stderr(&out).contains("`check` says where"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("`check` says where"),
+        "{}",
+        stderr(&out)
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -517,13 +548,17 @@ fn check_gives_the_reason_for_a_non_reciprocal_energy_account() {
     let text = crate::fixtures::stdout(&out);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
-        text.contains("(relative error: montecarlo samples=64 seed=1's form factors are not reciprocal"),
+        text.contains(
+            "(relative error: montecarlo samples=64 seed=1's form factors are not reciprocal"
+        ),
         "{text}"
     );
     // One wording for escaped light on the energy line and the list of surfaces.
     let escaped = text
         .lines()
-        .filter(|l| l.contains("through openings, into gaps and contacts or onto the backs of faces"))
+        .filter(|l| {
+            l.contains("through openings, into gaps and contacts or onto the backs of faces")
+        })
         .count();
     assert_eq!(escaped, 2, "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -536,17 +571,32 @@ fn a_form_factor_file_for_another_mesh_says_both_meshes_settings() {
     let out = radiosity(&["formfactors", "--max-area", "20000", "-o", "c.ff"], &dir);
     assert!(out.status.success(), "{}", stderr(&out));
     let out = radiosity(
-        &["solve", "--max-area", "10000", "--form-factors", "c.ff", "-o", "c.csv"],
+        &[
+            "solve",
+            "--max-area",
+            "10000",
+            "--form-factors",
+            "c.ff",
+            "-o",
+            "c.csv",
+        ],
         &dir,
     );
     let err = stderr(&out);
     assert!(!out.status.success(), "{err}");
-    assert!(err.contains("elements, made with method `area k=2`"), "{err}");
     assert!(
-        err.contains("this run's mesh has") && err.contains("(MAX_PATCH_AREA 10000, INTEGRAL_STEPS 2"),
+        err.contains("elements, made with method `area k=2`"),
         "{err}"
     );
-    assert!(err.contains("recompute it with `radiosity formfactors`"), "{err}");
+    assert!(
+        err.contains("this run's mesh has")
+            && err.contains("(MAX_PATCH_AREA 10000, INTEGRAL_STEPS 2"),
+        "{err}"
+    );
+    assert!(
+        err.contains("recompute it with `radiosity formfactors`"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -555,11 +605,22 @@ fn bench_says_what_its_other_column_holds() {
     // QA of issue #16: the "other" column was unexplained.
     let dir = scratch_dir("bench-other");
     let out = radiosity(
-        &["bench", "--max-area", "20000", "--repeat", "1", "--size", "8"],
+        &[
+            "bench",
+            "--max-area",
+            "20000",
+            "--repeat",
+            "1",
+            "--size",
+            "8",
+        ],
         &dir,
     );
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
-    assert!(err.contains("other: end to end less the stages listed"), "{err}");
+    assert!(
+        err.contains("other: end to end less the stages listed"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
