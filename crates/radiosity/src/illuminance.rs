@@ -56,6 +56,19 @@ pub struct Lux {
 /// The shadow-ray points per element side for the indirect light's visibility.
 const ELEMENT_POINTS: u32 = 3;
 
+/// Each element's reflectance (its surface's) and the exitance it shows
+/// ([`Solution::display_radiosity`]: progressive refinement's ambient term included).
+fn reflectance_and_shown(scene: &crate::scene::Scene, solution: &Solution) -> (Vec<Rgb>, Vec<Rgb>) {
+    let reflectance: Vec<Rgb> = solution
+        .mesh
+        .elements
+        .iter()
+        .map(|e| scene.surfaces[e.surface as usize].reflectance)
+        .collect();
+    let shown = solution.display_radiosity(&reflectance);
+    (reflectance, shown)
+}
+
 /// The illuminance at each of `points` for the scene of `prepared` solved as `solution`
 /// (any solver's: its mesh may be the prepared one, adaptive subdivision's or hierarchical
 /// radiosity's leaves). Points run in parallel; the result is in the order of `points` and
@@ -64,12 +77,7 @@ pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint
     let scene = &prepared.scene;
     let direct = DirectLight::new(scene);
     let mesh = &solution.mesh;
-    let reflectance: Vec<Rgb> = mesh
-        .elements
-        .iter()
-        .map(|e| scene.surfaces[e.surface as usize].reflectance)
-        .collect();
-    let shown = solution.display_radiosity(&reflectance);
+    let (reflectance, shown) = reflectance_and_shown(scene, solution);
     // The point lights' first bounce as the solver added it to the emission
     // ([`crate::light::ElementLight::of_mesh`]: the same call on the same mesh and
     // occluders), taken out of the element's exitance and integrated at the point instead.
@@ -653,12 +661,7 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
 pub fn element_illuminance(prepared: &Prepared, solution: &Solution) -> Vec<f64> {
     let scene = &prepared.scene;
     let mesh = &solution.mesh;
-    let reflectance: Vec<Rgb> = mesh
-        .elements
-        .iter()
-        .map(|e| scene.surfaces[e.surface as usize].reflectance)
-        .collect();
-    let shown = solution.display_radiosity(&reflectance);
+    let (reflectance, shown) = reflectance_and_shown(scene, solution);
     let mut out = vec![0.0; mesh.len()];
     let mut black = Vec::new();
     for (i, el) in mesh.elements.iter().enumerate() {
