@@ -23,10 +23,18 @@ pub fn run(args: CheckArgs) -> Result<()> {
                 scene.display()
             );
         }
-        if args.scene.method.method.is_some() || args.scene.steps.is_some() {
+        let m = &args.scene.method;
+        // A flag at its default value is not told apart from one left out.
+        let changed = m.method.is_some()
+            || args.scene.steps.is_some()
+            || m.resolution != crate::args::MethodArgs::RESOLUTION
+            || m.samples != crate::args::MethodArgs::SAMPLES
+            || m.seed != crate::args::MethodArgs::SEED;
+        if changed {
             bail!(
                 "check --compare-methods measures every method at its listed settings: drop \
-                 --method and --steps (--max-area sets the elements' size)"
+                 --method, --steps, --resolution, --samples and --seed (--max-area sets the \
+                 elements' size)"
             );
         }
         let max_area = args.scene.max_area.unwrap_or(1.0 / 64.0);

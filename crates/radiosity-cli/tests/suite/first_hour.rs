@@ -245,7 +245,12 @@ fn compare_methods_refuses_a_scene_and_reports_progress() {
         ),
         (
             vec!["check", "--compare-methods", "--method", "hemicube"],
-            "drop --method and --steps",
+            "drop --method, --steps, --resolution, --samples and --seed",
+        ),
+        // They were ignored without a word (QA of issue #16).
+        (
+            vec!["check", "--compare-methods", "--samples", "64"],
+            "drop --method, --steps, --resolution, --samples and --seed",
         ),
     ] {
         let out = radiosity(&args, &dir);
