@@ -346,14 +346,17 @@ pub fn load_scene(
 }
 
 /// A warning when nothing in `scene` emits light (QA of issue #16: such a scene rendered
-/// black without a word): no surface emits in any band and there is no point luminaire,
-/// with what would emit in a file of `format`.
+/// black without a word): no surface emits in any band and no point luminaire gives light
+/// (a `FLUX 0` or black `COLOUR` gives none), with what would emit in a file of `format`.
 pub fn no_emitter(scene: &Scene, format: Format) -> Option<String> {
     let emits = scene
         .surfaces
         .iter()
         .any(|s| s.emission.0.iter().any(|&e| e > 0.0))
-        || !scene.lights.is_empty();
+        || scene
+            .lights
+            .iter()
+            .any(|l| l.flux() > 0.0 && l.colour.0.iter().any(|&c| c > 0.0));
     if emits || scene.surfaces.is_empty() {
         return None;
     }

@@ -55,10 +55,25 @@ pub fn run(args: ExportArgs) -> Result<()> {
     for out in &outputs {
         refuse_overwriting_inputs(out, &inputs)?;
     }
+    // Printed even with --quiet: the file will not hold what the scene holds.
+    let warn_lights = |scene: &radiosity::scene::Scene| {
+        if !scene.lights.is_empty() {
+            let names: Vec<&str> = scene.lights.iter().map(|l| l.name.as_str()).collect();
+            errln!(
+                "warning: {} point luminaire(s) left out of {} ({}): glTF and OBJ exports do \
+                 not carry LIGHTBEGIN blocks yet, so the file read back has only the emitting \
+                 surfaces",
+                names.len(),
+                output.display(),
+                names.join(", ")
+            );
+        }
+    };
     if format == Format::Obj {
-        return export_obj(&args, &reporter);
+        return export_obj(&args, &reporter, warn_lights);
     }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    warn_lights(&prepared.scene);
     let camera = camera(&args.camera, &prepared.scene)?;
     let solution = solve_as_asked(&prepared, solver, &args.solve, &reporter)?;
     let b = solution.element_rgb();
@@ -111,8 +126,13 @@ pub fn run(args: ExportArgs) -> Result<()> {
 /// `-o out.obj`: the scene's surfaces as they are (no meshing or solving; the mesh and
 /// solver flags do not apply), with the file's meshing settings (and --max-area,
 /// --steps) as comments.
-fn export_obj(args: &ExportArgs, reporter: &Reporter) -> Result<()> {
+fn export_obj(
+    args: &ExportArgs,
+    reporter: &Reporter,
+    warn_lights: impl Fn(&radiosity::scene::Scene),
+) -> Result<()> {
     let (file, _) = load_scene(args.scene.scene.as_deref(), args.scene.scale, reporter)?;
+    warn_lights(&file.scene);
     let settings = radiosity::mesh::MeshSettings {
         max_patch_area: args.scene.max_area.unwrap_or(file.settings.max_patch_area),
         integral_steps: args.scene.steps.unwrap_or(file.settings.integral_steps),

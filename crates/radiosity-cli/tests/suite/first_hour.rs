@@ -441,6 +441,20 @@ fn a_scene_that_emits_nothing_is_said_to_render_black() {
             && err.contains("Er, Eg or Eb above 0, LUMINANCE or FLUX, or a LIGHTBEGIN block"),
         "{err}"
     );
+    // A point luminaire of no flux gives no light either (QA: FLUX 0 rendered black
+    // without a word).
+    let zero_light = lamp_over_floor([0.0; 3]).replace(
+        "SCENEEND",
+        "LIGHTBEGIN\n#Off\nPOSITION 0 1 0\nFLUX 0\nDISTRIBUTION ISOTROPIC\nLIGHTEND\nSCENEEND",
+    );
+    std::fs::write(dir.join("off.scene"), zero_light).unwrap();
+    let out = radiosity(&["solve", "off.scene", "-o", "off.csv"], &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("off.scene: warning: nothing in the scene emits light"),
+        "{err}"
+    );
     // A lit scene: nothing said.
     std::fs::write(dir.join("lit.scene"), lamp_over_floor([1.0; 3])).unwrap();
     let out = radiosity(&["solve", "lit.scene", "-o", "lit.csv"], &dir);
@@ -627,5 +641,29 @@ fn bench_says_what_its_other_column_holds() {
         err.contains("other: end to end less the stages listed"),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn export_names_the_point_luminaires_it_cannot_write() {
+    // QA: an exported scene with LIGHTBEGIN blocks read back black, and nothing said so.
+    let dir = scratch_dir("export-lights");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/room_downlights.scene"
+    );
+    for out_name in ["dl.obj", "dl.glb"] {
+        let out = radiosity(
+            &["export", scene, "--max-area", "4", "-o", out_name, "-q"],
+            &dir,
+        );
+        let err = stderr(&out);
+        assert!(out.status.success(), "{err}");
+        assert!(
+            err.contains("warning: 2 point luminaire(s) left out of")
+                && err.contains("(Down1, Down2)"),
+            "{out_name}: {err}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
