@@ -661,7 +661,7 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
 pub fn element_illuminance(prepared: &Prepared, solution: &Solution) -> Vec<f64> {
     let scene = &prepared.scene;
     let mesh = &solution.mesh;
-    let (reflectance, shown) = reflectance_and_shown(scene, solution);
+    let (_, shown) = reflectance_and_shown(scene, solution);
     let mut out = vec![0.0; mesh.len()];
     let mut black = Vec::new();
     for (i, el) in mesh.elements.iter().enumerate() {

@@ -313,6 +313,36 @@ pub fn element_irradiance(
         .collect()
 }
 
+/// The lumens of `light` that land on the fronts of `mesh`'s elements, with occlusion by
+/// the scene's surfaces (`occluders`): [`power_onto`] over every element, as the first
+/// bounce takes it, in lumens of the untinted light (the tint's luminance divided out).
+/// The rest of [`Luminaire::flux`] lands on the backs of faces (a light inside furniture
+/// or behind a wall) or leaves the scene (a light outside the room, an open side), and
+/// none of it is in the solution; `check` reports the share.
+pub fn landing_flux(
+    mesh: &crate::mesh::Mesh,
+    light: &Luminaire,
+    occluders: &crate::visibility::PolygonBvh,
+) -> f64 {
+    use rayon::prelude::*;
+    let tint = light.colour.luminance();
+    if tint <= 0.0 {
+        return 0.0;
+    }
+    // Summed in element order, whatever the threads (the same figure every run).
+    let per_element: Vec<f64> = (0..mesh.len())
+        .into_par_iter()
+        .map(|e| {
+            let poly: Vec<DVec3> = mesh.corner_positions(e).collect();
+            power_onto(light, &poly, ELEMENT_SUBDIVISION, |x, y| {
+                occluders.segment_blocked(x, y)
+            })
+            .luminance()
+        })
+        .collect();
+    per_element.iter().sum::<f64>() / tint
+}
+
 #[cfg(test)]
 #[path = "luminaire_tests.rs"]
 mod tests;

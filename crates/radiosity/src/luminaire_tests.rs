@@ -446,3 +446,21 @@ fn hierarchical_radiosity_balances_a_point_light_and_agrees_with_the_dense_solve
     };
     assert!(d[facing(1.0)] > 2.0 * d[facing(-1.0)], "{d:?}");
 }
+
+#[test]
+fn every_lumen_lands_in_a_closed_room_and_none_from_outside_it() {
+    // An isotropic light at the centre of a closed cube: the elements' solid angles tile
+    // the sphere, so all 10 000 lm land on the fronts (rounding only). Moved outside the
+    // cube it reaches only the walls' backs: nothing lands.
+    let p = prepare(cube_with_light(
+        0.5,
+        "FLUX 10000\nDISTRIBUTION ISOTROPIC",
+        2.0,
+    ));
+    let occluders = crate::visibility::PolygonBvh::over_surfaces(&p.scene);
+    let inside = &p.scene.lights[0];
+    assert!((landing_flux(&p.mesh, inside, &occluders) - 10000.0).abs() < 1e-6);
+    let mut outside = inside.clone();
+    outside.position = dvec3(10.0, 2.0, 2.0);
+    assert_eq!(landing_flux(&p.mesh, &outside, &occluders), 0.0);
+}

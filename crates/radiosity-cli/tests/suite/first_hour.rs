@@ -667,3 +667,35 @@ fn export_names_the_point_luminaires_it_cannot_write() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn check_lists_the_point_lights_and_warns_of_one_whose_light_is_lost() {
+    // QA: a luminaire moved outside the room by a typo lost all its light, and `check`
+    // said nothing (its energy account counts only what lands).
+    let dir = scratch_dir("check-lights");
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/room_downlights.scene"
+    ))
+    .unwrap();
+    assert!(text.contains("POSITION 1.5 2.6 1.5"));
+    std::fs::write(
+        dir.join("far.scene"),
+        text.replace("POSITION 1.5 2.6 1.5", "POSITION 100 100 100"),
+    )
+    .unwrap();
+    let out = radiosity(&["check", "far.scene", "--max-area", "4"], &dir);
+    let (text, err) = (crate::fixtures::stdout(&out), stderr(&out));
+    assert!(out.status.success(), "{err}");
+    assert!(
+        text.contains("point lights      Down1 3000.0 lm at (100, 100, 100); 0.0 % lands"),
+        "{text}"
+    );
+    assert!(
+        err.contains("warning: point luminaire Down1 at (100, 100, 100): only 0.0 %"),
+        "{err}"
+    );
+    // The other one, in the room, lands (almost) whole and is not warned about.
+    assert!(!err.contains("luminaire Down2"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
