@@ -233,17 +233,7 @@ fn direct_cases_are_within_one_percent_through_the_program() {
         facade_opening(),
     ] {
         let computed = compute(&case, crate::Solver::DEFAULT_GAUSS_SEIDEL).unwrap();
-        for row in case.compare(&computed) {
-            assert!(
-                row.passes(case.tolerance_percent),
-                "case {} point {}: reference {} computed {} ({:?} %)",
-                row.case,
-                row.point,
-                row.reference,
-                row.computed,
-                row.difference_percent()
-            );
-        }
+        assert_rows_within_target(&case, &computed);
     }
 }
 
@@ -294,7 +284,12 @@ fn assert_within_target_at(case: &Case, max_patch_area: f64) {
         integral_steps: None,
     };
     let computed = compute_with(case, crate::Solver::DEFAULT_GAUSS_SEIDEL, overrides).unwrap();
-    for row in case.compare(&computed) {
+    assert_rows_within_target(case, &computed);
+}
+
+/// Every row of `case` against `computed` within the case's target.
+fn assert_rows_within_target(case: &Case, computed: &[(f64, f64)]) {
+    for row in case.compare(computed) {
         assert!(
             row.passes(case.tolerance_percent),
             "case {} point {}: reference {} computed {} ({:?} %)",
