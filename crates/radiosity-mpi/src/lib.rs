@@ -3,7 +3,7 @@
 //!
 //! This library holds what needs no MPI, so that it is built and tested everywhere: the
 //! dealing of row blocks ([`deal`]), the checkpoint directory ([`checkpoint`]) and the
-//! messages between the ranks ([`wire`]). The program (src/main.rs, feature `mpi`) runs the
+//! messages between the ranks ([`wire`]). The program (src/main.rs, default feature `mpi`) runs the
 //! ranks over them.
 
 pub mod checkpoint;
