@@ -29,6 +29,7 @@ mod adaptive;
 mod camera;
 mod direct;
 mod film;
+mod holes;
 mod renderer;
 #[cfg(test)]
 mod test_support;

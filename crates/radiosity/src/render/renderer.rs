@@ -11,7 +11,10 @@
 //!   the element a ray hits first are drawn).
 //!
 //! Surfaces are one-sided: a ray that reaches the back of an element sees black (the back
-//! reflects and emits nothing). A ray that hits nothing sees black.
+//! reflects and emits nothing). A ray that hits nothing sees black. Given the scene
+//! ([`Renderer::for_settings`]), a ray that meets a surface where no element covers it (a
+//! buried piece dropped, seen through a gap) sees the nearest element's light there
+//! ([`super::holes`]), not what lies behind the surface.
 //!
 //! [`Renderer::film`] casts the rays of a view, n x n per pixel, in parallel by rows, and
 //! writes what each sees into a linear [`Film`]: radiosity for flat and smooth shading,
@@ -27,6 +30,7 @@ use rayon::prelude::*;
 use super::adaptive::{refinement, Refine, Seen};
 use super::direct::DirectCorrection;
 use super::film::{sample_offset, Film, FilmContent};
+use super::holes::{nearest_element, Holes, Uncovered};
 use super::Camera;
 use crate::mesh::Mesh;
 use crate::progress::{run_stage, Progress, Stage};
@@ -60,6 +64,9 @@ pub struct Renderer<'m> {
     direct: Option<DirectCorrection<'m>>,
     /// Adaptive antialiasing's contrast threshold, when on ([`Renderer::with_adaptive_sampling`]).
     adaptive: Option<f64>,
+    /// The scene's surfaces, where rays meet the holes that dropped buried pieces leave
+    /// ([`Renderer::with_holes_covered`]).
+    holes: Option<Holes>,
 }
 
 impl<'m> Renderer<'m> {
@@ -114,6 +121,7 @@ impl<'m> Renderer<'m> {
             boundary_edges,
             direct: None,
             adaptive: None,
+            holes: None,
         }
     }
 
@@ -124,7 +132,9 @@ impl<'m> Renderer<'m> {
         scene: &Scene,
         settings: &super::RenderSettings,
     ) -> Renderer<'m> {
-        let mut renderer = Renderer::new(mesh).with_surfaces_on_top(scene);
+        let mut renderer = Renderer::new(mesh)
+            .with_surfaces_on_top(scene)
+            .with_holes_covered(scene);
         if settings.direct_light {
             renderer = renderer.with_direct_light(scene);
         }
@@ -170,6 +180,15 @@ impl<'m> Renderer<'m> {
             .collect();
         let ids: Vec<u32> = (0..self.mesh.len() as u32).collect();
         self.bvh = PolygonBvh::new(&polygons, &ids);
+        self
+    }
+
+    /// From now on a ray that meets a surface of `scene` (from which the mesh was cut)
+    /// where no element covers it, nearer than any element, shows the light of that
+    /// surface's nearest element there, or black at the back of the surface, instead of
+    /// passing through (see [`super::holes`]).
+    pub fn with_holes_covered(mut self, scene: &Scene) -> Renderer<'m> {
+        self.holes = Some(Holes::new(scene));
         self
     }
 
@@ -356,7 +375,30 @@ impl<'m> Renderer<'m> {
         }
         let (lo, hi) = self.bounds;
         let t_max = (eye - 0.5 * (lo + hi)).length() + (hi - lo).length() + 1.0;
-        let Some(hit) = self.bvh.closest_hit(eye, dir, 0.0, t_max) else {
+        let hit = self.bvh.closest_hit(eye, dir, 0.0, t_max);
+        if let Some(holes) = &self.holes {
+            match holes.uncovered(eye, dir, hit.map(|h| h.t), t_max) {
+                None => {}
+                Some(Uncovered::Back) => return Seen::NOTHING,
+                Some(Uncovered::Front { surface, x }) => {
+                    let Some((e, at)) = nearest_element(self.mesh, surface, x) else {
+                        return Seen::NOTHING;
+                    };
+                    let near = match shading {
+                        Shading::Flat => element_b[e],
+                        Shading::Smooth => interpolation(self.mesh, e, at).of(vertex_b),
+                        Shading::Wireframe => [0.0; 3],
+                    };
+                    let open = holes.open_share(surface, x);
+                    let value = near.map(|b| b * open);
+                    return Seen {
+                        value,
+                        surface: Some(surface),
+                    };
+                }
+            }
+        }
+        let Some(hit) = hit else {
             return Seen::NOTHING;
         };
         let e = hit.id as usize;
