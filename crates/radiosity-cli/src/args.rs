@@ -40,12 +40,16 @@ pub struct Cie171Args {
     /// Run only the cases whose id starts with this, e.g. 5.8 or 5.11.
     #[arg(long, value_name = "ID")]
     pub case: Option<String>,
+    /// Only the verdict line (no table, no list of sources); the exit status still says
+    /// whether every value is within its target.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Args)]
 pub struct BuildingArgs {
-    /// Output scene file.
-    #[arg(short, long, value_name = "FILE")]
+    /// Output scene file, named *.scene.
+    #[arg(short, long, value_name = "FILE.scene")]
     pub output: PathBuf,
     /// Storeys.
     #[arg(long, default_value_t = 2, value_name = "N")]
@@ -79,6 +83,9 @@ pub struct BuildingArgs {
     /// Exitance of the ceiling panels (W/m^2); windows emit 0.6 of it, bluish.
     #[arg(long, default_value_t = 20.0, value_name = "E")]
     pub light: f64,
+    /// No summary line (rooms, surfaces, size and element count; errors are still printed).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// Options every command shares.
@@ -175,6 +182,12 @@ pub struct SolveOptions {
     /// solves directly and takes none.
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
+    /// Dense solvers (auto, which then takes Gauss-Seidel, gauss-seidel, lu): read the form
+    /// factors from this file (written by `radiosity formfactors`) instead of computing
+    /// them; refused if it was made for another mesh or method, and with --solver
+    /// progressive or hierarchical or --adapt-rounds, which compute their own.
+    #[arg(long, value_name = "FILE")]
+    pub form_factors: Option<PathBuf>,
     /// Hierarchical: the BF refinement threshold, relative to the mean radiosity (smaller is
     /// finer and slower).
     #[arg(long, default_value_t = 0.05, value_name = "E")]
@@ -214,10 +227,6 @@ pub struct SolveOptions {
     /// got.
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     pub max_shots: usize,
-    /// Read form factors from this file (written by `radiosity formfactors`) instead of
-    /// computing them; refused if it was made for another mesh or method.
-    #[arg(long, value_name = "FILE")]
-    pub form_factors: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -311,13 +320,15 @@ pub struct CameraArgs {
     /// Eye position "x,y,z" (default: the scene's camera, or one that frames the scene).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
     pub eye: Option<DVec3>,
-    /// Point looked at "x,y,z".
+    /// Point looked at "x,y,z" (default: the scene's camera's, or the automatic camera's,
+    /// as for --eye).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
     pub look_at: Option<DVec3>,
-    /// Up direction "x,y,z".
+    /// Up direction "x,y,z" (default: the scene's camera's, or +y).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
     pub up: Option<DVec3>,
-    /// Vertical field of view in degrees.
+    /// Vertical field of view in degrees (default: the scene's camera's, or one that
+    /// frames the scene).
     #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
     pub fov: Option<f64>,
     /// Image width in pixels.
@@ -404,8 +415,8 @@ pub struct PathTraceArgs {
     pub camera: CameraArgs,
     /// Output of the path-traced view, PNG or, by extension, .exr (linear radiance)
     /// (default: <scene>-pathtrace.png). With --compare
-    /// the radiosity render and the error map go beside it, as <output>-radiosity.png and
-    /// <output>-error.png.
+    /// the radiosity render and the error map go beside it, as <output>-radiosity.png
+    /// (.exr for an .exr output) and <output>-error.png.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Paths per pixel (at least 2, for a standard error): the noise falls as 1/sqrt(N).
@@ -438,7 +449,8 @@ pub struct PathTraceArgs {
     /// --compare: the radiosity render's shading.
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
-    /// --compare: the radiosity render's rays, as for `render`.
+    /// --compare: the radiosity render's rays, as for `render` (--supersample,
+    /// --adaptive-contrast and --direct-light act on that render only).
     #[command(flatten)]
     pub rays: RayArgs,
     /// --compare: the relative error that saturates the error map's colours (blue: the
@@ -480,8 +492,9 @@ pub struct ExportArgs {
 pub struct FormFactorArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Output file (default: the scene's name with .ff).
-    #[arg(short, long, value_name = "FILE")]
+    /// Output file, named *.ff (default: the scene's name with .ff): the matrix in this
+    /// program's binary format, read back by --form-factors.
+    #[arg(short, long, value_name = "FILE.ff")]
     pub output: Option<PathBuf>,
 }
 
@@ -491,7 +504,8 @@ pub struct SolveArgs {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub solve: SolveOptions,
-    /// Output file: CSV, or JSON when it ends in .json (default: the scene's name with .csv).
+    /// Output file, named *.csv (CSV) or *.json (JSON) (default: the scene's name with
+    /// .csv).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Also write the per-surface report to this CSV file: one row per input surface with
@@ -691,6 +705,10 @@ pub struct ViewArgs {
     /// Frames timed per scene.
     #[arg(long, default_value_t = 30, value_name = "N")]
     pub bench_frames: u32,
+    /// No notes (what a --screenshot wrote, --bench's line per measurement); errors and
+    /// warnings are still printed, --bench's tables too.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 // Value parsers. clap names the flag and the value in its message ("invalid value '1,2'

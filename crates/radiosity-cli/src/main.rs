@@ -11,7 +11,7 @@ use radiosity_cli::{args, commands, errors};
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use args::{
     BenchArgs, CheckArgs, CompareArgs, ExportArgs, FormFactorArgs, GenerateCommand,
@@ -79,7 +79,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|e| e.exit());
     // No output of this run may replace a file it read (an OBJ's MTL as much as the scene).
     radiosity::io::protect_inputs();
     match run(cli) {
@@ -89,6 +89,35 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The command line with every flag that takes a value accepting a negative number
+/// (`--tolerance -1`, `--scale -2`): clap otherwise reads "-1" as an unknown flag and
+/// suggests `-- -1`, which makes it a scene file name (QA of issue #16). The value is then
+/// refused, if it must be positive, by a message naming the flag and what it takes. The
+/// vectors (`--eye -1,2,3`) take any value starting with a hyphen (`allow_hyphen_values`).
+fn command() -> clap::Command {
+    fn negative_numbers(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|arg| {
+            if !arg.is_positional() && arg.get_action().takes_values() {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+        .mut_subcommands(negative_numbers)
+    }
+    negative_numbers(Cli::command())
+        // `check` prints its report, stage times included, whatever -q says: the shared
+        // help ("no progress bars, timings or notes") was untrue there.
+        .mut_subcommand("check", |check| {
+            check.mut_arg("quiet", |quiet| {
+                quiet.help(
+                    "No progress bars or lines (the report, with its stage times, is still \
+                     printed; errors too)",
+                )
+            })
+        })
 }
 
 fn run(cli: Cli) -> Result<()> {

@@ -45,7 +45,7 @@ impl Counting {
             Solver::Hierarchical(_) => Counting {
                 unit: "refinement rounds",
                 until: "hierarchical radiosity refines until a round changes almost no \
-                        links, then gathers",
+                        links (its final gather then counts its points)",
             },
             _ => return None,
         })

@@ -60,6 +60,7 @@ fn prepare_solve_as(
     reporter: &Reporter,
     method_used_elsewhere: bool,
 ) -> Result<(Prepared, String, Solver)> {
+    check_form_factor_file(options)?;
     let (prepared, stem) = prepare_scene(args, reporter)?;
     let solver = solver(
         options,
@@ -93,6 +94,37 @@ fn prepare_solve_as(
     }
     note_scene(&prepared, &stem, reporter);
     Ok((prepared, stem, solver))
+}
+
+/// `--form-factors FILE` against the flags it cannot go with, and the file readable, before
+/// the scene is read and meshed (QA of issue #16: a missing file, or `--solver progressive`
+/// beside it, was found only after the meshing and contact refinement, seconds on a large
+/// scene). Whether the file fits the mesh is checked when it is read.
+fn check_form_factor_file(options: &SolveOptions) -> Result<()> {
+    let Some(path) = options.form_factors.as_deref() else {
+        return Ok(());
+    };
+    match options.solver.0 {
+        SolverKind::Progressive => bail!(
+            "--form-factors cannot be used with --solver progressive, which computes its rows \
+             as it shoots"
+        ),
+        SolverKind::Hierarchical => bail!(
+            "--form-factors cannot be used with --solver hierarchical, which uses links, not a \
+             matrix"
+        ),
+        _ => {}
+    }
+    if options.adapt_rounds.is_some_and(|r| r > 0) {
+        bail!(
+            "--adapt-rounds cannot be used with --form-factors: adaptive subdivision computes \
+             the form factors of the meshes it makes"
+        );
+    }
+    if let Err(e) = std::fs::File::open(path) {
+        bail!("cannot read form-factor file {}: {e}", path.display());
+    }
+    Ok(())
 }
 
 /// The method `--method` names when it was given (an explicit `--method area` too), which
@@ -420,7 +452,13 @@ fn solver(
         }
     }
     let choice = match options.solver.0 {
-        SolverKind::Auto if options.form_factors.is_some() => SolverKind::GaussSeidel,
+        SolverKind::Auto if options.form_factors.is_some() => {
+            reporter.note(
+                "solver auto: Gauss-Seidel on the dense matrix, the form factors read from \
+                 --form-factors",
+            );
+            SolverKind::GaussSeidel
+        }
         SolverKind::Auto => {
             let choice =
                 radiosity::solve::choose(n, radiosity::form_factor::available_memory_bytes());
@@ -480,9 +518,7 @@ fn solver(
             },
         )),
         SolverKind::Progressive => {
-            if options.form_factors.is_some() {
-                bail!("--form-factors cannot be used with --solver progressive, which computes its rows as it shoots");
-            }
+            // --form-factors with it is refused before the scene is read.
             if options.max_shots == 0 {
                 bail!("--max-shots must be at least 1");
             }
@@ -494,9 +530,7 @@ fn solver(
             })
         }
         SolverKind::Hierarchical => {
-            if options.form_factors.is_some() {
-                bail!("--form-factors cannot be used with --solver hierarchical, which uses links, not a matrix");
-            }
+            // --form-factors with it is refused before the scene is read.
             let min_area = options.min_area.unwrap_or(max_patch_area / 16.0);
             if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
                 bail!(
@@ -626,6 +660,28 @@ pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
             out.display()
         ),
     }
+}
+
+/// Refuses, before any work, an output named with none of the `extensions` (any case) it
+/// can be written as (QA of issue #16: `solve -o x.txt` wrote CSV into it without a word,
+/// an extensionless name too). `flag` names the option, `what` what is written.
+pub fn output_extension(output: &Path, flag: &str, what: &str, extensions: &[&str]) -> Result<()> {
+    let ext = output
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if ext.as_deref().is_some_and(|e| extensions.contains(&e)) {
+        return Ok(());
+    }
+    let names: Vec<String> = extensions.iter().map(|e| format!(".{e}")).collect();
+    let names = match names.as_slice() {
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} or {last}", init.join(", ")),
+        [] => String::new(),
+    };
+    bail!(
+        "{flag} {}: {what}; give it a {names} name",
+        output.display()
+    )
 }
 
 /// `--gamma`, checked.

@@ -25,6 +25,9 @@ pub enum Stage {
     Adapt,
     /// Solving the radiosity system (work unit: one band or one iteration).
     Solve,
+    /// Hierarchical radiosity's final gather, after its solve (work unit: one gather
+    /// point's terms, see [`crate::solve::HierarchicalSettings::final_gather`]).
+    Gather,
     /// Computing vertex radiosities.
     Shade,
     /// Rendering the image (work unit: one image row).
@@ -46,6 +49,7 @@ impl Stage {
             Stage::FormFactors => "form factors",
             Stage::Adapt => "adapt",
             Stage::Solve => "solve",
+            Stage::Gather => "final gather",
             Stage::Shade => "shade",
             Stage::Render => "render",
             Stage::PathTrace => "path trace",

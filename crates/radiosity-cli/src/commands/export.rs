@@ -131,6 +131,32 @@ fn export_obj(
     reporter: &Reporter,
     warn_lights: impl Fn(&radiosity::scene::Scene),
 ) -> Result<()> {
+    // The solve, exposure and camera flags bake the glTF; an OBJ holds the surfaces only
+    // (QA of issue #16: `-o x.obj --solver hierarchical --exposure 2` said nothing). A flag
+    // at its default value is not told apart from one left out. Printed even with --quiet.
+    let (s, c) = (&args.solve, &args.camera);
+    let given = [
+        ("--method", args.scene.method.method.is_some()),
+        ("--solver", s.solver.0 != radiosity::solve::SolverKind::Auto),
+        ("--tolerance", s.tolerance.is_some()),
+        ("--form-factors", s.form_factors.is_some()),
+        ("--min-area", s.min_area.is_some()),
+        ("--adapt-rounds", s.adapt_rounds.is_some()),
+        ("--exposure", !matches!(args.exposure, Exposure::Auto)),
+        ("--eye", c.eye.is_some()),
+        ("--look-at", c.look_at.is_some()),
+        ("--up", c.up.is_some()),
+        ("--fov", c.fov.is_some()),
+    ];
+    let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+    if !ignored.is_empty() {
+        errln!(
+            "warning: {} ignored: an .obj export writes the scene's surfaces with their \
+             reflectance and emission, unsolved (the solve, exposure and camera flags set the \
+             baked glTF of a .glb or .gltf name)",
+            ignored.join(", ")
+        );
+    }
     let (file, _) = load_scene(args.scene.scene.as_deref(), args.scene.scale, reporter)?;
     warn_lights(&file.scene);
     let settings = radiosity::mesh::MeshSettings {

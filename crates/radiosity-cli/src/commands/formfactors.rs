@@ -7,7 +7,7 @@ use anyhow::Result;
 use crate::args::FormFactorArgs;
 use crate::progress_bar::Reporter;
 use crate::report;
-use crate::setup::{prepare, refuse_overwriting_inputs, stem_of};
+use crate::setup::{output_extension, prepare, refuse_overwriting_inputs, stem_of};
 
 pub fn run(args: FormFactorArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
@@ -16,6 +16,13 @@ pub fn run(args: FormFactorArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.ff", stem_of(args.scene.scene.as_deref()))));
     refuse_overwriting_inputs(&output, &[("scene file", args.scene.scene.as_deref())])?;
+    output_extension(
+        &output,
+        "-o",
+        "the form factors are written in this program's binary matrix format, read back by \
+         --form-factors (`solve` writes radiosities as CSV)",
+        &["ff"],
+    )?;
     let (prepared, _) = prepare(&args.scene, &reporter)?;
     reporter.note(&format!(
         "form factors by {}; occlusion: {}",

@@ -21,12 +21,24 @@ pub fn building(args: BuildingArgs) -> Result<()> {
         integral_steps: args.steps,
         light: args.light,
     };
+    // The other commands read a scene by its extension (QA of issue #16: `-o b.txt` was
+    // written, then refused by every command that read it).
+    crate::setup::output_extension(
+        &args.output,
+        "-o",
+        "the building is written in the scene format (Appendix A), which the other \
+         commands read by the extension .scene",
+        &["scene"],
+    )?;
     if let Err(e) = params.check() {
         bail!("{e}");
     }
     let built = scene::building(&params);
     scene::write_scene_file(&built.scene, built.settings, &args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
+    if args.quiet {
+        return Ok(());
+    }
     // The element count the other commands will mesh the file into: the grid, then the
     // contact refinement that splits elements along the furniture's footprints (so the
     // count `check` and `render` print); the grid's alone where meshing would refuse it

@@ -7,7 +7,7 @@ use radiosity::progress::{run_stage, Stage};
 use super::solve_as_asked;
 use crate::args::IlluminanceArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{prepare_solve, refuse_overwriting_inputs};
+use crate::setup::{output_extension, prepare_solve, refuse_overwriting_inputs};
 
 /// The most grid points one run computes.
 const MAX_GRID_POINTS: usize = 1_000_000;
@@ -20,8 +20,15 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         ("form-factor file", args.solve.form_factors.as_deref()),
     ];
     refuse_overwriting_inputs(&args.output, &inputs)?;
+    output_extension(
+        &args.output,
+        "-o",
+        "the illuminance is written as a CSV table",
+        &["csv"],
+    )?;
     if let Some(png) = &args.png {
         refuse_overwriting_inputs(png, &inputs)?;
+        output_extension(png, "--png", "the grid's picture is a PNG", &["png"])?;
     }
     let (points, dims) = match (&args.points, args.grid) {
         (Some(path), _) => (illuminance::read_points(path)?, None),

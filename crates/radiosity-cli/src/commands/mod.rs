@@ -79,8 +79,22 @@ pub fn solve_scene(
             )),
         }
     }
+    // A dense solve of one mesh computes its form factors here, so that what they found
+    // (rays, row sums, the rows that see nothing) is said before the solve's line, not after
+    // it (QA of issue #16: "solved ..." came first). Adaptive subdivision makes its own.
+    let computed = match (&form_factors, &adapt) {
+        (FormFactors::Compute, None) if solver.needs_matrix() => {
+            let (f, stats) = prepared.form_factors(reporter)?;
+            report::form_factor_stats(prepared, &prepared.mesh, &stats, reporter);
+            Some((f, stats))
+        }
+        _ => None,
+    };
     let request = SolveRequest {
-        form_factors,
+        form_factors: match &computed {
+            Some((f, _)) => FormFactors::Matrix(f),
+            None => form_factors,
+        },
         adapt,
         ..SolveRequest::new(solver)
     };
@@ -101,14 +115,23 @@ pub fn solve_scene(
         }
         flow
     };
-    let solution = pipeline::solve(prepared, &request, &mut capping, reporter)?;
+    let mut solution = pipeline::solve(prepared, &request, &mut capping, reporter)?;
+    // The matrix is not kept past the solve (as the library's own computation does not).
+    let stats_said = match computed {
+        Some((f, stats)) => {
+            drop(f);
+            solution.form_factors = Some(stats);
+            true
+        }
+        None => false,
+    };
     if let (true, Some(s), SolutionReport::Progressive(r)) = (capped, cap, &solution.report) {
         reporter.note(&shot_cap_note(s.max_shots, s.tolerance, r.unshot_fraction));
     }
     if let Some(a) = &solution.adapt {
         report::adapt(a, reporter);
     }
-    if let Some(stats) = &solution.form_factors {
+    if let (Some(stats), false) = (&solution.form_factors, stats_said) {
         report::form_factor_stats(prepared, &solution.mesh, stats, reporter);
     }
     report::energy_note(&solution, reporter);

@@ -71,6 +71,37 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             ),
             ("--tolerance", args.solve.tolerance.is_some()),
             ("--form-factors", args.solve.form_factors.is_some()),
+            (
+                "--epsilon",
+                args.solve.epsilon != radiosity::solve::HierarchicalSettings::DEFAULT_EPSILON,
+            ),
+            ("--min-area", args.solve.min_area.is_some()),
+            ("--no-final-gather", args.solve.no_final_gather),
+            (
+                "--gather-points",
+                args.solve.gather_points != radiosity::solve::GATHER_POINTS_DEFAULT,
+            ),
+            ("--adapt-rounds", args.solve.adapt_rounds.is_some()),
+            (
+                "--max-shots",
+                args.solve.max_shots != radiosity::solve::ProgressiveSettings::default().max_shots,
+            ),
+        ];
+        // The flags of the radiosity render --compare draws beside it (QA of issue #16:
+        // `pathtrace --supersample 2` was ignored without a word). A flag at its default
+        // value is not told apart from one left out.
+        let render_given = [
+            ("--shading", args.shading != crate::args::ShadingArg::Smooth),
+            ("--supersample", args.rays.supersample != 8),
+            (
+                "--adaptive-contrast",
+                args.rays.adaptive_contrast != crate::args::RayArgs::ADAPTIVE_CONTRAST,
+            ),
+            (
+                "--direct-light",
+                args.rays.direct_light != crate::args::DirectLightArg::Gather,
+            ),
+            ("--error-scale", args.error_scale != 0.2),
         ];
         let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
         if !ignored.is_empty() {
@@ -78,6 +109,15 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                 "warning: {} ignored without --compare: the path tracer traces the scene's \
                  polygons (the meshing, form-factor and solver flags set the radiosity solve \
                  --compare adds)",
+                ignored.join(", ")
+            );
+        }
+        let ignored: Vec<&str> = render_given.iter().filter(|g| g.1).map(|g| g.0).collect();
+        if !ignored.is_empty() {
+            errln!(
+                "warning: {} ignored without --compare: they set the radiosity render \
+                 --compare draws beside the path-traced view (the path tracer averages over \
+                 each pixel with --paths)",
                 ignored.join(", ")
             );
         }

@@ -8,7 +8,7 @@ use radiosity::progress::{run_stage, Stage};
 use super::solve_as_asked;
 use crate::args::SolveArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{prepare_solve, refuse_overwriting_inputs, stem_of};
+use crate::setup::{output_extension, prepare_solve, refuse_overwriting_inputs, stem_of};
 
 pub fn run(args: SolveArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
@@ -21,8 +21,20 @@ pub fn run(args: SolveArgs) -> Result<()> {
         ("form-factor file", args.solve.form_factors.as_deref()),
     ];
     refuse_overwriting_inputs(&output, &inputs)?;
+    output_extension(
+        &output,
+        "-o",
+        "the element radiosities are written as CSV, or JSON for a .json name",
+        &["csv", "json"],
+    )?;
     if let Some(report) = &args.report {
         refuse_overwriting_inputs(report, &inputs)?;
+        output_extension(
+            report,
+            "--report",
+            "the per-surface report is a CSV table",
+            &["csv"],
+        )?;
         if radiosity::io::is_same_file(report, &output) || report == &output {
             bail!(
                 "--report {} is the solution's output too; give the report another name",

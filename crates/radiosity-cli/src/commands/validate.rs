@@ -33,9 +33,17 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
         );
     }
     let dir = tempfile_dir()?;
-    println!("| case | point | reference (lx) | computed (lx) | difference (%) | target (%) |");
-    println!("|---|---|---:|---:|---:|---:|");
+    let quiet = args.quiet;
+    // The table and the sources are left out with --quiet; the verdict never is.
+    let say = |line: &str| {
+        if !quiet {
+            println!("{line}");
+        }
+    };
+    say("| case | point | reference (lx) | computed (lx) | difference (%) | target (%) |");
+    say("|---|---|---:|---:|---:|---:|");
     let mut failures = Vec::new();
+    let mut values = 0usize;
     for case in &cases {
         let scene = dir.join(format!("{}.scene", case.stem));
         std::fs::write(&scene, &case.scene)
@@ -43,25 +51,49 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
         let computed = illuminance(&scene, case)
             .with_context(|| format!("case {} ({})", case.id, case.title))?;
         for row in case.compare(&computed) {
-            println!("{}", table_row(&row, case.tolerance_percent));
+            say(&table_row(&row, case.tolerance_percent));
+            values += 1;
             if !row.passes(case.tolerance_percent) {
                 failures.push(format!("{} {}", row.case, row.point));
             }
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
-    println!();
+    say("");
     for case in &cases {
-        println!("{}: {}; reference: {}", case.id, case.title, case.source);
+        say(&format!(
+            "{}: {}; reference: {}",
+            case.id, case.title, case.source
+        ));
     }
-    if !failures.is_empty() {
-        bail!(
-            "{} value(s) outside the targets: {}",
-            failures.len(),
-            failures.join(", ")
-        );
+    let (line, passed) = verdict(values, &failures);
+    say("");
+    println!("{line}");
+    if !passed {
+        bail!("{line}");
     }
     Ok(())
+}
+
+/// The run's last line, and whether it passed: every value within its target, or how many
+/// and which are not (QA of issue #16: a passing run ended with the list of sources and no
+/// word on the outcome).
+pub fn verdict(values: usize, failures: &[String]) -> (String, bool) {
+    if failures.is_empty() {
+        (
+            format!("verdict: PASS, all {values} values within their targets"),
+            true,
+        )
+    } else {
+        (
+            format!(
+                "verdict: FAIL, {} of {values} values outside their targets: {}",
+                failures.len(),
+                failures.join(", ")
+            ),
+            false,
+        )
+    }
 }
 
 fn table_row(row: &Row, target: f64) -> String {
@@ -92,4 +124,23 @@ fn illuminance(scene: &Path, case: &Case) -> Result<Vec<(f64, f64)>> {
         case,
         radiosity::Solver::DEFAULT_GAUSS_SEIDEL,
     )?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::verdict;
+
+    #[test]
+    fn the_verdict_says_pass_or_names_what_failed() {
+        let (line, passed) = verdict(3, &[]);
+        assert!(passed);
+        assert_eq!(line, "verdict: PASS, all 3 values within their targets");
+        let failed = ["5.7 ceiling_2".to_string(), "5.8 rho 0.95".to_string()];
+        let (line, passed) = verdict(40, &failed);
+        assert!(!passed);
+        assert_eq!(
+            line,
+            "verdict: FAIL, 2 of 40 values outside their targets: 5.7 ceiling_2, 5.8 rho 0.95"
+        );
+    }
 }

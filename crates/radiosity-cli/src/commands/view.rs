@@ -11,6 +11,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
     use radiosity::solve::SolverKind;
     use radiosity_viewer::{worker::ViewSolver, ViewerOptions};
 
+    let quiet = args.quiet;
     if args.steps == Some(0) {
         bail!("--steps must be at least 1");
     }
@@ -23,7 +24,11 @@ pub fn run(args: ViewArgs) -> Result<()> {
             &args.bench_elements,
             args.bench_triangles,
             args.bench_frames,
-            &mut |line| errln!("view --bench: {}", line.trim_end()),
+            &mut |line| {
+                if !quiet {
+                    errln!("view --bench: {}", line.trim_end())
+                }
+            },
         )
         .map_err(anyhow::Error::msg)?;
         outln!("{table}");
@@ -81,7 +86,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
     options.select = args.select;
     options.shading = args.shading;
     for note in radiosity_viewer::run(options)? {
-        outln!("{note}");
+        if !quiet {
+            outln!("{note}");
+        }
     }
     Ok(())
 }

@@ -699,3 +699,441 @@ fn check_lists_the_point_lights_and_warns_of_one_whose_light_is_lost() {
     assert!(!err.contains("luminaire Down2"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_negative_number_is_taken_as_the_flags_value() {
+    // QA of issue #16: `--tolerance -1` was read as an unknown flag "-1", and clap's tip, to
+    // write `-- -1`, made it a scene file name. Every flag that takes a value takes a
+    // negative number; those that must be positive are then refused naming the flag (exit
+    // 1, after parsing), the vectors take it as a coordinate.
+    let dir = scratch_dir("negative");
+    for (args, needle) in [
+        (
+            vec!["solve", "--tolerance", "-1", "-o", "x.csv"],
+            "--tolerance must be a positive number, got -1",
+        ),
+        (
+            vec!["render", "--gamma", "-2.2", "-o", "x.png"],
+            "--gamma must be a positive number, got -2.2",
+        ),
+        (
+            vec!["render", "--fov", "-45", "-o", "x.png"],
+            "--fov must be between 0 and 180 degrees, got -45",
+        ),
+        (
+            vec!["render", "--solver", "hierarchical", "--epsilon", "-0.5"],
+            "--epsilon must be a positive number, got -0.5",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+    }
+    // A negative coordinate of the camera is a position like any other: the box's own eye
+    // moved to -x renders (a tiny picture, one ray a pixel, on the coarse box).
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--eye",
+            "-278,273,-800",
+            "--look-at",
+            "-100,273,280",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--supersample",
+            "1",
+            "-q",
+            "-o",
+            "neg.png",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.join("neg.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_output_name_of_a_format_not_written_is_refused_before_any_work() {
+    // QA of issue #16: `solve -o x.txt` wrote CSV into x.txt without a word (an
+    // extensionless name too), `illuminance --png g.jpg` a PNG. Each output's name is now
+    // checked first; the run stops with exit 1 and writes nothing.
+    let dir = scratch_dir("out-ext");
+    for (args, needle, file) in [
+        (
+            vec!["solve", "-o", "x.txt"],
+            "-o x.txt: the element radiosities are written as CSV, or JSON for a .json name; \
+             give it a .csv or .json name",
+            "x.txt",
+        ),
+        (
+            vec!["solve", "-o", "radiosities"],
+            "give it a .csv or .json name",
+            "radiosities",
+        ),
+        (
+            vec!["solve", "-o", "ok.csv", "--report", "surfaces.json"],
+            "--report surfaces.json: the per-surface report is a CSV table; give it a .csv name",
+            "ok.csv",
+        ),
+        (
+            vec!["formfactors", "-o", "matrix.csv"],
+            "-o matrix.csv: the form factors are written in this program's binary matrix \
+             format, read back by --form-factors (`solve` writes radiosities as CSV); give it \
+             a .ff name",
+            "matrix.csv",
+        ),
+        (
+            vec!["render", "-o", "out.jpg"],
+            "give the output a .png name, or .exr for linear radiance",
+            "out.jpg",
+        ),
+        (
+            vec![
+                "illuminance",
+                "--grid",
+                "0,0,0:500,0,500:100",
+                "--normal",
+                "0,1,0",
+                "-o",
+                "lux.txt",
+            ],
+            "-o lux.txt: the illuminance is written as a CSV table; give it a .csv name",
+            "lux.txt",
+        ),
+        (
+            vec![
+                "illuminance",
+                "--grid",
+                "0,0,0:500,0,500:100",
+                "--normal",
+                "0,1,0",
+                "-o",
+                "lux.csv",
+                "--png",
+                "lux.jpg",
+            ],
+            "--png lux.jpg: the grid's picture is a PNG; give it a .png name",
+            "lux.csv",
+        ),
+        (
+            vec!["generate", "building", "-o", "b.txt"],
+            "-o b.txt: the building is written in the scene format (Appendix A), which the \
+             other commands read by the extension .scene; give it a .scene name",
+            "b.txt",
+        ),
+        (
+            vec!["export", "-o", "scene.fbx"],
+            "give the output one of these extensions",
+            "scene.fbx",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        // Before any work: not even the scene was read (its note would come first).
+        assert!(!err.contains("elements"), "{args:?}: {err}");
+        assert!(!dir.join(file).exists(), "{args:?} wrote {file}");
+    }
+    // Any case of the right extension is taken.
+    let out = radiosity(
+        &["solve", "--max-area", "20000", "-q", "-o", "UP.CSV"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::read_to_string(dir.join("UP.CSV"))
+        .unwrap()
+        .starts_with("surface,element,area,"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn every_command_that_prints_notes_takes_quiet() {
+    // QA of issue #16: `generate`, `validate` and `view` had no -q.
+    let dir = scratch_dir("quiet-all");
+    let out = radiosity(
+        &[
+            "generate",
+            "building",
+            "-q",
+            "-o",
+            "b.scene",
+            "--floors",
+            "1",
+            "--rooms-x",
+            "1",
+            "--rooms-z",
+            "1",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.join("b.scene").exists());
+    assert_eq!(crate::fixtures::stdout(&out), "", "nothing but the file");
+    assert_eq!(stderr(&out), "");
+    // The same without -q says what it wrote: the quiet run above left something out.
+    let out = radiosity(
+        &[
+            "generate",
+            "building",
+            "-o",
+            "c.scene",
+            "--floors",
+            "1",
+            "--rooms-x",
+            "1",
+            "--rooms-z",
+            "1",
+        ],
+        &dir,
+    );
+    assert!(crate::fixtures::stdout(&out).contains("c.scene: 1 room, "));
+
+    // validate -q: the verdict alone, on the fastest case (direct light only).
+    let out = radiosity(&["validate", "cie171", "--case", "5.2", "-q"], &dir);
+    let text = crate::fixtures::stdout(&out);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert!(
+        text.starts_with("verdict: PASS, all ") && text.contains("values within their targets"),
+        "{text}"
+    );
+
+    // view takes -q (without a display or the window feature it stops later, with exit 1,
+    // not clap's exit 2 for an unknown flag): the flag check before any window runs.
+    let out = radiosity(&["view", "-q", "--steps", "0"], &dir);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("unexpected argument"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn validate_ends_with_a_verdict() {
+    // QA of issue #16: a passing run ended with the list of sources and nothing saying it
+    // passed.
+    let dir = scratch_dir("validate-verdict");
+    let out = radiosity(&["validate", "cie171", "--case", "5.2"], &dir);
+    let text = crate::fixtures::stdout(&out);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(text.contains("| 5.2 |"), "the table is there: {text}");
+    let last = text.lines().last().unwrap_or("");
+    assert!(last.starts_with("verdict: PASS, all "), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn hierarchical_radiositys_final_gather_is_timed_as_its_own_stage() {
+    // QA of issue #16: the final gather ran inside the solve stage, whose progress lines
+    // went on counting refinement rounds through a minute of gathering.
+    let dir = scratch_dir("gather-stage");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "solve",
+            "--max-area",
+            "20000",
+            "--solver",
+            "hierarchical",
+            "-o",
+            "h.csv",
+        ];
+        args.extend_from_slice(extra);
+        let out = radiosity(&args, &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let err = run(&[]);
+    let timings = err.lines().find(|l| l.starts_with("timings: ")).unwrap();
+    assert!(
+        timings.contains(", solve ") && timings.contains(", final gather "),
+        "{timings}"
+    );
+    let err = run(&["--no-final-gather"]);
+    let timings = err.lines().find(|l| l.starts_with("timings: ")).unwrap();
+    assert!(!timings.contains("final gather"), "{timings}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn pathtrace_says_which_compare_flags_it_ignores_without_compare() {
+    // QA of issue #16: `pathtrace --supersample 2 --shading flat` (the radiosity render's
+    // flags) and `--epsilon` (its solve's) did nothing without --compare, without a word.
+    let dir = scratch_dir("pathtrace-ignored");
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--supersample",
+            "2",
+            "--shading",
+            "flat",
+            "--epsilon",
+            "0.1",
+            "--paths",
+            "2",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "-q",
+            "-o",
+            "p.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: --shading, --supersample ignored without --compare"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: --epsilon ignored without --compare"),
+        "{err}"
+    );
+    // With --compare they are used: no such warning.
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--compare",
+            "--max-area",
+            "20000",
+            "--supersample",
+            "2",
+            "--shading",
+            "flat",
+            "--paths",
+            "2",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "-q",
+            "-o",
+            "c.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("ignored"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn form_factors_flag_is_checked_before_the_scene_is_meshed() {
+    // QA of issue #16: `--form-factors missing.ff`, or beside --solver progressive, was
+    // refused only after the scene was read and meshed (its note printed first); `auto`
+    // said nothing of the solver it took for the file.
+    let dir = scratch_dir("ff-order");
+    for (args, needle) in [
+        (
+            vec!["render", "--form-factors", "missing.ff", "-o", "x.png"],
+            "cannot read form-factor file missing.ff",
+        ),
+        (
+            vec![
+                "solve",
+                "--form-factors",
+                "missing.ff",
+                "--solver",
+                "progressive",
+            ],
+            "--form-factors cannot be used with --solver progressive",
+        ),
+        (
+            vec![
+                "solve",
+                "--form-factors",
+                "missing.ff",
+                "--solver",
+                "hierarchical",
+            ],
+            "--form-factors cannot be used with --solver hierarchical",
+        ),
+        (
+            vec![
+                "solve",
+                "--form-factors",
+                "missing.ff",
+                "--adapt-rounds",
+                "2",
+            ],
+            "--adapt-rounds cannot be used with --form-factors",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(
+            !err.contains("elements"),
+            "before the scene's note: {args:?}: {err}"
+        );
+    }
+    // A file that is there: auto says what it took.
+    let out = radiosity(
+        &["formfactors", "--max-area", "20000", "-q", "-o", "c.ff"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = radiosity(
+        &[
+            "solve",
+            "--max-area",
+            "20000",
+            "--form-factors",
+            "c.ff",
+            "-o",
+            "c.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("solver auto: Gauss-Seidel on the dense matrix, the form factors read from --form-factors"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_obj_export_says_which_solve_and_camera_flags_it_ignores() {
+    // QA of issue #16: `export -o x.obj --solver hierarchical --exposure 2 --eye 1,2,3`
+    // wrote the unsolved surfaces without a word about the flags.
+    let dir = scratch_dir("obj-ignored");
+    let out = radiosity(
+        &[
+            "export",
+            "-o",
+            "x.obj",
+            "--solver",
+            "hierarchical",
+            "--exposure",
+            "2",
+            "--eye",
+            "-1,2,3",
+            "-q",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(dir.join("x.obj").exists() && dir.join("x.mtl").exists());
+    assert!(
+        err.contains("warning: --solver, --exposure, --eye ignored: an .obj export writes"),
+        "{err}"
+    );
+    // Plain, nothing is said.
+    let out = radiosity(&["export", "-o", "y.obj", "-q"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stderr(&out), "");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

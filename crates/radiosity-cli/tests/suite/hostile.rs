@@ -261,7 +261,13 @@ fn work_past_the_limit_is_refused_before_it_starts_with_what_fits() {
         ),
     ] {
         let mut args = args.clone();
-        args.extend(["-o", "out.png"]);
+        // Each command's own kind of output (the name is checked first).
+        let output = if args[0] == "solve" {
+            "out.csv"
+        } else {
+            "out.png"
+        };
+        args.extend(["-o", output]);
         let out = radiosity(&args, &dir);
         let err = stderr(&out);
         assert!(!out.status.success(), "{args:?}: {err}");
@@ -355,9 +361,13 @@ fn an_objs_material_file_is_never_written_over() {
         assert!(!out.status.success(), "{args:?} succeeded");
         let err = stderr(&out);
         // The scene file itself has the command line's own message; every other input
-        // the library's.
+        // the library's. `solve` and `formfactors` refuse a .mtl name before reading
+        // anything (they write .csv or .json, and .ff): the MTL is as safe (below, the
+        // library's refusal is shown for material files named as they may write).
         assert!(
-            err.contains("an output never replaces an input") || err.contains("destroy the input"),
+            err.contains("an output never replaces an input")
+                || err.contains("destroy the input")
+                || (args[0] != "export" && err.contains(" room.mtl: the ")),
             "{args:?}: {err}"
         );
         assert_eq!(
@@ -370,6 +380,29 @@ fn an_objs_material_file_is_never_written_over() {
             obj,
             "{args:?}"
         );
+    }
+    // Material files with names `solve` and `formfactors` write: refused as inputs by the
+    // library.
+    for (command, flag, name) in [
+        ("solve", "-o", "mat.csv"),
+        ("solve", "--report", "mat.csv"),
+        ("formfactors", "-o", "mat.ff"),
+    ] {
+        let scene = format!("{command}.obj");
+        std::fs::write(dir.join(&scene), obj.replace("room.mtl", name)).unwrap();
+        std::fs::write(dir.join(name), mtl).unwrap();
+        let mut args = vec![command, &scene, flag, name];
+        if flag == "--report" {
+            args.extend(["-o", "out.csv"]);
+        }
+        let out = radiosity(&args, &dir);
+        assert!(!out.status.success(), "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains("an output never replaces an input"),
+            "{command}: {}",
+            stderr(&out)
+        );
+        assert_eq!(std::fs::read_to_string(dir.join(name)).unwrap(), mtl);
     }
     // An export named so that its own MTL is the input's (`mat.obj` writes `mat.mtl`).
     std::fs::write(dir.join("other.obj"), obj.replace("room.mtl", "mat.mtl")).unwrap();

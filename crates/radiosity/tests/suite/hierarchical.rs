@@ -721,3 +721,90 @@ fn memory_estimate_counts_the_refinement_frontier_of_a_many_sided_polygon() {
         "{err:?}"
     );
 }
+
+/// A progress sink that records each stage's start (with its total), its advances and its
+/// end, in order.
+#[derive(Default)]
+struct Recorder {
+    events: std::sync::Mutex<Vec<(radiosity::progress::Stage, &'static str, u64)>>,
+    current: std::sync::Mutex<Option<radiosity::progress::Stage>>,
+}
+
+impl radiosity::progress::Progress for Recorder {
+    fn start(&self, stage: radiosity::progress::Stage, total: u64) {
+        *self.current.lock().unwrap() = Some(stage);
+        self.events.lock().unwrap().push((stage, "start", total));
+    }
+    fn advance(&self, done: u64) {
+        let stage = self
+            .current
+            .lock()
+            .unwrap()
+            .expect("advance inside a stage");
+        self.events.lock().unwrap().push((stage, "advance", done));
+    }
+    fn finish(&self, stage: radiosity::progress::Stage, _elapsed: std::time::Duration) {
+        assert_eq!(
+            *self.current.lock().unwrap(),
+            Some(stage),
+            "stages do not nest"
+        );
+        *self.current.lock().unwrap() = None;
+        self.events.lock().unwrap().push((stage, "finish", 0));
+    }
+}
+
+#[test]
+fn the_final_gather_is_a_stage_that_counts_its_points() {
+    // QA of issue #16: the final gather ran inside the solve stage, whose progress lines
+    // counted refinement rounds that no longer changed, for a minute on large scenes. It is
+    // now its own stage after the solve, announced with its number of gather points and
+    // advanced once per point, so a progress line can give how far it is and the time left.
+    use radiosity::progress::Stage;
+    let (scene, max_area) = cornell();
+    let bvh = occluder_bvh(&scene);
+    let recorder = Recorder::default();
+    let s = solve_hierarchical(
+        &scene,
+        max_area,
+        &bvh,
+        &HierarchicalSettings::defaults_for(max_area),
+        &recorder,
+    )
+    .unwrap();
+    let events = recorder.events.into_inner().unwrap();
+    let starts: Vec<_> = events.iter().filter(|e| e.1 == "start").collect();
+    assert_eq!(
+        starts.iter().map(|e| e.0).collect::<Vec<_>>(),
+        [Stage::Solve, Stage::Gather],
+        "{starts:?}"
+    );
+    let points = s.report.gather_points as u64;
+    assert!(points > 0);
+    assert_eq!(
+        starts[1].2, points,
+        "the stage's total is its gather points"
+    );
+    let advanced: u64 = events
+        .iter()
+        .filter(|e| e.0 == Stage::Gather && e.1 == "advance")
+        .map(|e| e.2)
+        .sum();
+    assert_eq!(advanced, points, "each point counted once");
+
+    // Without the final gather there is no such stage.
+    let recorder = Recorder::default();
+    solve_hierarchical(
+        &scene,
+        max_area,
+        &bvh,
+        &HierarchicalSettings {
+            final_gather: false,
+            ..HierarchicalSettings::defaults_for(max_area)
+        },
+        &recorder,
+    )
+    .unwrap();
+    let events = recorder.events.into_inner().unwrap();
+    assert!(events.iter().all(|e| e.0 != Stage::Gather), "{events:?}");
+}

@@ -59,6 +59,7 @@ use super::link::{patch_form_factor, Link};
 use super::solver::Solver;
 use super::tree::NONE;
 use crate::form_factor::kernel::mean_cos_over_r2;
+use crate::progress::{Progress, Stage};
 
 /// The gather descends into a patch source's children while the source's radius is more than this
 /// fraction of its distance from the receiver. Measured on the Cornell box at 2,046
@@ -341,11 +342,30 @@ impl Solver<'_> {
     /// E + rho H from the irradiance H gathered at the leaf, iterated with the gathered
     /// terms to the solve's tolerance (or [`GATHER_PASSES`] passes where the terms are too
     /// many to keep), and returns each leaf's H.
-    pub(super) fn final_gather(&mut self) -> HashMap<u32, [f64; 3]> {
+    ///
+    /// It is its own stage, [`Stage::Gather`], whose work units are the gather points: each
+    /// is counted when its terms are made (the rays, most of the time); the passes over the
+    /// terms that follow are sums.
+    pub(super) fn final_gather(&mut self, progress: &dyn Progress) -> HashMap<u32, [f64; 3]> {
+        let start = std::time::Instant::now();
         self.split_leaves_to_cells();
         let (parent, leaves) = self.parents_and_leaves();
         let points = self.gather_points(&leaves, self.settings.gather_points);
         self.gathered_at = points.len();
+        progress.start(Stage::Gather, points.len() as u64);
+        let h = self.gather_at(&parent, &leaves, &points, progress);
+        progress.finish(Stage::Gather, start.elapsed());
+        h
+    }
+
+    /// [`Solver::final_gather`] at `points` (of `leaves`, whose parents are `parent`).
+    fn gather_at(
+        &mut self,
+        parent: &[u32],
+        leaves: &[u32],
+        points: &[u32],
+        progress: &dyn Progress,
+    ) -> HashMap<u32, [f64; 3]> {
         let walk = points.len() <= CLUSTER_WALK_MAX_POINTS;
         let mut from_clusters = if walk {
             Vec::new()
@@ -363,7 +383,7 @@ impl Solver<'_> {
         let mut kept: Vec<LeafTerms> = Vec::new();
         let mut bytes = 0u64;
         for chunk in points.chunks(TERM_CHUNK) {
-            let terms = self.leaf_terms(chunk, &parent, walk);
+            let terms = self.leaf_terms(chunk, parent, walk, Some(progress));
             bytes += terms.iter().map(LeafTerms::bytes).sum::<u64>();
             kept.extend(terms);
             if bytes > budget {
@@ -372,6 +392,14 @@ impl Solver<'_> {
             }
         }
         let cached = kept.len() == points.len();
+        if !cached {
+            progress.message(&format!(
+                "final gather: the terms of {} points pass the memory left ({} MiB); each of \
+                 {GATHER_PASSES} passes makes them again (the progress counts the first)",
+                points.len(),
+                budget >> 20
+            ));
+        }
         let passes = if cached {
             MAX_GATHER_PASSES
         } else {
@@ -395,7 +423,7 @@ impl Solver<'_> {
             } else {
                 let mut all = Vec::with_capacity(points.len());
                 for chunk in points.chunks(TERM_CHUNK) {
-                    let terms = self.leaf_terms(chunk, &parent, walk);
+                    let terms = self.leaf_terms(chunk, parent, walk, None);
                     all.extend(self.evaluate(&terms, &from_clusters));
                 }
                 all
@@ -403,7 +431,7 @@ impl Solver<'_> {
             h = if points.len() == leaves.len() {
                 at_points
             } else {
-                self.push_below_points(&points, &at_points, leaves.len())
+                self.push_below_points(points, &at_points, leaves.len())
             };
             let mut change = [0.0; 3];
             for (&l, hl) in leaves.iter().zip(&h) {
@@ -423,7 +451,7 @@ impl Solver<'_> {
                 break;
             }
         }
-        leaves.into_iter().zip(h).collect()
+        leaves.iter().copied().zip(h).collect()
     }
 
     /// Without the final gather: the leaves along contacts (pieces of partly buried cells)
@@ -443,7 +471,7 @@ impl Solver<'_> {
         } else {
             self.irradiance_from_clusters()
         };
-        let terms = self.leaf_terms(&leaves, &parent, walk);
+        let terms = self.leaf_terms(&leaves, &parent, walk, None);
         let h = self.evaluate(&terms, &from_clusters);
         for (&l, hl) in leaves.iter().zip(h) {
             let (s, e) = (
@@ -578,8 +606,15 @@ impl Solver<'_> {
         h
     }
 
-    /// The gather terms of `leaves`, in parallel; their rays are counted in the report.
-    fn leaf_terms(&mut self, leaves: &[u32], parent: &[u32], walk: bool) -> Vec<LeafTerms> {
+    /// The gather terms of `leaves`, in parallel; their rays are counted in the report, and
+    /// each leaf done in `progress` where given.
+    fn leaf_terms(
+        &mut self,
+        leaves: &[u32],
+        parent: &[u32],
+        walk: bool,
+        progress: Option<&dyn Progress>,
+    ) -> Vec<LeafTerms> {
         let this = &*self;
         let terms: Vec<LeafTerms> = leaves
             .par_iter()
@@ -614,6 +649,9 @@ impl Solver<'_> {
                     a = parent[a as usize];
                 }
                 t.root = if walk { NONE } else { root };
+                if let Some(p) = progress {
+                    p.advance(1);
+                }
                 t
             })
             .collect();

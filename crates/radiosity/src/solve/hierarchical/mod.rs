@@ -390,7 +390,7 @@ pub fn solve_hierarchical(
                 .sum::<f64>()
     });
 
-    let (rounds, iterations, initial_links, residual, gathered) =
+    let (rounds, iterations, initial_links, residual, lit) =
         run_stage(progress, Stage::Solve, 0, || -> Result<_, SolveError> {
             // Power bins and mean B from the emission.
             solver.push_pull(solver.top, &[[0.0; 6]; 3], &mut None);
@@ -403,7 +403,7 @@ pub fn solve_hierarchical(
             let initial_links = solver.nodes.iter().map(|n| n.links.len()).sum();
             let (mut iterations, mut rounds, mut residual) = (0, 0, 0.0);
             if max3(emitted) == 0.0 {
-                return Ok((rounds, iterations, initial_links, residual, None));
+                return Ok((rounds, iterations, initial_links, residual, false));
             }
             // The rounds before the last only feed the oracle, which compares B to 5 % or
             // so: they solve to ROUND_TOLERANCE, the last to the settings' tolerance.
@@ -433,10 +433,12 @@ pub fn solve_hierarchical(
                     break;
                 }
             }
-            // The final gather, at each leaf's own resolution.
-            let gathered = settings.final_gather.then(|| solver.final_gather());
-            Ok((rounds, iterations, initial_links, residual, gathered))
+            Ok((rounds, iterations, initial_links, residual, true))
         })?;
+    // The final gather, at each leaf's own resolution: a stage of its own, with the gather
+    // points as its progress (QA of issue #16: on large scenes it ran for a minute inside
+    // the solve stage, whose lines counted refinement rounds that no longer changed).
+    let gathered = (settings.final_gather && lit).then(|| solver.final_gather(progress));
 
     // Each leaf's total irradiance, for the energy account (gathered again at each leaf, or
     // pushed down); the leaves as a mesh; where the emitted power went.
