@@ -33,8 +33,11 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
         );
     }
     let dir = tempfile_dir()?;
-    println!("| case | point | reference (lx) | computed (lx) | difference (%) | target (%) |");
-    println!("|---|---|---:|---:|---:|---:|");
+    println!(
+        "| case | point | reference (lx) | computed (lx) | difference (%) | target (%) | \
+         reference from |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---|");
     let mut failures = Vec::new();
     for case in &cases {
         let scene = dir.join(format!("{}.scene", case.stem));
@@ -43,7 +46,7 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
         let computed = illuminance(&scene, case)
             .with_context(|| format!("case {} ({})", case.id, case.title))?;
         for row in case.compare(&computed) {
-            println!("{}", table_row(&row, case.tolerance_percent));
+            println!("{}", table_row(&row, case));
             if !row.passes(case.tolerance_percent) {
                 failures.push(format!("{} {}", row.case, row.point));
             }
@@ -51,8 +54,9 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
     }
     let _ = std::fs::remove_dir_all(&dir);
     println!();
+    println!("{}.", cie171::GEOMETRY_NOTE);
     for case in &cases {
-        println!("{}: {}; reference: {}", case.id, case.title, case.source);
+        println!("\n{}", case.provenance());
     }
     if !failures.is_empty() {
         bail!(
@@ -64,14 +68,20 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
     Ok(())
 }
 
-fn table_row(row: &Row, target: f64) -> String {
+fn table_row(row: &Row, case: &Case) -> String {
     let difference = match row.difference_percent() {
         Some(d) => format!("{d:+.3}"),
         None => "(reference 0)".to_string(),
     };
     format!(
-        "| {} | {} | {:.3} | {:.3} | {} | {} |",
-        row.case, row.point, row.reference, row.computed, difference, target
+        "| {} | {} | {:.3} | {:.3} | {} | {} | {} |",
+        row.case,
+        row.point,
+        row.reference,
+        row.computed,
+        difference,
+        case.tolerance_percent,
+        case.reference_from.label()
     )
 }
 
