@@ -31,6 +31,9 @@ pub enum Stage {
     Render,
     /// Path tracing a view (work unit: one image row), see [`crate::pathtrace`].
     PathTrace,
+    /// Illuminance at calculation points (work unit: one point), see
+    /// [`crate::illuminance`].
+    Illuminance,
     /// Writing output files.
     Write,
 }
@@ -49,6 +52,7 @@ impl Stage {
             Stage::Shade => "shade",
             Stage::Render => "render",
             Stage::PathTrace => "path trace",
+            Stage::Illuminance => "illuminance",
             Stage::Write => "write",
         }
     }
