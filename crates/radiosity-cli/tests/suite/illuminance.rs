@@ -156,8 +156,9 @@ fn render_false_colour_draws_lux_with_a_scale_bar_and_refuses_what_it_cannot_dra
     assert!(out.status.success(), "{err}");
     assert!(err.contains("false colour from 0 to"), "{err}");
     let png = image::open(dir.join("fc.png")).unwrap().to_rgb8();
-    // The view and a 100 pixel scale bar beside it; the bar's height at least 160.
-    assert_eq!(png.width(), 64 + 100);
+    // The view and a 110 pixel scale bar beside it (its values in 9 x 15 px figures);
+    // the bar's height at least 160.
+    assert_eq!(png.width(), 64 + 110);
     assert!(png.height() >= 160);
     // The view is coloured (the ramp has no grey), not shaded grey.
     let coloured = png
