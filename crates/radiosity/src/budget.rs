@@ -123,6 +123,46 @@ pub const MAX_RENDER_RAYS: f64 = 2e9;
 /// took 1.8 s on two cores, 5.9e5 a second; 2e9 is about an hour.
 pub const MAX_PATHS: f64 = 2e9;
 
+/// Point-element pairs `radiosity illuminance` may compute (calculation points x elements
+/// of the solved mesh; each pair is an exact point-to-polygon form factor and up to 9 shadow
+/// rays, more where a point luminaire's first bounce is integrated at the point): measured
+/// on the two-core machine (load about 5) at 1.5e5 pairs a second in the downlight room
+/// (6,561 points x 320 elements in 14.1 s) and 6.5e5 with surface emitters only
+/// (examples/room.scene, 7,821 x 899 in 10.8 s; BENCHMARKS.md, "illuminance"), so 1e9 is
+/// about 2 hours at the slower rate and 25 minutes at the faster.
+pub const MAX_POINT_ELEMENT_PAIRS: f64 = 1e9;
+
+/// Checks an illuminance run of `points` calculation points on a solution of `elements`
+/// elements; the error says how many points (or elements) would fit, and the caller may
+/// add what that means for its grid.
+pub fn check_illuminance_work(points: usize, elements: usize) -> Result<(), TooMuchWork> {
+    let (p, n) = (points as f64, elements as f64);
+    let amount = p * n;
+    if amount <= MAX_POINT_ELEMENT_PAIRS {
+        return Ok(());
+    }
+    Err(TooMuchWork {
+        what: format!("{points} calculation points on {elements} elements"),
+        amount,
+        unit: "point-element pairs",
+        limit: MAX_POINT_ELEMENT_PAIRS,
+        rate: "about 2 hours on two cores at the 1.5e5 a second measured with a point \
+               luminaire",
+        fits: format!(
+            "at most {} points on these elements would fit, or these points on at most {} \
+             elements (a larger MAX_PATCH_AREA, --max-area)",
+            most_illuminance_points(elements),
+            (MAX_POINT_ELEMENT_PAIRS / p).floor()
+        ),
+    })
+}
+
+/// The most calculation points [`check_illuminance_work`] lets through on `elements`
+/// elements.
+pub fn most_illuminance_points(elements: usize) -> usize {
+    (MAX_POINT_ELEMENT_PAIRS / (elements.max(1) as f64)).floor() as usize
+}
+
 /// Checks the form factors of `elements` elements by `method` against the limits above.
 pub fn check_form_factor_work(
     method: FormFactorMethod,
@@ -244,6 +284,24 @@ pub fn check_path_trace_work(width: u32, height: u32, paths: u32) -> Result<(), 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_illuminance_run_of_hours_is_refused_with_the_points_that_fit() {
+        // 1,000,000 points on 100,000 elements: 1e11 pairs, 100 times the 1e9 limit, so
+        // 10,000 points fit on these elements, or 1,000 elements for these points.
+        let err = check_illuminance_work(1_000_000, 100_000).unwrap_err();
+        assert_eq!(err.amount, 1e11);
+        let text = err.to_string();
+        assert!(text.contains("at most 10000 points"), "{text}");
+        assert!(text.contains("at most 1000 elements"), "{text}");
+        // What it says fits does fit; one more point does not.
+        assert_eq!(most_illuminance_points(100_000), 10_000);
+        assert!(check_illuminance_work(10_000, 100_000).is_ok());
+        assert!(check_illuminance_work(10_001, 100_000).is_err());
+        assert!(check_illuminance_work(1_000_000, 1_000).is_ok());
+        // An ordinary run passes: a 100 x 100 grid in a room of 20,000 elements is 2e8.
+        assert!(check_illuminance_work(10_000, 20_000).is_ok());
+    }
 
     #[test]
     fn integral_steps_1000_on_13_elements_is_refused_with_what_fits() {

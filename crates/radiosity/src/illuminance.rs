@@ -74,6 +74,18 @@ fn reflectance_and_shown(scene: &crate::scene::Scene, solution: &Solution) -> (V
 /// radiosity's leaves). Points run in parallel; the result is in the order of `points` and
 /// does not depend on threads.
 pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint]) -> Vec<Lux> {
+    illuminance_with_progress(prepared, solution, points, &crate::progress::NoProgress)
+}
+
+/// [`illuminance`], reporting each finished point to `progress` as one `advance(1)` of
+/// the current stage (the caller starts and finishes [`crate::progress::Stage::Illuminance`]
+/// with `points.len()` units), so that a run of hours is never silent.
+pub fn illuminance_with_progress(
+    prepared: &Prepared,
+    solution: &Solution,
+    points: &[CalcPoint],
+    progress: &dyn crate::progress::Progress,
+) -> Vec<Lux> {
     let scene = &prepared.scene;
     let direct = DirectLight::new(scene);
     let mesh = &solution.mesh;
@@ -113,6 +125,14 @@ pub fn illuminance(prepared: &Prepared, solution: &Solution, points: &[CalcPoint
         .par_iter()
         .enumerate()
         .map(|(k, p)| {
+            // One unit of progress per point, whichever way it returns.
+            struct Tick<'a>(&'a dyn crate::progress::Progress);
+            impl Drop for Tick<'_> {
+                fn drop(&mut self) {
+                    self.0.advance(1);
+                }
+            }
+            let _tick = Tick(progress);
             let n = p.normal.normalize_or_zero();
             if n == DVec3::ZERO {
                 return Lux::default();
@@ -482,11 +502,21 @@ fn glyph(c: char) -> Option<[u8; 5]> {
         '9' => [7, 5, 7, 1, 7],
         '.' => [0, 0, 0, 0, 2],
         '-' => [0, 0, 7, 0, 0],
-        'l' => [4, 4, 4, 4, 3],
+        'l' => [6, 2, 2, 2, 3],
         'x' => [0, 5, 2, 5, 5],
+        'y' => [5, 5, 7, 1, 7],
+        'z' => [7, 1, 2, 4, 7],
         'u' => [0, 5, 5, 5, 7],
         'e' => [7, 5, 7, 4, 7],
         '+' => [0, 2, 7, 2, 0],
+        '/' => [1, 1, 2, 4, 4],
+        'A' => [2, 5, 7, 5, 5],
+        'E' => [7, 4, 6, 4, 7],
+        'I' => [7, 2, 2, 2, 7],
+        'M' => [5, 7, 7, 5, 5],
+        'N' => [6, 5, 5, 5, 5],
+        'U' => [5, 5, 5, 5, 7],
+        'X' => [5, 5, 2, 5, 5],
         ' ' => [0; 5],
         _ => return None,
     })
@@ -556,18 +586,143 @@ pub fn lux_label(v: f64) -> String {
     }
 }
 
-/// The grid as lighting tools draw it: one cell per point coloured by its value on the
-/// false-colour scale from 0 to the largest value, the value printed in the cell (where it
-/// fits), row 0 at the bottom (a plan seen from above for a z-up floor grid), and on the
-/// right a scale bar with six values and the unit `lx`. `values` run column by column
-/// within rows (as [`grid`] makes them); `dims` = [columns, rows].
+/// The figures a lighting designer reads off a grid: the least, the mean and the largest
+/// illuminance, and the uniformity U0 = min / mean (EN 12464-1's measure); over the finite
+/// values, `None` when there are none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridSummary {
+    /// The least value, lux.
+    pub min: f64,
+    /// The mean of the values (the points of a regular grid stand for equal areas), lux.
+    pub mean: f64,
+    /// The largest value, lux.
+    pub max: f64,
+}
+
+impl GridSummary {
+    /// The summary of `values` (non-finite ones left out).
+    pub fn of(values: &[f64]) -> Option<Self> {
+        let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+        if finite.is_empty() {
+            return None;
+        }
+        Some(Self {
+            min: finite.iter().copied().fold(f64::INFINITY, f64::min),
+            mean: finite.iter().sum::<f64>() / finite.len() as f64,
+            max: finite.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        })
+    }
+
+    /// U0 = min / mean; 0 when the mean is not above 0.
+    pub fn uniformity(&self) -> f64 {
+        if self.mean > 0.0 {
+            self.min / self.mean
+        } else {
+            0.0
+        }
+    }
+
+    /// The line printed above the grid: "MIN 12.3  MEAN 45.6  MAX 78.9 lx  U0 0.27" (the
+    /// picture's font has capitals for these words only).
+    pub fn line(&self) -> String {
+        format!(
+            "MIN {}  MEAN {}  MAX {} lx  U0 {:.2}",
+            lux_label(self.min),
+            lux_label(self.mean),
+            lux_label(self.max),
+            self.uniformity()
+        )
+    }
+}
+
+/// The labels of a scale from 0 to `max` in `ticks` equal steps, all with the decimals the
+/// step needs and no more (0, 20, ..., 160; 0, 0.25, ..., 1.25; 0, 0.5, ..., 2.5 as
+/// 0.0, 0.5, ..., 2.5), so that a column of them reads at a glance.
+pub fn tick_labels(max: f64, ticks: usize) -> Vec<String> {
+    let ticks = ticks.max(1);
+    let step = max / ticks as f64;
+    let decimals = decimals_of(step);
+    (0..=ticks)
+        .map(|k| format!("{:.*}", decimals, step * k as f64))
+        .collect()
+}
+
+/// The fewest decimals (up to 4) that write every multiple of `step` exactly.
+fn decimals_of(step: f64) -> usize {
+    (0..=4)
+        .find(|&d| {
+            let scaled = step.abs() * 10f64.powi(d as i32);
+            (scaled - scaled.round()).abs() <= 1e-6 * scaled.max(1.0)
+        })
+        .unwrap_or(4)
+}
+
+/// Where a grid's columns and rows stand, for the coordinates printed along the picture's
+/// edges (a plan reads by its coordinates).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridAxes {
+    /// The axes along the columns and along the rows: 'x', 'y' or 'z'.
+    pub names: [char; 2],
+    /// The coordinate of column 0 and of row 0.
+    pub first: [f64; 2],
+    /// From one column (row) to the next: the spacing, signed.
+    pub step: [f64; 2],
+}
+
+impl GridAxes {
+    /// The axes of [`grid`]`(a, b, spacing, ..)` when it varies along two axes (a line or
+    /// a point has none to print).
+    pub fn of(a: DVec3, b: DVec3, spacing: f64) -> Option<Self> {
+        let varying: Vec<usize> = (0..3).filter(|&i| a[i] != b[i]).collect();
+        let [u, v] = varying[..] else { return None };
+        let name = |i: usize| ['x', 'y', 'z'][i];
+        Some(Self {
+            names: [name(u), name(v)],
+            first: [a[u], a[v]],
+            step: [
+                (b[u] - a[u]).signum() * spacing,
+                (b[v] - a[v]).signum() * spacing,
+            ],
+        })
+    }
+
+    /// The labels of `n` columns (`axis` 0) or rows (1), with the decimals of the step.
+    pub fn labels(&self, axis: usize, n: usize) -> Vec<String> {
+        let d = decimals_of(self.step[axis]).max(decimals_of(self.first[axis]));
+        (0..n)
+            .map(|k| {
+                let v = self.first[axis] + k as f64 * self.step[axis];
+                // + 0.0 writes -0 as 0.
+                format!("{:.*}", d, v + 0.0)
+            })
+            .collect()
+    }
+}
+
+/// The font scale of the scale bars' text (3 x 5 glyphs drawn 3 times: 9 x 15 pixels).
+const LEGEND_FONT: i64 = 3;
+
+/// The grid as lighting tools draw it: above it, the least, mean and largest illuminance and
+/// the uniformity U0 ([`GridSummary`]); one cell per point coloured by its value on the
+/// false-colour scale from 0 to a round top ([`nice_scale`] of the largest value), the value
+/// printed in the cell (where it fits), row 0 at the bottom (a plan seen from above for a
+/// z-up floor grid); on the right a scale bar with its values and the unit `lx`. `values`
+/// run column by column within rows (as [`grid`] makes them); `dims` = [columns, rows].
 pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
+    grid_picture_with_axes(values, dims, None)
+}
+
+/// [`grid_picture`] with the coordinates of the columns below the cells and of the rows
+/// left of them (every column or row where the labels fit, else every second, third, ...),
+/// each axis named at the end of its labels.
+pub fn grid_picture_with_axes(
+    values: &[f64],
+    dims: [usize; 2],
+    axes: Option<GridAxes>,
+) -> image::RgbImage {
     let [nu, nv] = dims;
-    let max = values
-        .iter()
-        .copied()
-        .filter(|v| v.is_finite())
-        .fold(0.0, f64::max);
+    let summary = GridSummary::of(values);
+    let (max, ticks) = nice_scale(summary.map_or(0.0, |s| s.max));
     let scale_of = |v: f64| if max > 0.0 { v / max } else { 0.0 };
     // Cells wide enough for the longest label at font scale 2 where the grid allows it.
     let longest = values
@@ -580,19 +735,65 @@ pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
         .min((1600 / nu.max(1) as i64).max(4))
         .min((1200 / nv.max(1) as i64).max(4));
     let (gw, gh) = (cell * nu as i64, cell * nv as i64);
-    let margin = 10;
-    let legend_w = 90;
-    let height = (gh + 2 * margin).max(240);
-    let width = gw + 2 * margin + legend_w;
+    let top = GRID_TOP;
+    let labels = axes.map(|a| (a.labels(0, nu), a.labels(1, nv)));
+    // Room for the row labels on the left and the column labels below.
+    let (left, below) = match &labels {
+        Some((_, rows)) => {
+            let widest = rows.iter().map(|l| text_width(l, 2)).max().unwrap_or(0);
+            (GRID_MARGIN + widest + 8, GRID_MARGIN + 20)
+        }
+        None => (GRID_MARGIN, GRID_MARGIN),
+    };
+    let margin = left;
+    let line = summary.map(|s| s.line()).unwrap_or_default();
+    // The scale bar runs beside the cells, 200 px at least.
+    let bar_bottom = top + gh.max(200);
+    let height = bar_bottom + below;
+    let width =
+        (gw + margin + GRID_MARGIN + GRID_LEGEND_WIDTH).max(text_width(&line, 2) + 2 * GRID_MARGIN);
     let mut img = image::RgbImage::from_pixel(width as u32, height as u32, image::Rgb([255; 3]));
+    draw_text(&mut img, GRID_MARGIN, 10, 2, &line, [0; 3]);
+    if let (Some((cols, rows)), Some(axes)) = (&labels, axes) {
+        // Every k-th column so that the labels keep 6 px apart; every k-th row so that
+        // they keep 4 px apart (10 px tall).
+        let widest = cols.iter().map(|l| text_width(l, 2)).max().unwrap_or(0);
+        let every_col = ((widest + 6 + cell - 1) / cell).max(1) as usize;
+        let every_row = ((14 + cell - 1) / cell).max(1) as usize;
+        for (i, label) in cols.iter().enumerate().step_by(every_col) {
+            let centre = margin + i as i64 * cell + cell / 2;
+            let x = centre - text_width(label, 2) / 2;
+            draw_text(&mut img, x, top + gh + 6, 2, label, [0; 3]);
+        }
+        for (j, label) in rows.iter().enumerate().step_by(every_row) {
+            let centre = top + (nv - 1 - j) as i64 * cell + cell / 2;
+            let x = margin - 6 - text_width(label, 2);
+            draw_text(&mut img, x, centre - 5, 2, label, [0; 3]);
+        }
+        // The axis names: the columns' right of their labels, the rows' above theirs.
+        let name = |c: char| c.to_string();
+        draw_text(
+            &mut img,
+            margin + gw + 6,
+            top + gh + 6,
+            2,
+            &name(axes.names[0]),
+            [0; 3],
+        );
+        draw_text(
+            &mut img,
+            margin - 18,
+            top - 16,
+            2,
+            &name(axes.names[1]),
+            [0; 3],
+        );
+    }
     for j in 0..nv {
         for i in 0..nu {
             let v = values.get(j * nu + i).copied().unwrap_or(0.0);
             let c = false_colour(scale_of(v));
-            let (x0, y0) = (
-                margin + i as i64 * cell,
-                margin + (nv - 1 - j) as i64 * cell,
-            );
+            let (x0, y0) = (margin + i as i64 * cell, top + (nv - 1 - j) as i64 * cell);
             for y in y0..y0 + cell {
                 for x in x0..x0 + cell {
                     let edge = x == x0 || y == y0;
@@ -618,35 +819,49 @@ pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
     }
     draw_scale_bar(
         &mut img,
-        gw + 2 * margin,
-        margin,
-        height - margin - 6,
+        gw + margin + GRID_MARGIN + 8,
+        top - 24,
+        bar_bottom,
         max,
-        5,
+        ticks,
     );
     img
 }
 
+/// The grid picture's margin left, right and below, pixels.
+pub const GRID_MARGIN: i64 = 10;
+/// Where the grid picture's cells start from the top (below the summary line), pixels.
+pub const GRID_TOP: i64 = 60;
+/// The width of the grid picture's scale bar and its values, pixels.
+pub const GRID_LEGEND_WIDTH: i64 = SCALE_BAR_WIDTH as i64;
+
 /// The scale bar of a false-colour picture, `lx` at its top left corner (x, y), the bar
-/// from y + 20 down to `bottom` (top = `max`, bottom = 0), and `ticks` + 1 values beside it
-/// (0 and `ticks` equal steps up to `max`); 90 pixels wide.
+/// from y + 24 down to `bottom` (top = `max`, bottom = 0), and `ticks` + 1 values beside it
+/// ([`tick_labels`]), in the [`LEGEND_FONT`]; [`SCALE_BAR_WIDTH`] wide at most.
 fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: f64, ticks: usize) {
-    let (by0, by1) = (y + 20, bottom);
-    draw_text(img, bx, y, 2, "lx", [0; 3]);
+    let (by0, by1) = (y + 24, bottom);
+    draw_text(img, bx, y, LEGEND_FONT, "lx", [0; 3]);
     for y in by0..by1 {
         let t = 1.0 - (y - by0) as f64 / (by1 - by0 - 1).max(1) as f64;
         for x in bx..bx + 18 {
             img.put_pixel(x as u32, y as u32, image::Rgb(false_colour(t)));
         }
     }
-    let ticks = ticks.max(1);
-    for k in 0..=ticks {
+    let labels = tick_labels(max, ticks);
+    let ticks = labels.len() - 1;
+    for (k, label) in labels.iter().enumerate() {
         let t = k as f64 / ticks as f64;
         let y = by1 - 1 - ((by1 - by0 - 1) as f64 * t).round() as i64;
-        for x in bx + 18..bx + 23 {
-            img.put_pixel(x as u32, y as u32, image::Rgb([0; 3]));
+        // A short tick, then a gap of 6 px, so that it does not read as a minus sign.
+        for x in bx + 18..bx + 21 {
+            for dy in 0..2 {
+                if y + dy < by1 {
+                    img.put_pixel(x as u32, (y + dy) as u32, image::Rgb([0; 3]));
+                }
+            }
         }
-        draw_text(img, bx + 26, (y - 5).max(0), 2, &lux_label(max * t), [0; 3]);
+        let half = 5 * LEGEND_FONT / 2;
+        draw_text(img, bx + 27, (y - half).max(0), LEGEND_FONT, label, [0; 3]);
     }
 }
 
@@ -659,6 +874,16 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
 /// at the element's centroid as [`illuminance`] computes it at a calculation point (direct
 /// plus indirect, exact form factors and shadow rays).
 pub fn element_illuminance(prepared: &Prepared, solution: &Solution) -> Vec<f64> {
+    element_illuminance_with_progress(prepared, solution, &crate::progress::NoProgress)
+}
+
+/// [`element_illuminance`], reporting the centroids it computes (the elements that do not
+/// reflect in every band) as [`crate::progress::Stage::Illuminance`], one unit a centroid.
+pub fn element_illuminance_with_progress(
+    prepared: &Prepared,
+    solution: &Solution,
+    progress: &dyn crate::progress::Progress,
+) -> Vec<f64> {
     let scene = &prepared.scene;
     let mesh = &solution.mesh;
     let (_, shown) = reflectance_and_shown(scene, solution);
@@ -681,7 +906,12 @@ pub fn element_illuminance(prepared: &Prepared, solution: &Solution) -> Vec<f64>
         }
     }
     if !black.is_empty() {
-        let lux = illuminance(prepared, solution, &black);
+        let lux = crate::progress::run_stage(
+            progress,
+            crate::progress::Stage::Illuminance,
+            black.len() as u64,
+            || illuminance_with_progress(prepared, solution, &black, progress),
+        );
         let mut k = 0;
         for (i, el) in mesh.elements.iter().enumerate() {
             if !scene.surfaces[el.surface as usize]
@@ -722,7 +952,7 @@ pub fn nice_scale(max: f64) -> (f64, usize) {
 }
 
 /// The width in pixels of the scale bar [`false_colour_picture`] adds on the right.
-pub const SCALE_BAR_WIDTH: u32 = 100;
+pub const SCALE_BAR_WIDTH: u32 = 110;
 
 /// A rendered view in false colour: `lux` and `coverage` per pixel (row by row from the
 /// top, `width` x `height`), coverage the fraction of the pixel's rays that met a surface

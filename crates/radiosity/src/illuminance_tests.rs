@@ -173,19 +173,77 @@ fn the_grid_picture_colours_cells_by_value_with_a_legend() {
     // 3 x 2 cells, values rising along the row; the largest is red, 0 dark blue.
     let values = [0.0, 50.0, 100.0, 25.0, 75.0, 100.0];
     let img = grid_picture(&values, [3, 2]);
-    assert!(img.width() > 3 * 24 && img.height() >= 240);
+    assert!(img.height() >= 260);
     assert_eq!(false_colour(0.0), [0, 0, 153]);
     assert_eq!(false_colour(1.0), [230, 26, 0]);
-    // Row 0 is drawn at the bottom: cell (0, 0) holds 0 (dark blue) at its corner pixel
-    // just inside the white grid line.
-    let cell = (img.width() as i64 - 20 - 90) / 3;
-    let bottom_left = img.get_pixel(10 + 1, (10 + 2 * cell - 2) as u32).0;
+    // The cells are 38 px: the widest value, "50.0", is 4 glyphs of 8 px less the last
+    // gap (30 px), plus 8. Row 0 is drawn at the bottom: cell (0, 0) holds 0 (dark blue)
+    // at its corner pixel just inside the white grid line; the top of the scale is 100
+    // (a round number already), so 25 is a quarter of it.
+    let cell = 38;
+    let (x, top) = ((GRID_MARGIN + 1) as u32, GRID_TOP);
+    let bottom_left = img.get_pixel(x, (top + 2 * cell - 2) as u32).0;
     assert_eq!(bottom_left, false_colour(0.0));
-    let top_left = img.get_pixel(10 + 1, 10 + 1).0;
+    let top_left = img.get_pixel(x, (top + 1) as u32).0;
     assert_eq!(top_left, false_colour(0.25));
+    // The summary line is drawn above the cells: black ink between y = 10 and 20.
+    let inked = (10..20)
+        .flat_map(|y| (0..img.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| img.get_pixel(x, y).0 == [0; 3])
+        .count();
+    assert!(inked > 100, "{inked}");
     assert_eq!(lux_label(1234.4), "1234");
     assert_eq!(lux_label(12.34), "12.3");
     assert_eq!(lux_label(1.234), "1.23");
+}
+
+#[test]
+fn the_grid_summary_gives_min_mean_max_and_the_uniformity() {
+    // 40, 60, 80, 100: mean 70, U0 = 40 / 70 = 0.571.
+    let s = GridSummary::of(&[40.0, 60.0, 80.0, 100.0, f64::NAN]).unwrap();
+    assert_eq!((s.min, s.mean, s.max), (40.0, 70.0, 100.0));
+    assert!((s.uniformity() - 4.0 / 7.0).abs() < 1e-15);
+    assert_eq!(s.line(), "MIN 40.0  MEAN 70.0  MAX 100 lx  U0 0.57");
+    // A dark grid: U0 0, not a division by zero.
+    assert_eq!(GridSummary::of(&[0.0, 0.0]).unwrap().uniformity(), 0.0);
+    assert_eq!(GridSummary::of(&[]), None);
+    // Every character of a summary line has a glyph (none is skipped in the picture).
+    for c in s.line().chars() {
+        assert!(glyph(c).is_some(), "{c:?}");
+    }
+}
+
+#[test]
+fn tick_labels_have_the_decimals_of_their_step() {
+    // 160 in 8 steps of 20: whole numbers (before, "0.00" and "20.0" beside "100").
+    assert_eq!(
+        tick_labels(160.0, 8),
+        ["0", "20", "40", "60", "80", "100", "120", "140", "160"]
+    );
+    // 250 in 5 steps of 50 (the 5.7 view's scale read "0.00", "50.0", "100").
+    assert_eq!(
+        tick_labels(250.0, 5),
+        ["0", "50", "100", "150", "200", "250"]
+    );
+    // Steps of 0.25 need two decimals, of 0.5 one, of 2500 none.
+    assert_eq!(
+        tick_labels(1.25, 5),
+        ["0.00", "0.25", "0.50", "0.75", "1.00", "1.25"]
+    );
+    assert_eq!(
+        tick_labels(2.5, 5),
+        ["0.0", "0.5", "1.0", "1.5", "2.0", "2.5"]
+    );
+    assert_eq!(tick_labels(12_500.0, 5)[5], "12500");
+    // Each label fits the scale bar beside a view at the legend's font.
+    for (max, ticks) in [(12_500.0, 5), (0.4, 8), (1.25, 5)] {
+        for label in tick_labels(max, ticks) {
+            assert!(
+                27 + text_width(&label, LEGEND_FONT) <= SCALE_BAR_WIDTH as i64 - 8,
+                "{label}"
+            );
+        }
+    }
 }
 
 #[test]
@@ -227,9 +285,9 @@ fn the_false_colour_picture_colours_pixels_by_lux_on_white_with_a_scale_bar() {
     let img = false_colour_picture(&[500.0], &[1.0], 1, 1, 200.0, 4);
     assert_eq!(img.get_pixel(0, 0).0, false_colour(1.0));
     // The bar: the top colour near its top, the bottom colour near its bottom (the bar is
-    // 18 px wide, 8 px right of the view, from y = 30 to 16 px above the bottom).
+    // 18 px wide, 8 px right of the view, from y = 34 to 16 px above the bottom).
     let (x, h) = (1 + 8 + 9, img.height());
-    assert_eq!(img.get_pixel(x, 30).0, false_colour(1.0));
+    assert_eq!(img.get_pixel(x, 34).0, false_colour(1.0));
     assert_eq!(img.get_pixel(x, h - 17).0, false_colour(0.0));
     // Black text ("lx" and the values) left of and beside the bar.
     let inked = (0..img.height())
@@ -249,4 +307,65 @@ fn nice_scales_step_in_round_numbers() {
     assert!((nice_scale(0.37).0 - 0.4).abs() < 1e-12);
     assert_eq!(nice_scale(12_345.0), (12_500.0, 5));
     assert_eq!(nice_scale(0.0), (0.0, 5));
+}
+
+#[test]
+fn illuminance_reports_one_unit_of_progress_per_point() {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    struct Count(AtomicU64);
+    impl crate::progress::Progress for Count {
+        fn start(&self, _: crate::progress::Stage, _: u64) {}
+        fn advance(&self, done: u64) {
+            self.0.fetch_add(done, Ordering::Relaxed);
+        }
+        fn finish(&self, _: crate::progress::Stage, _: std::time::Duration) {}
+    }
+    let (p, s) = solved(&black_floor(
+        "LIGHTBEGIN\n#L\nPOSITION 0 0 2\nINTENSITY 1000\nDISTRIBUTION ISOTROPIC\nLIGHTEND",
+    ));
+    // 7 points, one of them with no normal (it returns early and still counts).
+    let mut points: Vec<CalcPoint> = (0..6)
+        .map(|k| at(k as f64 * 0.5, 0.0, 0.0, DVec3::Z))
+        .collect();
+    points.push(at(0.0, 0.0, 0.0, DVec3::ZERO));
+    let count = Count(AtomicU64::new(0));
+    let lux = illuminance_with_progress(&p, &s, &points, &count);
+    assert_eq!(count.0.load(Ordering::Relaxed), 7);
+    // The same numbers as without progress: at (0, 0, 0), 2 m below 1000 cd, 250 lx.
+    assert_eq!(lux, illuminance(&p, &s, &points));
+    assert!((lux[0].total - 250.0).abs() < 1e-9);
+}
+
+#[test]
+fn the_grid_picture_prints_the_coordinates_of_its_columns_and_rows() {
+    // The work plane of the README's example: x from 0.25 every 0.5 (columns), z from 0.25
+    // every 0.5 (rows), at y = 0.8.
+    let axes = GridAxes::of(dvec3(0.25, 0.8, 0.25), dvec3(4.75, 0.8, 3.75), 0.5).unwrap();
+    assert_eq!(axes.names, ['x', 'z']);
+    assert_eq!(axes.labels(0, 3), ["0.25", "0.75", "1.25"]);
+    assert_eq!(axes.labels(1, 8)[7], "3.75");
+    // Whole spacings print whole numbers; a grid run backwards counts down.
+    let back = GridAxes::of(dvec3(4.0, 2.0, 0.0), dvec3(0.0, 0.0, 0.0), 1.0).unwrap();
+    assert_eq!(back.names, ['x', 'y']);
+    assert_eq!(back.labels(0, 5), ["4", "3", "2", "1", "0"]);
+    assert_eq!(back.labels(1, 3), ["2", "1", "0"]);
+    // A line has no second axis to print.
+    assert_eq!(GridAxes::of(DVec3::ZERO, dvec3(1.0, 0.0, 0.0), 0.5), None);
+    // Drawn: ink left of the cells (the row labels) and below them (the column labels),
+    // none there without axes.
+    let values = [10.0, 20.0, 30.0, 40.0, 50.0, 60.0];
+    let ink = |img: &image::RgbImage, x0: u32, x1: u32, y0: u32, y1: u32| {
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0 == [0; 3])
+            .count()
+    };
+    let with = grid_picture_with_axes(&values, [3, 2], Some(axes));
+    let without = grid_picture(&values, [3, 2]);
+    // The cells are 38 px ("10.0": 30 px + 8); 2 rows from GRID_TOP, labels 6 px below.
+    let below = (GRID_TOP + 2 * 38 + 6) as u32;
+    assert!(ink(&with, 0, 150, below, below + 10) > 40);
+    // Row labels ("0.25", 30 px) end 6 px left of the cells, which start at 10 + 30 + 8.
+    assert!(ink(&with, 10, 42, GRID_TOP as u32, below) > 40);
+    assert_eq!(ink(&without, 0, 120, below, below + 10), 0);
 }

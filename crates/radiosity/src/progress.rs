@@ -34,6 +34,9 @@ pub enum Stage {
     Render,
     /// Path tracing a view (work unit: one image row), see [`crate::pathtrace`].
     PathTrace,
+    /// Illuminance at calculation points (work unit: one point), see
+    /// [`crate::illuminance`].
+    Illuminance,
     /// Writing output files.
     Write,
 }
@@ -53,6 +56,7 @@ impl Stage {
             Stage::Shade => "shade",
             Stage::Render => "render",
             Stage::PathTrace => "path trace",
+            Stage::Illuminance => "illuminance",
             Stage::Write => "write",
         }
     }

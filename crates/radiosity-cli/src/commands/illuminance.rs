@@ -39,20 +39,48 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
             }
             let Some((points, dims)) = illuminance::grid(a, b, spacing, normal, MAX_GRID_POINTS)
             else {
-                bail!(
-                    "--grid {a},{b}:{spacing}: the corners must agree in at least one axis (a \
-                     rectangle, not a box), and the grid may have at most {MAX_GRID_POINTS} \
-                     points; use a larger spacing"
-                );
+                bail!("{}", grid_refusal(a, b, spacing));
             };
             (points, Some(dims))
         }
         (None, None) => bail!("give --points P.csv or --grid x0,y0,z0:x1,y1,z1:SPACING"),
     };
+    // The points are in the scene file's units, so --scale applies to them as to the scene
+    // (a room in millimetres with --scale 0.001, points in millimetres: lux as in metres);
+    // the CSV gives them back as they were written.
+    let scale = args.scene.scale;
+    let scaled: Vec<CalcPoint> = points
+        .iter()
+        .map(|p| CalcPoint {
+            position: p.position * scale,
+            ..p.clone()
+        })
+        .collect();
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    // Refused before the solve when the prepared mesh already makes it too much, and again
+    // after it on the solved mesh (adaptive subdivision and hierarchical radiosity's
+    // leaves have more elements).
+    let check_work = |elements: usize| -> Result<()> {
+        if args.scene.no_work_limit {
+            return Ok(());
+        }
+        if let Err(mut e) = radiosity::budget::check_illuminance_work(points.len(), elements) {
+            if let Some((a, b, s)) = args.grid {
+                let most = radiosity::budget::most_illuminance_points(elements);
+                if let Some(wider) = smallest_spacing(a, b, s, most) {
+                    e.fits
+                        .push_str(&format!("; for this grid, a spacing of {wider} or more"));
+                }
+            }
+            return Err(e.into());
+        }
+        Ok(())
+    };
+    check_work(prepared.mesh.len())?;
     let solution = solve_as_asked(&prepared, solver, &args.solve, &reporter)?;
-    let lux = run_stage(&reporter, Stage::Render, points.len() as u64, || {
-        illuminance::illuminance(&prepared, &solution, &points)
+    check_work(solution.mesh.len())?;
+    let lux = run_stage(&reporter, Stage::Illuminance, points.len() as u64, || {
+        illuminance::illuminance_with_progress(&prepared, &solution, &scaled, &reporter)
     });
     write(&args, &points, &lux)?;
     reporter.note(&format!(
@@ -63,7 +91,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     ));
     if let (Some(png), Some(dims)) = (&args.png, dims) {
         let totals: Vec<f64> = lux.iter().map(|l| l.total).collect();
-        let img = illuminance::grid_picture(&totals, dims);
+        let axes = args
+            .grid
+            .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing));
+        let img = illuminance::grid_picture_with_axes(&totals, dims, axes);
         radiosity::io::png::write_png(&img, png)
             .with_context(|| format!("cannot write {}", png.display()))?;
         reporter.note(&format!(
@@ -75,6 +106,71 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     }
     reporter.print_timings();
     Ok(())
+}
+
+/// Why a `--grid` is refused, with what would fit: corners that differ in all three axes,
+/// a spacing that is no length, or more than [`MAX_GRID_POINTS`] points (then the smallest
+/// spacing that fits).
+fn grid_refusal(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> String {
+    let head = format!(
+        "--grid {},{},{}:{},{},{}:{spacing}",
+        a.x, a.y, a.z, b.x, b.y, b.z
+    );
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return format!("{head}: the spacing must be a positive length");
+    }
+    if (0..3).all(|i| a[i] != b[i]) {
+        return format!(
+            "{head}: the corners differ in x, y and z; a grid is a rectangle, so they must \
+             agree in at least one axis (the height of a work plane, say)"
+        );
+    }
+    let count = grid_count(a, b, spacing);
+    match smallest_spacing(a, b, spacing, MAX_GRID_POINTS) {
+        Some(wider) => format!(
+            "{head} makes {count:.0} points, more than the {MAX_GRID_POINTS} one run \
+             computes; a spacing of {wider} or more fits"
+        ),
+        None => format!("{head} makes {count:.0} points, more than one run computes"),
+    }
+}
+
+/// The points of the grid from `a` to `b` every `spacing` (as [`illuminance::grid`]
+/// counts them).
+fn grid_count(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> f64 {
+    (0..3)
+        .filter(|&i| a[i] != b[i])
+        .map(|i| ((b[i] - a[i]).abs() / spacing + 1e-9).floor() + 1.0)
+        .product()
+}
+
+/// The smallest spacing of 3 significant digits, from `spacing` up, that makes at most
+/// `most` points of the grid from `a` to `b`, as text; `None` when even one point a side
+/// is too many.
+fn smallest_spacing(a: glam::DVec3, b: glam::DVec3, spacing: f64, most: usize) -> Option<String> {
+    let longest = (0..3).map(|i| (b[i] - a[i]).abs()).fold(0.0, f64::max);
+    if most == 0 || !(spacing.is_finite() && spacing > 0.0) {
+        return None;
+    }
+    // Bisection: the count falls as the spacing grows, and beyond the longest side the
+    // grid is one point a side.
+    let (mut lo, mut hi) = (spacing, longest.max(spacing) * 2.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if grid_count(a, b, mid) > most as f64 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(round_up_3(hi))
+}
+
+/// `x` rounded up to 3 significant digits, as text (a spacing to type that still fits).
+fn round_up_3(x: f64) -> String {
+    let k = x.log10().floor() as i32 - 2;
+    let v = (x / 10f64.powi(k)).ceil() * 10f64.powi(k);
+    format!("{v:.*}", (-k).max(0) as usize)
 }
 
 fn write(args: &IlluminanceArgs, points: &[CalcPoint], lux: &[illuminance::Lux]) -> Result<()> {

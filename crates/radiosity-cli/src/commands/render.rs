@@ -211,10 +211,10 @@ fn false_colour(
     output: &std::path::Path,
     reporter: &Reporter,
 ) -> Result<()> {
-    use radiosity::illuminance::{element_illuminance, false_colour_picture};
-    let lux = run_stage(reporter, Stage::Shade, 0, || {
-        element_illuminance(prepared, solution)
-    });
+    use radiosity::illuminance::{element_illuminance_with_progress, false_colour_picture};
+    // Reported as the illuminance stage, a unit per element whose illuminance is computed
+    // at its centroid (a black surface's): a long run shows its progress and time left.
+    let lux = element_illuminance_with_progress(prepared, solution, reporter);
     let largest = lux
         .iter()
         .copied()

@@ -40,8 +40,8 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
             println!("{line}");
         }
     };
-    say("| case | point | reference (lx) | computed (lx) | difference (%) | target (%) |");
-    say("|---|---|---:|---:|---:|---:|");
+    say("| case | point | reference (lx) | computed (lx) | difference (%) | target (%) | reference from |");
+    say("|---|---|---:|---:|---:|---:|---|");
     let mut failures = Vec::new();
     let mut values = 0usize;
     for case in &cases {
@@ -51,7 +51,7 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
         let computed = illuminance(&scene, case)
             .with_context(|| format!("case {} ({})", case.id, case.title))?;
         for row in case.compare(&computed) {
-            say(&table_row(&row, case.tolerance_percent));
+            say(&table_row(&row, case));
             values += 1;
             if !row.passes(case.tolerance_percent) {
                 failures.push(format!("{} {}", row.case, row.point));
@@ -60,11 +60,9 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
     }
     let _ = std::fs::remove_dir_all(&dir);
     say("");
+    say(&format!("{}.", cie171::GEOMETRY_NOTE));
     for case in &cases {
-        say(&format!(
-            "{}: {}; reference: {}",
-            case.id, case.title, case.source
-        ));
+        say(&format!("\n{}", case.provenance()));
     }
     let (line, passed) = verdict(values, &failures);
     say("");
@@ -96,14 +94,20 @@ pub fn verdict(values: usize, failures: &[String]) -> (String, bool) {
     }
 }
 
-fn table_row(row: &Row, target: f64) -> String {
+fn table_row(row: &Row, case: &Case) -> String {
     let difference = match row.difference_percent() {
         Some(d) => format!("{d:+.3}"),
         None => "(reference 0)".to_string(),
     };
     format!(
-        "| {} | {} | {:.3} | {:.3} | {} | {} |",
-        row.case, row.point, row.reference, row.computed, difference, target
+        "| {} | {} | {:.3} | {:.3} | {} | {} | {} |",
+        row.case,
+        row.point,
+        row.reference,
+        row.computed,
+        difference,
+        case.tolerance_percent,
+        case.reference_from.label()
     )
 }
 

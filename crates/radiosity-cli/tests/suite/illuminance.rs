@@ -156,8 +156,9 @@ fn render_false_colour_draws_lux_with_a_scale_bar_and_refuses_what_it_cannot_dra
     assert!(out.status.success(), "{err}");
     assert!(err.contains("false colour from 0 to"), "{err}");
     let png = image::open(dir.join("fc.png")).unwrap().to_rgb8();
-    // The view and a 100 pixel scale bar beside it; the bar's height at least 160.
-    assert_eq!(png.width(), 64 + 100);
+    // The view and a 110 pixel scale bar beside it (its values in 9 x 15 px figures);
+    // the bar's height at least 160.
+    assert_eq!(png.width(), 64 + 110);
     assert!(png.height() >= 160);
     // The view is coloured (the ramp has no grey), not shaded grey.
     let coloured = png
@@ -200,4 +201,180 @@ fn room_ref() -> &'static str {
         env!("CARGO_MANIFEST_DIR"),
         "/../../tests/data/downlight_room.scene"
     )
+}
+
+/// The downlight room with a FLUX ceiling panel, every length times `unit` (1 for metres,
+/// 1000 for millimetres): a grey 0.5 box of 4 x 4 x 3 m, a 1000 cd cosine downlight at
+/// (2, 2, 2.9) m, and a black 1 x 1 m panel 1 cm below the ceiling, centred, facing down,
+/// giving FLUX 1000 (1000 lm/m^2).
+fn room_in(unit: f64) -> String {
+    let l = |m: f64| m * unit;
+    format!(
+        "MAX_PATCH_AREA {}\nINTEGRAL_STEPS 2\nSCENEBEGIN\nBOXBEGIN\n#Room\nFACING IN\n\
+         Er 0\nEg 0\nEb 0\nRr 0.5\nRg 0.5\nRb 0.5\nVERTICES 4\nVERTEX0 0 0 0\n\
+         VERTEX1 {w} 0 0\nVERTEX2 {w} {w} 0\nVERTEX3 0 {w} 0\nHEIGHT {h}\nBOXEND\n\
+         PATCHBEGIN\n#Panel\nVERTICES 4\nFLUX 1000\nRr 0\nRg 0\nRb 0\n\
+         VERTEX0 {a} {a} {z}\nVERTEX1 {a} {b} {z}\nVERTEX2 {b} {b} {z}\nVERTEX3 {b} {a} {z}\n\
+         PATCHEND\nLIGHTBEGIN\n#Downlight\nPOSITION {c} {c} {lz}\nINTENSITY 1000\n\
+         DISTRIBUTION COSINE\nLIGHTEND\nSCENEEND\n",
+        0.25 * unit * unit,
+        w = l(4.0),
+        h = l(3.0),
+        a = l(1.5),
+        b = l(2.5),
+        z = l(2.99),
+        c = l(2.0),
+        lz = l(2.9),
+    )
+}
+
+/// The rows of an illuminance CSV: the numbers after the name.
+fn lux_rows(path: &std::path::Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|line| {
+            line.split(',')
+                .skip(1)
+                .map(|v| v.parse().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn a_room_in_millimetres_with_scale_gives_the_lux_of_the_room_in_metres() {
+    // Before, --scale moved the surfaces but not the point luminaires (the downlight stood
+    // 1000 times too far away), spread a FLUX over the areas in mm^2 (10^6 times too dim)
+    // and left the points in mm: the room in mm read 0.000227 lx where metres read 258.
+    let dir = scratch_dir("illuminance-scale");
+    std::fs::write(dir.join("m.scene"), room_in(1.0)).unwrap();
+    std::fs::write(dir.join("mm.scene"), room_in(1000.0)).unwrap();
+    std::fs::write(
+        dir.join("m.csv"),
+        "name,x,y,z,nx,ny,nz\ncentre,2,2,0.8,0,0,1\nwall,0,1,1.5,1,0,0\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("mm.csv"),
+        "name,x,y,z,nx,ny,nz\ncentre,2000,2000,800,0,0,1\nwall,0,1000,1500,1,0,0\n",
+    )
+    .unwrap();
+    for (scene, points, scale, out) in [
+        ("m.scene", "m.csv", "1", "om.csv"),
+        ("mm.scene", "mm.csv", "0.001", "omm.csv"),
+    ] {
+        let out = radiosity(
+            &[
+                "illuminance",
+                scene,
+                "--scale",
+                scale,
+                "--points",
+                points,
+                "-o",
+                out,
+                "-q",
+            ],
+            &dir,
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let (m, mm) = (
+        lux_rows(&dir.join("om.csv")),
+        lux_rows(&dir.join("omm.csv")),
+    );
+    // The CSV gives the points back as written (in mm for the mm run).
+    assert_eq!(&mm[0][..3], &[2000.0, 2000.0, 800.0]);
+    // Direct light at the centre of the floor plane, 2.1 m below the downlight and 2.19 m
+    // below the panel: I0 / 2.1^2 plus M F, F of a 1 x 1 m square centred above the point
+    // (four corner rectangles of 0.5 x 0.5 m, Siegel and Howell's parallel-rectangle
+    // corner formula). Exact contour integrals and clear shadow rays: 1e-9.
+    let corner = |x: f64, y: f64| {
+        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+    };
+    let h = 2.19;
+    let expected = 1000.0 / (2.1 * 2.1) + 1000.0 * 4.0 * corner(0.5 / h, 0.5 / h);
+    for rows in [&m, &mm] {
+        assert!(
+            (rows[0][6] / expected - 1.0).abs() < 1e-9,
+            "{} against {expected}",
+            rows[0][6]
+        );
+        assert!(
+            rows[0][7] > 1.0,
+            "the grey room reflects light: {:?}",
+            rows[0]
+        );
+    }
+    // Direct, indirect and total at both points: the same lux in mm as in m. The two runs
+    // differ only in the rounding of lengths times 0.001 (1e-16 relative), which the solve
+    // carries to 1e-12 or so; 1e-9 relative is far below what a unit error makes (10^6).
+    for (a, b) in m.iter().zip(&mm) {
+        for k in 6..9 {
+            assert!((a[k] / b[k] - 1.0).abs() < 1e-9, "m {a:?}, mm {b:?}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn illuminance_refuses_a_grid_too_large_and_work_of_hours_saying_what_fits() {
+    let dir = scratch_dir("illuminance-limits");
+    // 0.001 m over 4 x 4 m: 4001^2 = 16 million points, above the 1,000,000 one run takes.
+    // A spacing fits when floor(4 / s) + 1 <= 1000 points a side, so above 0.004: rounded
+    // up to 3 significant digits, 0.00401 (998^2 = 996,004 points).
+    let out = radiosity(
+        &[
+            "illuminance",
+            &room(),
+            "--grid",
+            "0,0,0.8:4,4,0.8:0.001",
+            "--normal",
+            "0,0,1",
+            "-o",
+            "g.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("makes 16008001 points") && err.contains("a spacing of 0.00401 or more"),
+        "{err}"
+    );
+    // 0.005 m: 801^2 = 641,601 points. On the room's 320 elements (80 m^2 at 0.25) that
+    // is 2.1e8 point-element pairs, within the 1e9 work limit; on a mesh of 0.0025 m^2
+    // elements (32,000) it is 2.1e10: refused before the solve, with what fits: 31,250
+    // points, so at most 176 a side (176^2 = 30,976; 177^2 = 31,329), floor(4 / s) <= 175,
+    // 4 / s < 176: a spacing above 0.022727, rounded up to 3 digits 0.0228.
+    let out = radiosity(
+        &[
+            "illuminance",
+            &room(),
+            "--max-area",
+            "0.0025",
+            "--grid",
+            "0,0,0.8:4,4,0.8:0.005",
+            "--normal",
+            "0,0,1",
+            "-o",
+            "g.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("641601 calculation points on")
+            && err.contains("point-element pairs")
+            && err.contains("at most 31250 points")
+            && err.contains("for this grid, a spacing of 0.0228 or more")
+            && err.contains("--no-work-limit"),
+        "{err}"
+    );
+    assert!(!dir.join("g.csv").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -35,3 +35,31 @@ fn validate_cie171_unknown_case_lists_the_cases() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn validate_cie171_says_where_each_reference_comes_from() {
+    let dir = scratch_dir("validate-provenance");
+    let out = radiosity(&["validate", "cie171", "--case", "5.2"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table = stdout(&out);
+    assert!(table.contains("| target (%) | reference from |"), "{table}");
+    // Every row of 5.2 (8 points) names its reference's source in the last column.
+    let rows: Vec<&str> = table.lines().filter(|l| l.starts_with("| 5.2 |")).collect();
+    assert_eq!(rows.len(), 8, "{table}");
+    for row in rows {
+        assert!(
+            row.ends_with("| first principles (recomputed here) |"),
+            "{row}"
+        );
+    }
+    // The notes: what was available, and the published description the case follows.
+    assert!(
+        table.contains("CIE 171:2006 itself was not available here"),
+        "{table}"
+    );
+    assert!(
+        table.contains("Scene: after CIE 171:2006 5.2 (light source directional output"),
+        "{table}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -76,6 +76,10 @@ pub enum EmissionGiven {
     Luminance(f64),
     /// `FLUX P` (lm): P spread uniformly over the surface, exitance P / area in every band.
     Flux(f64),
+    /// A share of a `FLUX P` block spread over several surfaces (a split patch, a box):
+    /// exitance P / (the block's area), written back as `Er Eg Eb`. Kept so that `--scale`
+    /// can turn the exitance into lm/m^2 of the scaled lengths, as for [`Self::Flux`].
+    FluxShare,
 }
 
 /// A checked scene: its surfaces (geometry, emission and reflectance), and the camera it

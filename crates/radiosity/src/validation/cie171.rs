@@ -81,11 +81,57 @@ pub struct Case {
     pub check: Check,
     /// The issue's target, percent.
     pub tolerance_percent: f64,
-    /// Where the reference comes from.
+    /// How the reference is computed.
     pub source: &'static str,
+    /// Which published description the scene follows, and what of it is this project's own.
+    pub scene_from: &'static str,
+    /// Where the reference values come from, for the table's last column.
+    pub reference_from: ReferenceFrom,
 }
 
+/// Where a case's reference values come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReferenceFrom {
+    /// Recomputed here from first principles for exactly the scene written (no published
+    /// table: CIE 171's own tables are for the report's geometry, which was not available).
+    FirstPrinciples,
+    /// The closed form CIE 171:2006 gives for the case (5.8's energy balance), evaluated
+    /// for the scene written.
+    Cie171Formula,
+}
+
+impl ReferenceFrom {
+    /// The label in the table.
+    pub fn label(self) -> &'static str {
+        match self {
+            ReferenceFrom::FirstPrinciples => "first principles (recomputed here)",
+            ReferenceFrom::Cie171Formula => "CIE 171:2006 5.8 formula",
+        }
+    }
+}
+
+/// What the cases take from the report: its public summary and Ashdown's errata page were
+/// read, not the report's tables, figures or dimensions.
+pub const GEOMETRY_NOTE: &str = "CIE 171:2006 itself was not available here (its public \
+    summary and Ashdown's errata page were read): each case follows the published \
+    description named below, the dimensions, sources and points not given there are this \
+    project's, and every reference is computed for exactly the scene written \
+    (validation/<case>.scene), so no published table is compared";
+
 impl Case {
+    /// Where the case comes from, for the notes under the table: its title, the published
+    /// description its scene follows, and where its reference comes from and how.
+    pub fn provenance(&self) -> String {
+        format!(
+            "{}: {}. Scene: after {}. Reference: {}: {}.",
+            self.id,
+            self.title,
+            self.scene_from,
+            self.reference_from.label(),
+            self.source
+        )
+    }
+
     /// The points file (`name,x,y,z,nx,ny,nz`).
     pub fn points_csv(&self) -> String {
         let mut text = String::from("name,x,y,z,nx,ny,nz\n");
@@ -408,6 +454,9 @@ pub fn point_source() -> Case {
         },
         tolerance_percent: 1.0,
         source: "E = I0 cos(theta) cos(theta_p) / d^2 (inverse-square and cosine laws)",
+        scene_from: "CIE 171:2006 5.2 (light source directional output, point source), by \
+                     its title",
+        reference_from: ReferenceFrom::FirstPrinciples,
     }
 }
 
@@ -442,6 +491,9 @@ pub fn area_source() -> Case {
         },
         tolerance_percent: 1.0,
         source: "E = pi L F, F by Lambert's contour integral (checked against the corner formula)",
+        scene_from: "CIE 171:2006 5.3 (light source directional output, area source), by \
+                     its title",
+        reference_from: ReferenceFrom::FirstPrinciples,
     }
 }
 
@@ -534,6 +586,17 @@ fn reflection_case(obstructed: bool) -> Case {
                 )
         })
         .collect();
+    let scene_from = if obstructed {
+        "CIE 171:2006 5.7 (diffuse reflections with internal obstructions), by its title; \
+         in the report the case is a configuration factor past an obstruction, given as \
+         E / E_v in its Table 19, which is wrong (Dau 2007; Ashdown's errata): neither that \
+         table nor Dau's corrected values are used, as they are for the report's geometry; \
+         this scene (a floor of reflectance 0.5 lit by a downlight, seen past a black panel) \
+         is this project's"
+    } else {
+        "CIE 171:2006 5.6 (diffuse reflections), by its title; the scene (a floor of \
+         reflectance 0.5 lit by a downlight, all else black) is this project's"
+    };
     let (id, stem, title, name) = if obstructed {
         (
             "5.7",
@@ -561,6 +624,8 @@ fn reflection_case(obstructed: bool) -> Case {
         tolerance_percent: 1.0,
         source: "direct: I cos cos / d^2; reflected: one bounce integrated over the lit, visible \
                  floor (shadows cut exactly), Gauss-Legendre; computed here, not CIE's Table 19",
+        scene_from,
+        reference_from: ReferenceFrom::FirstPrinciples,
     }
 }
 
@@ -636,6 +701,11 @@ pub fn cube(rho: f64) -> Case {
         },
         tolerance_percent: 0.5,
         source: "energy conservation: mean indirect = Phi / S_T * rho / (1 - rho) (CIE 171 5.8)",
+        scene_from: "CIE 171:2006 5.8 (diffuse inter-reflections) as Ashdown's errata page \
+                     describes it: a 4 m cube, S_T = 96 m^2, uniform diffusers, reflectances 0 \
+                     to 0.95; the 10 000 lm isotropic source at the centre and the quadrature \
+                     points are this project's",
+        reference_from: ReferenceFrom::Cie171Formula,
     }
 }
 
@@ -646,7 +716,14 @@ const ROOF_HOLE: [f64; 4] = [0.375, 0.625, 0.25, 0.75];
 /// `u` = z and `v` = x).
 const WINDOW_HOLE: [f64; 4] = [1.0 / 3.0, 2.5 / 3.0, 0.25, 0.75];
 
-fn opening_case(face: usize, hole: [f64; 4], id: &str, stem: &str, title: &'static str) -> Case {
+fn opening_case(
+    face: usize,
+    hole: [f64; 4],
+    id: &str,
+    stem: &str,
+    title: &'static str,
+    scene_from: &'static str,
+) -> Case {
     let mut patches = room(W, D, H, [0.0; 6], Some((face, hole)));
     let opening = hole_rect(W, D, H, face, hole);
     patches.push(Patch {
@@ -674,6 +751,8 @@ fn opening_case(face: usize, hole: [f64; 4], id: &str, stem: &str, title: &'stat
         tolerance_percent: 1.0,
         source: "a uniform sky of luminance L seen through an opening is a Lambertian emitter: \
                  E = pi L F, F by Lambert's contour integral",
+        scene_from,
+        reference_from: ReferenceFrom::FirstPrinciples,
     }
 }
 
@@ -685,6 +764,8 @@ pub fn roof_opening() -> Case {
         "5.9",
         "cie171_5_9_roof_opening",
         "roof opening (2 x 1 m) under a uniform sky of 10 000 lux, black room",
+        "CIE 171:2006 5.9 (sky component for a roof unglazed opening), by its title, under \
+         a uniform sky (the CIE general sky of uniform luminance)",
     )
 }
 
@@ -696,6 +777,8 @@ pub fn facade_opening() -> Case {
         "5.11",
         "cie171_5_11_facade_opening",
         "facade opening (2 x 1.5 m, sill 1 m) under a uniform sky of 10 000 lux, black room",
+        "CIE 171:2006 5.11 (sky component for a facade unglazed opening), by its title, \
+         under a uniform sky (the CIE general sky of uniform luminance)",
     )
 }
 

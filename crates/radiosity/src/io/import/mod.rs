@@ -70,8 +70,9 @@ pub use face_soup::{FaceSoup, SoupFace, SoupMaterial};
 
 use crate::geometry;
 use crate::io::scene_file::{read_scene, SceneError, SceneFile};
+use crate::light::Rgb;
 use crate::mesh::MeshSettings;
-use crate::scene::Scene;
+use crate::scene::{EmissionGiven, Scene};
 
 /// The extensions [`read_any_scene`] knows, as a message lists them.
 pub const EXTENSIONS: &str = ".scene, .obj, .gltf, .glb, .dxf or .wrl";
@@ -393,8 +394,10 @@ pub fn scaled_unit(unit: &str, scale: f64) -> String {
     }
 }
 
-/// A `.scene` file, scaled: every coordinate (and the camera) times `scale`, and
-/// `MAX_PATCH_AREA` times its square, so that the scene meshes into the same elements.
+/// A `.scene` file, scaled: every coordinate (the camera and the point luminaires too)
+/// times `scale`, `MAX_PATCH_AREA` times its square, so that the scene meshes into the same
+/// elements, and a `FLUX` block's exitance over its scaled area, so that it emits the same
+/// lumens (the same room in millimetres with `--scale 0.001` gives the same lux).
 fn read_scene_scaled(path: &Path, scale: f64) -> Result<Imported, ImportError> {
     let mut file = read_scene(path)?;
     if scale != 1.0 {
@@ -424,6 +427,23 @@ fn read_scene_scaled(path: &Path, scale: f64) -> Result<Imported, ImportError> {
         if let Some(c) = &mut file.scene.camera {
             c.eye *= scale;
             c.look_at *= scale;
+        }
+        // Point luminaires stand where the scaled surfaces are (their candela and lumens
+        // do not depend on lengths).
+        for light in &mut file.scene.lights {
+            light.position *= scale;
+        }
+        // A FLUX was spread over the areas as written: the same lumens over areas scale^2
+        // times as large (exitance in lm/m^2 of the scaled lengths). Er Eg Eb and LUMINANCE
+        // are per unit area of the scaled scene already (lm/m^2, cd/m^2).
+        for s in &mut file.scene.surfaces {
+            match s.photometry.emission {
+                EmissionGiven::Flux(p) => {
+                    s.emission = Rgb::splat(p / geometry::polygon_area(&s.vertices));
+                }
+                EmissionGiven::FluxShare => s.emission = s.emission * (1.0 / (scale * scale)),
+                EmissionGiven::Exitance | EmissionGiven::Luminance(_) => {}
+            }
         }
         file.settings.max_patch_area *= scale * scale;
     }

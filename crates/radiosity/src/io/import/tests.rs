@@ -478,3 +478,57 @@ fn faces_of_two_objects_or_two_materials_or_a_bend_stay_apart() {
         .unwrap();
     assert_eq!(scene.surfaces.len(), 2);
 }
+
+#[test]
+fn a_scene_in_millimetres_scaled_to_metres_keeps_its_lights_and_lumens() {
+    // A 2000 x 1000 mm FLUX 600 panel, a FLUX 1200 box of 1000 mm sides (six faces of
+    // 1 m^2), and a point light at (1000, 2000, 3000) mm, read with --scale 0.001.
+    let text = "MAX_PATCH_AREA 250000\nINTEGRAL_STEPS 2\nSCENEBEGIN\nPATCHBEGIN\n#Panel\n\
+                VERTICES 4\nFLUX 600\nRr 0\nRg 0\nRb 0\nVERTEX0 0 0 0\nVERTEX1 2000 0 0\n\
+                VERTEX2 2000 1000 0\nVERTEX3 0 1000 0\nPATCHEND\nBOXBEGIN\n#Lamp\nFACING OUT\n\
+                FLUX 1200\nRr 0\nRg 0\nRb 0\nORIGIN 5000 0 0\nSIZE 1000 1000 1000\nBOXEND\n\
+                LIGHTBEGIN\n#Down\nPOSITION 1000 2000 3000\nINTENSITY 100\n\
+                DISTRIBUTION ISOTROPIC\nLIGHTEND\nSCENEEND\n";
+    let dir = std::env::temp_dir().join(format!("radiosity-mm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("mm.scene");
+    std::fs::write(&path, text).unwrap();
+    let read = |scale: f64| {
+        read_any_scene(
+            &path,
+            &ImportOptions {
+                scale,
+                settings: None,
+            },
+        )
+        .unwrap()
+        .file
+    };
+    let metres = read(0.001);
+    let scene = &metres.scene;
+    // The light stands at the scaled position (before: left at 1000, 2000, 3000 "metres").
+    assert!((scene.lights[0].position - dvec3(1.0, 2.0, 3.0)).length() < 1e-12);
+    // The panel's 600 lm over its 2 m^2: 300 lm/m^2 (before: 600 / 2e6 mm^2).
+    assert!((scene.surfaces[0].emission.luminance() - 300.0).abs() < 1e-9);
+    // The box's 1200 lm over 6 m^2: 200 lm/m^2 on each face.
+    for s in &scene.surfaces[1..] {
+        assert!(
+            (s.emission.luminance() - 200.0).abs() < 1e-9,
+            "{}: {:?}",
+            s.name,
+            s.emission
+        );
+    }
+    // The lumens emitted are those of the file, at either scale.
+    let lumens = |file: &crate::io::scene_file::SceneFile| -> f64 {
+        file.scene
+            .surfaces
+            .iter()
+            .map(|s| s.emission.luminance() * geometry::polygon_area(&s.vertices))
+            .sum()
+    };
+    assert!((lumens(&metres) - 1800.0).abs() < 1e-9);
+    assert!((lumens(&read(1.0)) - 1800.0).abs() < 1e-9);
+    assert!((metres.settings.max_patch_area - 0.25).abs() < 1e-12);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

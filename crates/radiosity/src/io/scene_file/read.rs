@@ -912,7 +912,7 @@ impl<'a> Parser<'a> {
         for s in surfaces {
             s.emission = Rgb::splat(exitance);
             if !single {
-                s.photometry.emission = EmissionGiven::Exitance;
+                s.photometry.emission = EmissionGiven::FluxShare;
             }
         }
     }
