@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use super::adaptive::{refinement, Refine, Seen};
 use super::direct::DirectCorrection;
 use super::film::{sample_offset, Film, FilmContent};
-use super::holes::{nearest_element, Holes, Uncovered};
+use super::holes::{closest_on_segment, nearest_element, Holes, Uncovered};
 use super::Camera;
 use crate::mesh::Mesh;
 use crate::progress::{run_stage, Progress, Stage};
@@ -460,14 +460,7 @@ fn film_content(shading: Shading) -> FilmContent {
 
 /// The distance from `x` to the segment from `a` to `b`.
 fn segment_distance(x: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let len2 = ab.length_squared();
-    let s = if len2 > 0.0 {
-        ((x - a).dot(ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (x - (a + s * ab)).length()
+    (x - closest_on_segment(x, a, b)).length()
 }
 
 /// The vertices smooth shading interpolates at a point of an element, with their weights
