@@ -18,7 +18,9 @@
 //! through a gap sees some of the room, but much of its sky is the back of what buries it,
 //! and its irradiance is about the neighbour's scaled by what it sees of the room (exact
 //! where the light arriving is uniform over the hemisphere). A back face met there stops the
-//! ray (black), as the surface does.
+//! ray (black), as the surface does. The share scales the whole radiosity, emission
+//! included: a buried piece of an emitter seen through a gap would show darker than its
+//! emission (the renderer holds no emission per element; no scene here has one).
 
 use glam::DVec3;
 
