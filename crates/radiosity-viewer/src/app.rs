@@ -10,13 +10,13 @@ use std::time::Instant;
 
 use eframe::egui;
 use radiosity::mesh::Mesh;
-use radiosity::render::{Camera, Shading};
+use radiosity::render::{Camera, HoleCover, Shading};
 use radiosity::scene::Rgb;
 use radiosity::shade::{self, Exposure};
 use radiosity::visibility::PolygonBvh;
 
 use crate::camera::{CameraController, MoveKeys};
-use crate::gpu::{colour_vertices, mesh_bounds, MeshRenderer, Style, Target};
+use crate::gpu::{colour_vertices, cover_colours, mesh_bounds, MeshRenderer, Style, Target};
 use crate::model::{Modeller, SurfaceColours};
 use crate::worker::{self, Recolour, StageProgress, Update};
 use crate::ViewerOptions;
@@ -86,6 +86,8 @@ pub(crate) struct ViewerApp {
     mesh: Option<Arc<Mesh>>,
     bvh: Option<Arc<PolygonBvh>>,
     element_b: Vec<[f64; 3]>,
+    /// What covers the holes that dropped buried pieces leave in the mesh's surfaces.
+    cover: HoleCover,
     colours_dirty: bool,
     gpu_mesh_pending: bool,
     close_requested: bool,
@@ -162,6 +164,7 @@ impl ViewerApp {
             mesh: None,
             bvh: None,
             element_b: Vec::new(),
+            cover: HoleCover::default(),
             colours_dirty: false,
             gpu_mesh_pending: false,
             close_requested: false,
@@ -205,6 +208,7 @@ impl ViewerApp {
                         .map(|e| surfaces[e.surface as usize].emission.0)
                         .collect();
                     self.colours_dirty = true;
+                    self.cover = HoleCover::new(&self.modeller.scene, &mesh);
                     self.mesh = Some(mesh);
                     self.bvh = Some(bvh);
                     self.gpu_mesh_pending = true;
@@ -609,14 +613,16 @@ impl ViewerApp {
             if let Some(mesh) = &self.mesh {
                 if self.gpu_mesh_pending {
                     let on_top = crate::gpu::on_top_surfaces(&self.modeller.scene);
-                    gpu.renderer.set_mesh(&rs.device, mesh, &on_top);
+                    gpu.renderer
+                        .set_mesh_covered(&rs.device, mesh, &on_top, &self.cover);
                     self.gpu_mesh_pending = false;
                     self.colours_dirty = true;
                 }
                 if self.colours_dirty {
                     let mut vertex_b = shade::vertex_radiosity(mesh, &self.element_b);
                     shade::smooth_objects(&self.modeller.scene, mesh, &mut vertex_b);
-                    let colours = colour_vertices(mesh, &self.element_b, &vertex_b);
+                    let mut colours = colour_vertices(mesh, &self.element_b, &vertex_b);
+                    colours.extend(cover_colours(&self.cover, mesh, &self.element_b, &vertex_b));
                     gpu.renderer.set_colours(&rs.device, &rs.queue, &colours);
                     self.colours_dirty = false;
                     drew = true;

@@ -15,7 +15,7 @@ use std::fmt;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, DVec4};
 use radiosity::mesh::Mesh;
-use radiosity::render::{Camera, Shading};
+use radiosity::render::{Camera, HoleCover, Shading};
 use radiosity::scene::Scene;
 use wgpu::util::DeviceExt;
 
@@ -94,15 +94,18 @@ struct ViewUniform {
     pad: [f32; 3],
 }
 
-/// Geometry of one vertex: position and `surface << 4 | on top << 3 | edge mask`.
+/// Geometry of one vertex: position and `surface << 5 | hole cover << 4 | on top << 3 |
+/// edge mask`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GeometryVertex {
     /// Position, scene units.
     pub position: [f32; 3],
-    /// Surface index shifted left by 4; bit 3 set for a surface that lies on another (drawn
-    /// a little towards the eye, see [`on_top_surfaces`]); bits 0-2 the mask of the
-    /// triangle's element edges (bit k: the edge opposite the triangle's vertex k).
+    /// Surface index shifted left by 5; bit 4 set for a triangle of the hole cover (drawn a
+    /// little away from the eye, see [`cover_geometry`]); bit 3 set for a surface that lies
+    /// on another (drawn a little towards the eye, see [`on_top_surfaces`]); bits 0-2 the
+    /// mask of the triangle's element edges (bit k: the edge opposite the triangle's vertex
+    /// k).
     pub info: u32,
 }
 
@@ -138,7 +141,7 @@ pub fn geometry_vertices(mesh: &Mesh, on_top: &[bool]) -> Vec<GeometryVertex> {
     let mut out = Vec::with_capacity(3 * display.all_triangles().len());
     for (e, el) in mesh.elements.iter().enumerate() {
         let top = on_top.get(el.surface as usize).copied().unwrap_or(false);
-        let surface = el.surface << 4 | (top as u32) << 3;
+        let surface = el.surface << SURFACE_SHIFT | (top as u32) << 3;
         for t in display.triangles(e) {
             // The mask of element edges: bit k = the edge opposite vertex k.
             for &v in &t.vertices {
@@ -150,6 +153,46 @@ pub fn geometry_vertices(mesh: &Mesh, on_top: &[bool]) -> Vec<GeometryVertex> {
         }
     }
     out
+}
+
+/// Where the surface index starts in [`GeometryVertex::info`].
+const SURFACE_SHIFT: u32 = 5;
+
+/// The triangles of the hole cover ([`HoleCover`]: the holes that dropped buried pieces
+/// leave in the surfaces, which the CPU renderer covers ray by ray) as vertices, three per
+/// triangle, flagged so that the shader draws them a little behind the elements: they show
+/// only where no element covers the surface. No edges of theirs are element edges.
+pub fn cover_geometry(cover: &HoleCover) -> Vec<GeometryVertex> {
+    cover
+        .corners
+        .chunks(3)
+        .zip(&cover.surfaces)
+        .flat_map(|(t, &s)| {
+            t.iter().map(move |p| GeometryVertex {
+                position: p.as_vec3().to_array(),
+                info: s << SURFACE_SHIFT | 1 << 4,
+            })
+        })
+        .collect()
+}
+
+/// The colours matching [`cover_geometry`], for `mesh` with radiosities `element_b` (per
+/// element) and `vertex_b` (per vertex; may be empty) as for [`colour_vertices`].
+pub fn cover_colours(
+    cover: &HoleCover,
+    mesh: &Mesh,
+    element_b: &[[f64; 3]],
+    vertex_b: &[[f64; 3]],
+) -> Vec<ColourVertex> {
+    let f = |b: [f64; 3]| b.map(|x| x as f32);
+    cover
+        .radiosity(mesh, element_b, vertex_b)
+        .into_iter()
+        .map(|(smooth, flat)| ColourVertex {
+            vertex_b: f(smooth),
+            element_b: f(flat),
+        })
+        .collect()
 }
 
 /// The colours matching [`geometry_vertices`]: `vertex_b` per mesh vertex (may be empty,
@@ -476,7 +519,22 @@ impl MeshRenderer {
 
     /// Uploads the mesh's triangles (once per mesh); `on_top` as for [`geometry_vertices`].
     pub fn set_mesh(&mut self, device: &wgpu::Device, mesh: &Mesh, on_top: &[bool]) {
-        self.set_triangles(device, &geometry_vertices(mesh, on_top), mesh_bounds(mesh));
+        self.set_mesh_covered(device, mesh, on_top, &HoleCover::default());
+    }
+
+    /// [`MeshRenderer::set_mesh`] followed by the triangles of `cover` (the mesh's hole
+    /// cover, [`cover_geometry`]); the colours then are [`colour_vertices`] followed by
+    /// [`cover_colours`].
+    pub fn set_mesh_covered(
+        &mut self,
+        device: &wgpu::Device,
+        mesh: &Mesh,
+        on_top: &[bool],
+        cover: &HoleCover,
+    ) {
+        let mut vertices = geometry_vertices(mesh, on_top);
+        vertices.extend(cover_geometry(cover));
+        self.set_triangles(device, &vertices, mesh_bounds(mesh));
     }
 
     /// Uploads triangles given as vertices (three per triangle; see [`geometry_vertices`])
@@ -698,7 +756,7 @@ impl Headless {
     }
 
     /// [`Headless::render`] with the surfaces flagged in `on_top` drawn as lying on others
-    /// (see [`geometry_vertices`]), as the window draws them.
+    /// (see [`geometry_vertices`]).
     pub fn render_with_on_top(
         &self,
         mesh: &Mesh,
@@ -708,13 +766,42 @@ impl Headless {
         camera: &Camera,
         style: &Style,
     ) -> Result<image::RgbaImage, GpuError> {
+        let cover = HoleCover::default();
+        self.render_covered(mesh, on_top, &cover, element_b, vertex_b, camera, style)
+    }
+
+    /// [`Headless::render`] of `mesh`, cut from `scene`, as the window draws it: the
+    /// surfaces lying on others drawn on top ([`on_top_surfaces`]) and the holes that
+    /// dropped buried pieces leave covered ([`HoleCover`]).
+    pub fn render_scene(
+        &self,
+        scene: &Scene,
+        mesh: &Mesh,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        camera: &Camera,
+        style: &Style,
+    ) -> Result<image::RgbaImage, GpuError> {
+        let (on_top, cover) = (on_top_surfaces(scene), HoleCover::new(scene, mesh));
+        self.render_covered(mesh, &on_top, &cover, element_b, vertex_b, camera, style)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn render_covered(
+        &self,
+        mesh: &Mesh,
+        on_top: &[bool],
+        cover: &HoleCover,
+        element_b: &[[f64; 3]],
+        vertex_b: &[[f64; 3]],
+        camera: &Camera,
+        style: &Style,
+    ) -> Result<image::RgbaImage, GpuError> {
         let mut renderer = MeshRenderer::new(&self.device);
-        renderer.set_mesh(&self.device, mesh, on_top);
-        renderer.set_colours(
-            &self.device,
-            &self.queue,
-            &colour_vertices(mesh, element_b, vertex_b),
-        );
+        renderer.set_mesh_covered(&self.device, mesh, on_top, cover);
+        let mut colours = colour_vertices(mesh, element_b, vertex_b);
+        colours.extend(cover_colours(cover, mesh, element_b, vertex_b));
+        renderer.set_colours(&self.device, &self.queue, &colours);
         let target = Target::new(&self.device, camera.width, camera.height);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         renderer.draw(&self.queue, &mut encoder, &target, camera, style);
@@ -749,7 +836,10 @@ mod tests {
                 .clone()
                 .map(|i| mesh.vertices[i as usize].as_vec3())
                 .collect();
-            for t in v.chunks_exact(3).filter(|t| (t[0].info >> 4) as usize == s) {
+            for t in v
+                .chunks_exact(3)
+                .filter(|t| (t[0].info >> SURFACE_SHIFT) as usize == s)
+            {
                 for k in 0..3 {
                     let a = glam::Vec3::from(t[k].position);
                     let b = glam::Vec3::from(t[(k + 1) % 3].position);

@@ -27,8 +27,8 @@ struct View {
 struct VertexIn {
     @builtin(vertex_index) index: u32,
     @location(0) position: vec3<f32>,
-    // surface index << 4 | lies on another surface << 3 | mask of the triangle's edges that
-    // are element edges.
+    // surface index << 5 | hole cover << 4 | lies on another surface << 3 | mask of the
+    // triangle's edges that are element edges.
     @location(1) info: u32,
     @location(2) vertex_b: vec3<f32>,
     @location(3) element_b: vec3<f32>,
@@ -52,6 +52,11 @@ fn vs_main(v: VertexIn) -> VertexOut {
         // it wins where the two share a plane.
         out.clip.z = out.clip.z * (1.0 + 1e-5);
     }
+    if ((v.info & 16u) != 0u) {
+        // The hole cover: drawn as if 1e-5 of its distance farther, so that the elements
+        // of its own surface, in the same plane, win wherever they are.
+        out.clip.z = out.clip.z * (1.0 - 1e-5);
+    }
     out.vertex_b = v.vertex_b;
     out.element_b = v.element_b;
     // Draws are not indexed, so vertex k of every triangle has index 3t + k.
@@ -70,7 +75,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> @location(0) ve
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     let mask = in.info & 7u;
-    let surface = in.info >> 4u;
+    let surface = in.info >> 5u;
     var display: vec3<f32>;
     if (view.mode == 2u) {
         var d = 1e9;

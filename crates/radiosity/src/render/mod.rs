@@ -29,6 +29,7 @@ mod adaptive;
 mod camera;
 mod direct;
 mod film;
+mod hole_cover;
 mod holes;
 mod renderer;
 #[cfg(test)]
@@ -38,6 +39,7 @@ pub mod tonemap;
 pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
 pub use direct::{DirectCorrection, DirectLight, COARSE_RAYS};
 pub use film::{sample_offset, Film, FilmContent};
+pub use hole_cover::HoleCover;
 pub use renderer::{
     barycentric, interpolation, inverse_bilinear, Interpolation, Renderer, Shading,
 };
