@@ -745,7 +745,7 @@ fn check_lists_surfaces_lying_on_others() {
         let area: f64 = text
             .lines()
             .find_map(|l| l.strip_prefix("total area"))
-            .and_then(|v| v.trim().parse().ok())
+            .and_then(|v| v.split_whitespace().next()?.parse().ok())
             .unwrap();
         assert!(
             (area - 20.0).abs() < 1e-9,
