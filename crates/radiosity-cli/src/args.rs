@@ -13,6 +13,23 @@ use radiosity::render::Shading;
 use radiosity::shade::Exposure;
 use radiosity::solve::SolverKind;
 
+/// `cmd` with every flag that takes a value, in it and its subcommands, accepting a
+/// negative number (`--tolerance -1`, `--scale -2`): clap otherwise reads "-1" as an
+/// unknown flag and suggests `-- -1`, which makes it a scene file name (QA of issue #16).
+/// The value is then refused, if it must be positive, by a message naming the flag and what
+/// it takes. The vectors (`--eye -1,2,3`) take any value starting with a hyphen
+/// (`allow_hyphen_values`). `radiosity` and `radiosity-mpi` both parse through it.
+pub fn negative_numbers(cmd: clap::Command) -> clap::Command {
+    cmd.mut_args(|arg| {
+        if !arg.is_positional() && arg.get_action().takes_values() {
+            arg.allow_negative_numbers(true)
+        } else {
+            arg
+        }
+    })
+    .mut_subcommands(negative_numbers)
+}
+
 #[derive(Subcommand)]
 pub enum GenerateCommand {
     /// A building: a grid of furnished rooms on one or more floors, joined by doors, lit by
@@ -60,10 +77,10 @@ pub struct BuildingArgs {
     /// Rooms along z on each floor.
     #[arg(long, default_value_t = 6, value_name = "N")]
     pub rooms_z: u32,
-    /// Inner side of each square room (m; at least 5.7 with furniture).
+    /// Inner side of each square room (m; 5.7 to 100 with furniture, from 2.5 without).
     #[arg(long, default_value_t = 6.0, value_name = "M")]
     pub room_size: f64,
-    /// Floor-to-ceiling height (m).
+    /// Floor-to-ceiling height (m; 2.4 to 20).
     #[arg(long, default_value_t = 2.7, value_name = "M")]
     pub height: f64,
     /// Empty rooms.
@@ -80,7 +97,8 @@ pub struct BuildingArgs {
     /// The scene's INTEGRAL_STEPS.
     #[arg(long, default_value_t = 2, value_name = "K")]
     pub steps: u32,
-    /// Exitance of the ceiling panels (W/m^2); windows emit 0.6 of it, bluish.
+    /// Exitance of the ceiling panels (lm/m^2, so that `illuminance` gives lux); windows
+    /// emit 0.6 of it, bluish.
     #[arg(long, default_value_t = 20.0, value_name = "E")]
     pub light: f64,
     /// No summary line (rooms, surfaces, size and element count; errors are still printed).
@@ -203,8 +221,9 @@ pub struct SolveOptions {
     pub no_final_gather: bool,
     /// Hierarchical: the most points the final gather gathers at; above it, the gather
     /// runs at coarser patches and the leaves under each take its light plus what finer
-    /// links bring. Its time is about proportional to this (the million-element building:
-    /// about a minute of CPU at the default).
+    /// links bring. Its time grows with this: at the default, the million-element building
+    /// gathers at 236,916 points in about 110 s of CPU (BENCHMARKS.md), the Cornell box at
+    /// --max-area 10 at its 176,191 leaves in about 40 s (two shared cores).
     #[arg(long, value_name = "N", default_value_t = radiosity::solve::GATHER_POINTS_DEFAULT)]
     pub gather_points: usize,
     /// Dense solvers: rounds of adaptive subdivision after the first solve (each splits

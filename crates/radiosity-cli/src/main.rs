@@ -92,22 +92,9 @@ fn main() -> ExitCode {
 }
 
 /// The command line with every flag that takes a value accepting a negative number
-/// (`--tolerance -1`, `--scale -2`): clap otherwise reads "-1" as an unknown flag and
-/// suggests `-- -1`, which makes it a scene file name (QA of issue #16). The value is then
-/// refused, if it must be positive, by a message naming the flag and what it takes. The
-/// vectors (`--eye -1,2,3`) take any value starting with a hyphen (`allow_hyphen_values`).
+/// ([`radiosity_cli::args::negative_numbers`], QA of issue #16).
 fn command() -> clap::Command {
-    fn negative_numbers(cmd: clap::Command) -> clap::Command {
-        cmd.mut_args(|arg| {
-            if !arg.is_positional() && arg.get_action().takes_values() {
-                arg.allow_negative_numbers(true)
-            } else {
-                arg
-            }
-        })
-        .mut_subcommands(negative_numbers)
-    }
-    negative_numbers(Cli::command())
+    radiosity_cli::args::negative_numbers(Cli::command())
         // `check` prints its report, stage times included, whatever -q says: the shared
         // help ("no progress bars, timings or notes") was untrue there.
         .mut_subcommand("check", |check| {

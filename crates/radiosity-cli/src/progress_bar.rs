@@ -24,6 +24,8 @@ struct Ticker {
 pub struct Counting {
     /// The steps counted, plural: "sweeps".
     pub unit: &'static str,
+    /// One of them: "sweep" (QA of issue #16: "solve: 1 refinement rounds after 10 s").
+    pub one: &'static str,
     /// When the steps end: "it sweeps until the change falls below --tolerance".
     pub until: &'static str,
 }
@@ -35,15 +37,18 @@ impl Counting {
         Some(match solver {
             Solver::Dense(DenseSolver::GaussSeidel(_)) => Counting {
                 unit: "sweeps",
+                one: "sweep",
                 until: "Gauss-Seidel sweeps until the change falls below --tolerance",
             },
             Solver::Progressive(_) => Counting {
                 unit: "shots",
+                one: "shot",
                 until: "progressive refinement shoots until the unshot power falls below \
                         --tolerance",
             },
             Solver::Hierarchical(_) => Counting {
                 unit: "refinement rounds",
+                one: "refinement round",
                 until: "hierarchical radiosity refines until a round changes almost no \
                         links (its final gather then counts its points)",
             },
@@ -67,9 +72,13 @@ pub fn progress_line(
         return match counting {
             Some(c) => format!(
                 "{stage}: {done} {} after {secs:.0} s (no time left can be estimated: {})",
-                c.unit, c.until
+                if done == 1 { c.one } else { c.unit },
+                c.until
             ),
-            None => format!("{stage}: {done} steps after {secs:.0} s"),
+            None => format!(
+                "{stage}: {done} {} after {secs:.0} s",
+                if done == 1 { "step" } else { "steps" }
+            ),
         };
     }
     let fraction = done as f64 / total as f64;
@@ -347,6 +356,18 @@ mod tests {
             line.starts_with(
                 "solve: 17 refinement rounds after 30 s (no time left can be estimated: "
             ),
+            "{line}"
+        );
+        // One of them is one.
+        let line = progress_line(
+            "solve",
+            1,
+            0,
+            Duration::from_secs(10),
+            Counting::solve(&hierarchical),
+        );
+        assert!(
+            line.starts_with("solve: 1 refinement round after 10 s"),
             "{line}"
         );
         // LU knows its total: it gets the percentage and the time left instead.

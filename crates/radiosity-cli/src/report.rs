@@ -281,16 +281,17 @@ fn lying_on(prepared: &Prepared) {
         same_plane
     );
     const SHOWN: usize = 10;
+    let (length_unit, area_unit) = length_and_area_units();
     for o in pairs.iter().take(SHOWN) {
         let name = |s: u32| &scene.surfaces[s as usize].name;
         outln!(
-            "                  surface {} {:?} on surface {} {:?}: gap {:.3e}, covering {:.6}",
+            "                  surface {} {:?} on surface {} {:?}: gap {} {length_unit}, covering {} {area_unit}",
             o.upper,
             name(o.upper),
             o.lower,
             name(o.lower),
-            o.gap,
-            o.covered_area
+            significant(o.gap, 4),
+            significant(o.covered_area, 4)
         );
     }
     if pairs.len() > SHOWN {
@@ -347,6 +348,51 @@ fn lights(prepared: &Prepared) {
     }
 }
 
+/// `x` with `digits` significant digits, without an exponent for everyday magnitudes
+/// (1e-4 to 1e9) and without trailing zeros: 0.5080691785954333 -> "0.5081" at 4 (QA of
+/// issue #16: the exposure scale came with 16 digits, `check`'s areas as "7.2977e0").
+pub fn significant(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor();
+    if !(-4.0..=9.0).contains(&magnitude) {
+        return format!("{x:.prec$e}", prec = digits.saturating_sub(1));
+    }
+    let decimals = (digits as f64 - 1.0 - magnitude).max(0.0) as usize;
+    let text = format!("{x:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+/// The unit of lengths and of areas of the scene read, short, for figures: `mm` and `mm^2`
+/// for the built-in box, `m` for a file read in metres unscaled, else the words of the
+/// `unit` line (`scene units`, `square scene units`).
+pub fn length_and_area_units() -> (String, String) {
+    let unit = crate::setup::scene_unit();
+    if unit.contains(" x ") {
+        return (
+            "units (see unit)".to_string(),
+            "square units (see unit)".to_string(),
+        );
+    }
+    if unit.starts_with("millimetres") {
+        ("mm".to_string(), "mm^2".to_string())
+    } else if unit.starts_with("metres") {
+        ("m".to_string(), "m^2".to_string())
+    } else if unit == "scene units" {
+        ("scene units".to_string(), "square scene units".to_string())
+    } else {
+        (
+            "units (see unit)".to_string(),
+            "square units (see unit)".to_string(),
+        )
+    }
+}
+
 /// Prints the `check` report of `solution` (the stage times from `reporter`); `stats` are
 /// the form factors' statistics when the solve used a matrix.
 pub fn check(
@@ -363,7 +409,29 @@ pub fn check(
     outln!("unit              {}", crate::setup::scene_unit());
     outln!("surfaces          {}", scene.surfaces.len());
     outln!("elements          {}", solution.mesh.len());
-    outln!("total area        {:.6}", solution.mesh.total_area());
+    let (_, area_unit) = length_and_area_units();
+    // The elements' area: less than the surfaces' where contact refinement dropped buried
+    // pieces or a surface lying on another covers part of it (QA of issue #16: `generate`
+    // printed 173 m^2 for a room whose `check` said 167.078).
+    let surfaces_area: f64 = scene
+        .surfaces
+        .iter()
+        .map(|s| radiosity::geometry::polygon_area(&s.vertices))
+        .sum();
+    let elements_area = solution.mesh.total_area();
+    outln!(
+        "total area        {} {area_unit}{}",
+        significant(elements_area, 6),
+        if elements_area < surfaces_area * (1.0 - 1e-6) {
+            format!(
+                " (the elements'; the surfaces' {} less the parts buried under or covered \
+                 by other surfaces)",
+                significant(surfaces_area, 6)
+            )
+        } else {
+            String::new()
+        }
+    );
     let contacts = &prepared.contacts;
     if contacts.skipped {
         outln!(
@@ -373,10 +441,10 @@ pub fn check(
     } else {
         // One wording with hierarchical radiosity's "leaf contacts" below (QA of issue #16).
         outln!(
-            "contacts          {} elements split, {} dropped whole; buried and left out: {:.4e} area (of the grid's elements)",
+            "contacts          {} elements split, {} dropped whole; buried and left out: {} {area_unit} (of the grid's elements)",
             contacts.split,
             contacts.dropped,
-            contacts.buried_area
+            significant(contacts.buried_area, 4)
         );
     }
     lying_on(prepared);
@@ -456,9 +524,9 @@ pub fn check(
                 );
             } else {
                 outln!(
-                    "leaf contacts     {} patches (whole cells and pieces) dropped; buried and left out: {:.4e} area",
+                    "leaf contacts     {} patches (whole cells and pieces) dropped; buried and left out: {} {area_unit}",
                     report.buried_patches,
-                    report.buried_area
+                    significant(report.buried_area, 4)
                 );
             }
         }
@@ -485,12 +553,12 @@ pub fn check(
         }
     };
     outln!(
-        "energy ({})        emitted {:.6e} = absorbed {:.6e}{} + escaped {:.6e}{} (relative error {:.1e})",
+        "energy ({})        emitted {} = absorbed {}{} + escaped {}{} (relative error {:.1e})",
         BAND_NAMES[k],
-        b.emitted[k],
-        b.absorbed[k],
+        significant(b.emitted[k], 7),
+        significant(b.absorbed[k], 7),
         share(b.absorbed[k]),
-        b.escaped[k],
+        significant(b.escaped[k], 7),
         share(b.escaped[k]),
         b.relative_error()
     );
@@ -596,19 +664,55 @@ fn where_escaped(
         .take(5)
         .map(|&(share, s)| format!("{:.2} % {}", -100.0 * share, name(s)))
         .collect();
+    // What the lists leave out, so that their shares add up to the energy line's escaped
+    // share (QA of issue #16: five shares that did not add up to it, with no word why).
+    let (out_total, out_count, in_total, in_count) =
+        by_surface
+            .iter()
+            .fold((0.0, 0usize, 0.0, 0usize), |(o, oc, i, ic), e| {
+                let share = e[band] / emitted;
+                if share > 0.0 {
+                    (o + share, oc + 1, i, ic)
+                } else if share < 0.0 {
+                    (o, oc, i - share, ic + 1)
+                } else {
+                    (o, oc, i, ic)
+                }
+            });
+    let all = |shown: usize, count: usize, total: f64| {
+        if shown == count {
+            format!("{:.2} % in all", 100.0 * total)
+        } else {
+            format!(
+                "the {shown} largest of {count} surfaces, {:.2} % in all",
+                100.0 * total
+            )
+        }
+    };
     outln!(
-        "escaped from      {} (of emitted, by the surface it left, where its rows of form \
-         factors sum below 1: {ESCAPED})",
+        "escaped from      {} ({}{}; of emitted, by the surface it left, where its rows of \
+         form factors sum below 1: {ESCAPED})",
         if lost.is_empty() {
             "no surface".to_string()
         } else {
             lost.join(", ")
+        },
+        all(lost.len(), out_count, out_total),
+        if in_count > 0 {
+            format!(
+                ", less {:.2} % counted twice below: {:.2} % escaped",
+                100.0 * in_total,
+                100.0 * (out_total - in_total)
+            )
+        } else {
+            String::new()
         }
     );
     if !twice.is_empty() {
         outln!(
-            "counted twice by  {} (of emitted; {COUNTED_TWICE})",
-            twice.join(", ")
+            "counted twice by  {} ({}; of emitted; {COUNTED_TWICE})",
+            twice.join(", "),
+            all(twice.len(), in_count, in_total)
         );
     }
 }
@@ -845,10 +949,10 @@ pub fn path_traced(view: &PathTraced, settings: &PathTraceSettings) {
     );
     outln!(
         "noise             {:.2} % (RMS standard error of luminance over the mean luminance \
-         {:.4e}; mean standard error {:.4e}; {} pixels, {} showing an emitter left out)",
+         {}; mean standard error {}; {} pixels, {} showing an emitter left out)",
         100.0 * noise.relative(),
-        noise.mean_luminance,
-        noise.mean_standard_error,
+        significant(noise.mean_luminance, 4),
+        significant(noise.mean_standard_error, 4),
         noise.pixels,
         pixels - noise.pixels
     );
@@ -861,10 +965,10 @@ pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
     outln!(
         "compared          the radiosity render ({elements} elements) with the path-traced \
          view on luminance: {} pixels ({} showing an emitter left out), relative to the \
-         path tracer's RMS luminance {:.4e}",
+         path tracer's RMS luminance {}",
         c.pixels,
         c.excluded,
-        c.reference_rms_luminance
+        significant(c.reference_rms_luminance, 4)
     );
     outln!("rms               {:.2} %", 100.0 * c.rms);
     outln!("bias              {:+.2} %", 100.0 * c.bias);
@@ -876,5 +980,26 @@ pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
             100.0 * noise
         );
         outln!("rms less noise    {:.2} %", 100.0 * c.rms_less_noise());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::significant;
+
+    #[test]
+    fn significant_figures_read_as_plain_numbers() {
+        assert_eq!(significant(0.5080691785954333, 4), "0.5081");
+        assert_eq!(significant(7.2977, 4), "7.298");
+        assert_eq!(significant(20.0, 7), "20");
+        assert_eq!(significant(19.898112, 7), "19.89811");
+        assert_eq!(significant(0.1018865, 7), "0.1018865");
+        assert_eq!(significant(0.005, 4), "0.005");
+        assert_eq!(significant(106.83529, 6), "106.835");
+        assert_eq!(significant(123456.7, 4), "123457");
+        assert_eq!(significant(-2.5, 4), "-2.5");
+        // Outside everyday magnitudes: an exponent, with the figures asked for.
+        assert_eq!(significant(1.5e-7, 4), "1.500e-7");
+        assert_eq!(significant(0.0, 4), "0");
     }
 }

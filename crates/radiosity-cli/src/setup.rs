@@ -60,6 +60,8 @@ fn prepare_solve_as(
     reporter: &Reporter,
     method_used_elsewhere: bool,
 ) -> Result<(Prepared, String, Solver)> {
+    check_scene_flags(args)?;
+    check_solve_flags(options)?;
     check_form_factor_file(options)?;
     let (prepared, stem) = prepare_scene(args, reporter)?;
     let solver = solver(
@@ -137,16 +139,12 @@ fn method_flag_given(args: &MethodArgs) -> Option<&'static str> {
 /// form-factor method set; none of [`prepare`]'s memory and work checks (for a caller that
 /// computes the matrix in blocks and never holds it: `radiosity-mpi`).
 pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared, String)> {
+    check_scene_flags(args)?;
     let (file, stem) = load_scene(args.scene.as_deref(), args.scale, reporter)?;
     let overrides = Overrides {
         max_patch_area: args.max_area,
         integral_steps: args.steps,
     };
-    if let Some(k) = args.steps {
-        if k == 0 {
-            bail!("--steps must be at least 1");
-        }
-    }
     let settings = overrides.apply(file.settings);
     let mut prepared = Prepared::new(file.scene, settings, reporter).map_err(|e| match e {
         // Say where the MAX_PATCH_AREA that cannot be met came from.
@@ -233,6 +231,73 @@ pub fn method_name(method: MethodArg) -> &'static str {
     }
 }
 
+/// The numbers of the scene's flags that need no scene (`--scale`, `--max-area`,
+/// `--steps`), checked before the scene is read, each refusal naming its flag (QA of issue
+/// #16: `--max-area 0` was refused as "MAX_PATCH_AREA must be a positive number" and
+/// `--scale 0` as "the scale", after the scene file was read, seconds on a large one).
+pub fn check_scene_flags(args: &SceneArgs) -> Result<()> {
+    if !(args.scale > 0.0 && args.scale.is_finite()) {
+        bail!(
+            "--scale {}: give the factor every coordinate is multiplied by, a number above 0",
+            args.scale
+        );
+    }
+    if let Some(a) = args.max_area {
+        if !(a > 0.0 && a.is_finite()) {
+            bail!(
+                "--max-area {a}: give the largest element area (scene units squared), a \
+                 number above 0"
+            );
+        }
+    }
+    if args.steps == Some(0) {
+        bail!("--steps 0: give the points along each axis of an element, at least 1");
+    }
+    Ok(())
+}
+
+/// The numbers of the solver's flags that need no scene, checked before the scene is read
+/// (QA of issue #16: `--epsilon -1` or `--max-shots 0` was refused only after the meshing
+/// and contact refinement). A flag of a solver the run does not use is checked too: a
+/// value that no solver takes is a mistake whichever runs.
+pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
+    if let Some(t) = options.tolerance {
+        if !(t > 0.0 && t.is_finite()) {
+            bail!("--tolerance must be a positive number, got {t}");
+        }
+        if options.solver.0 == SolverKind::Hierarchical && t >= 1.0 {
+            bail!("--tolerance must be a number in (0, 1) for --solver hierarchical, got {t}");
+        }
+    }
+    if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
+        bail!(
+            "--epsilon must be a positive number, got {}",
+            options.epsilon
+        );
+    }
+    if let Some(a) = options.min_area {
+        if !(a > 0.0 && a.is_finite()) {
+            bail!("--min-area must be a positive number, got {a}");
+        }
+    }
+    if options.gather_points == 0 {
+        bail!("--gather-points must be at least 1 (--no-final-gather leaves the gather out)");
+    }
+    if options.max_shots == 0 {
+        bail!("--max-shots must be at least 1");
+    }
+    if !(options.adapt_contrast > 0.0 && options.adapt_contrast.is_finite()) {
+        bail!(
+            "--adapt-contrast must be a positive number, got {}",
+            options.adapt_contrast
+        );
+    }
+    if options.adapt_max_elements == Some(0) {
+        bail!("--adapt-max-elements must be at least 1");
+    }
+    Ok(())
+}
+
 /// Where the MAX_PATCH_AREA in force came from: `--max-area`, the scene file's line
 /// (`room.scene:1: MAX_PATCH_AREA 0.001`), or the built-in box.
 fn max_area_origin(args: &SceneArgs) -> String {
@@ -308,6 +373,14 @@ pub fn refuse_overwriting_inputs(output: &Path, inputs: &[(&str, Option<&Path>)]
     }
     Ok(())
 }
+
+/// What the illuminance figures of `illuminance` and `render --false-colour` are in. The
+/// light of emitting surfaces reaches a point through form factors, which have no unit, so
+/// it is in the emission's units whatever the length unit; only point luminaires (I / d^2)
+/// and `FLUX` (lumens over an area) depend on lengths (QA of issue #16: the note said lux
+/// needed lengths in metres, which the Cornell box in millimetres seemed to break).
+pub const LUX_NOTE: &str = "lux where Er Eg Eb are in lm/m^2, whatever the length unit; \
+                            point luminaires and FLUX need lengths in metres (--scale)";
 
 /// The length unit of the scene [`load_scene`] read last, in the reader's words (with
 /// `--scale`), for the reports that give lengths or areas.
@@ -446,11 +519,7 @@ fn solver(
     max_patch_area: f64,
     reporter: &Reporter,
 ) -> Result<Solver> {
-    if let Some(t) = options.tolerance {
-        if !(t > 0.0 && t.is_finite()) {
-            bail!("--tolerance must be a positive number, got {t}");
-        }
-    }
+    // The numbers alone were checked before the scene was read (check_solve_flags).
     let choice = match options.solver.0 {
         SolverKind::Auto if options.form_factors.is_some() => {
             reporter.note(
@@ -519,9 +588,6 @@ fn solver(
         )),
         SolverKind::Progressive => {
             // --form-factors with it is refused before the scene is read.
-            if options.max_shots == 0 {
-                bail!("--max-shots must be at least 1");
-            }
             Solver::Progressive(ProgressiveSettings {
                 tolerance: options
                     .tolerance
@@ -532,20 +598,8 @@ fn solver(
         SolverKind::Hierarchical => {
             // --form-factors with it is refused before the scene is read.
             let min_area = options.min_area.unwrap_or(max_patch_area / 16.0);
-            if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
-                bail!(
-                    "--epsilon must be a positive number, got {}",
-                    options.epsilon
-                );
-            }
-            if !(min_area > 0.0 && min_area.is_finite()) {
-                bail!("--min-area must be a positive number, got {min_area}");
-            }
-            if options.gather_points == 0 {
-                bail!(
-                    "--gather-points must be at least 1 (--no-final-gather leaves the gather out)"
-                );
-            }
+            // The flags' numbers were checked before the scene was read; the tolerance's
+            // upper bound is checked here too, where `auto` chose hierarchical radiosity.
             let tolerance = options
                 .tolerance
                 .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
@@ -684,6 +738,47 @@ pub fn output_extension(output: &Path, flag: &str, what: &str, extensions: &[&st
     )
 }
 
+/// Refuses, before any work, an output that cannot be written: named with none of the
+/// `extensions` ([`output_extension`]), in a directory that does not exist, a directory
+/// itself, or one of the `inputs` ([`refuse_overwriting_inputs`]). Every command that
+/// writes a file checks its name so, and so does `radiosity-mpi` before any rank reads the
+/// scene. `flag` names the option, `what` what is written.
+pub fn check_output(
+    output: &Path,
+    flag: &str,
+    what: &str,
+    extensions: &[&str],
+    inputs: &[(&str, Option<&Path>)],
+) -> Result<()> {
+    refuse_overwriting_inputs(output, inputs)?;
+    output_extension(output, flag, what, extensions)?;
+    output_directory(output, flag)
+}
+
+/// Refuses an output whose directory does not exist or that is a directory (QA of issue
+/// #16: `solve -o nowhere/x.csv` solved the scene, then failed to write).
+pub fn output_directory(output: &Path, flag: &str) -> Result<()> {
+    if output.is_dir() {
+        bail!(
+            "{flag} {}: is a directory; give a file name in it",
+            output.display()
+        );
+    }
+    let dir = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => return Ok(()),
+    };
+    if !dir.is_dir() {
+        bail!(
+            "{flag} {}: the directory {} does not exist; create it first (mkdir -p {})",
+            output.display(),
+            dir.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
 /// `--gamma`, checked.
 pub fn gamma(args: &ToneArgs) -> Result<f64> {
     if !(args.gamma > 0.0 && args.gamma.is_finite()) {
@@ -782,12 +877,6 @@ pub fn adapt(
     prepared: &Prepared,
     solver: &Solver,
 ) -> Result<Option<AdaptSettings>> {
-    if !(options.adapt_contrast > 0.0 && options.adapt_contrast.is_finite()) {
-        bail!(
-            "--adapt-contrast must be a positive number, got {}",
-            options.adapt_contrast
-        );
-    }
     let rounds = options.adapt_rounds.unwrap_or(DEFAULT_ADAPT_ROUNDS);
     if !solver.needs_matrix() && options.adapt_rounds.is_some_and(|r| r > 0) {
         // Printed even with --quiet: the run does not do what the flags say.

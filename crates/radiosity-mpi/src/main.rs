@@ -26,7 +26,7 @@ use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use radiosity::form_factor::available_memory_bytes;
@@ -106,7 +106,10 @@ fn main() -> ExitCode {
     };
     let world = universe.world();
     let rank = world.rank();
-    let cli = match Cli::try_parse() {
+    // Negative numbers are values, as for `radiosity` (QA of issue #16: `--epsilon -1` was
+    // "unexpected argument '-1'" here).
+    let matches = radiosity_cli::args::negative_numbers(Cli::command()).try_get_matches();
+    let cli = match matches.and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(cli) => cli,
         Err(e) => {
             // Every rank parses the same flags; one copy of the message is enough.
@@ -175,26 +178,46 @@ fn broadcast_decision(world: &SimpleCommunicator, deal: bool) -> bool {
     flag == 1
 }
 
+/// The command's outputs and the flags that need no scene, checked on rank 0 before any
+/// rank reads the scene, by the same code as `radiosity`'s (QA of issue #16: `-o x.txt`,
+/// `-o nowhere/x.ff` or `-o` the scene itself were found only after every rank had read and
+/// meshed the scene, or after the whole job). Returns the form-factor output of
+/// `formfactors`.
+fn check_outputs(command: &Command) -> Result<Option<PathBuf>> {
+    Ok(match command {
+        Command::Formfactors { args, .. } => {
+            Some(radiosity_cli::commands::formfactors::output(args)?)
+        }
+        Command::Solve { args, .. } => {
+            radiosity_cli::commands::solve::outputs(args)?;
+            None
+        }
+        Command::Render { args, .. } => {
+            radiosity_cli::commands::render::check(args)?;
+            None
+        }
+    })
+}
+
 /// Rank 0: prepare, deal and write the form factors, then run the rest of the command.
 fn lead(world: &SimpleCommunicator, cli: Cli) -> Result<()> {
     let reporter = Reporter::new(scene_args(&cli.command).quiet);
     let alone = "radiosity-mpi: this solve takes no matrix of form factors (its solver computes \
                  its own, it reads them from a file, or adaptive subdivision remeshes): rank 0 \
                  runs it alone";
+    // A refused output stops every rank before any reads the scene: they are told that no
+    // form factors are dealt, and end.
+    let output = match check_outputs(&cli.command) {
+        Ok(output) => output,
+        Err(err) => {
+            broadcast_decision(world, false);
+            return Err(err);
+        }
+    };
     match cli.command {
         Command::Formfactors { args, mpi } => {
             broadcast_decision(world, true);
-            let output = args.output.clone().unwrap_or_else(|| {
-                PathBuf::from(format!(
-                    "{}.ff",
-                    setup::stem_of(args.scene.scene.as_deref())
-                ))
-            });
-            setup::refuse_overwriting_inputs(
-                &output,
-                &[("scene file", args.scene.scene.as_deref())],
-            )
-            .inspect_err(|_| stop_all(world, &mut vec![false; world.size() as usize]))?;
+            let output = output.expect("formfactors has an output");
             deal_form_factors(world, &args.scene, &mpi, &output, &reporter)?;
             reporter.print_timings();
             Ok(())

@@ -404,3 +404,74 @@ fn a_checkpoint_of_another_method_or_mesh_is_refused() {
     run_mpi(&mpirun, 2, &again);
     assert_eq!(std::fs::read(&out).unwrap(), first);
 }
+
+/// Outputs that cannot be written are refused on rank 0 before any rank reads the scene,
+/// by `radiosity`'s own checks (QA of issue #16: every rank read and meshed the scene, or
+/// the whole job ran, first). The scene named does not exist, so a rank that read it would
+/// fail on that instead; the refusal names the output, comes once, and comes within the
+/// limit (a job that read a scene would still stop, but say so).
+#[test]
+fn outputs_are_refused_before_any_rank_reads_the_scene() {
+    let Some(mpirun) = mpirun() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("absent.scene");
+    let missing = missing.to_str().unwrap();
+    let real = dir.path().join("room.scene");
+    std::fs::copy(scene(), &real).unwrap();
+    let real = real.to_str().unwrap();
+    let nowhere = dir.path().join("nowhere").join("x.ff");
+    let txt = dir.path().join("x.txt");
+    let (txt, nowhere) = (txt.to_str().unwrap(), nowhere.to_str().unwrap());
+    let csv = dir.path().join("x.csv").to_str().unwrap().to_string();
+    let cases: [(&[&str], &str); 6] = [
+        (&["formfactors", missing, "-o", txt], "binary matrix format"),
+        (&["formfactors", missing, "-o", nowhere], "does not exist"),
+        (&["formfactors", real, "-o", real], "is the scene file"),
+        (
+            &["solve", missing, "-o", txt],
+            "give it a .csv or .json name",
+        ),
+        (
+            &["render", missing, "-o", txt],
+            "give the output a .png name",
+        ),
+        (
+            &["solve", missing, "-o", &csv, "--epsilon", "-1"],
+            "--epsilon",
+        ),
+    ];
+    for (args, expect) in cases {
+        let start = Instant::now();
+        let child = mpi_command(&mpirun, 2, args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let out = wait_bounded(child, Duration::from_secs(60), "a refused output");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} was not refused:\n{err}");
+        assert!(
+            err.contains(expect),
+            "{args:?}: expected {expect:?} in:\n{err}"
+        );
+        assert!(
+            !err.contains("absent.scene"),
+            "{args:?}: a rank read the scene before the output was checked:\n{err}"
+        );
+        assert_eq!(
+            err.matches("error:").count(),
+            1,
+            "{args:?}: one rank should say it, once:\n{err}"
+        );
+        assert!(
+            std::fs::read_dir(dir.path()).unwrap().count() == 1,
+            "{args:?} wrote a file"
+        );
+        eprintln!("{args:?}: refused in {:.2?}", start.elapsed());
+    }
+    assert_eq!(
+        std::fs::read(real).unwrap(),
+        std::fs::read(scene()).unwrap(),
+        "the scene given as its own output was changed"
+    );
+}

@@ -12,7 +12,9 @@ use radiosity::shade::{self, Exposure};
 use super::{exposure_note, solve_as_asked};
 use crate::args::ExportArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{camera, load_scene, prepare_solve, refuse_overwriting_inputs};
+use crate::setup::{
+    camera, load_scene, output_directory, prepare_solve, refuse_overwriting_inputs,
+};
 
 /// What `-o` asks for, by extension.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -55,6 +57,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
     for out in &outputs {
         refuse_overwriting_inputs(out, &inputs)?;
     }
+    output_directory(output, "-o")?;
     // Printed even with --quiet: the file will not hold what the scene holds.
     let warn_lights = |scene: &radiosity::scene::Scene| {
         if !scene.lights.is_empty() {

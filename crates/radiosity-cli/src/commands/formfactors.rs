@@ -7,22 +7,31 @@ use anyhow::Result;
 use crate::args::FormFactorArgs;
 use crate::progress_bar::Reporter;
 use crate::report;
-use crate::setup::{output_extension, prepare, refuse_overwriting_inputs, stem_of};
+use crate::setup::{check_output, check_scene_flags, prepare, stem_of};
 
-pub fn run(args: FormFactorArgs) -> Result<()> {
-    let reporter = Reporter::new(args.scene.quiet);
+/// The output `args` name (default `<scene>.ff`), checked before any work
+/// ([`check_output`]); `radiosity-mpi formfactors` checks it so too, before any rank reads
+/// the scene.
+pub fn output(args: &FormFactorArgs) -> Result<PathBuf> {
     let output = args
         .output
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{}.ff", stem_of(args.scene.scene.as_deref()))));
-    refuse_overwriting_inputs(&output, &[("scene file", args.scene.scene.as_deref())])?;
-    output_extension(
+    check_output(
         &output,
         "-o",
         "the form factors are written in this program's binary matrix format, read back by \
          --form-factors (`solve` writes radiosities as CSV)",
         &["ff"],
+        &[("scene file", args.scene.scene.as_deref())],
     )?;
+    check_scene_flags(&args.scene)?;
+    Ok(output)
+}
+
+pub fn run(args: FormFactorArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let output = output(&args)?;
     let (prepared, _) = prepare(&args.scene, &reporter)?;
     reporter.note(&format!(
         "form factors by {}; occlusion: {}",

@@ -3,10 +3,54 @@
 use anyhow::{bail, Context, Result};
 use radiosity::pipeline::Prepared;
 use radiosity::progress::NoProgress;
-use radiosity::scene;
+use radiosity::scene::{self, BuildingError};
 
 use crate::args::BuildingArgs;
 use crate::report;
+
+/// The library's refusal of the building's parameters in the words of the flags (QA of
+/// issue #16: `--max-area 0` was refused as "MAX_PATCH_AREA must be ...", `--rooms-x 0` as
+/// "floors, rooms-x and rooms-z must be at least 1").
+fn flag_at_fault(e: &BuildingError) -> String {
+    match e {
+        BuildingError::NoRooms(what) => {
+            let (flag, what) = match *what {
+                "floors" => ("--floors", "floor"),
+                "rooms along x" => ("--rooms-x", "room along x"),
+                _ => ("--rooms-z", "room along z"),
+            };
+            format!("{flag} 0: a building needs at least 1 {what}")
+        }
+        BuildingError::RoomSize {
+            size,
+            min,
+            furniture,
+        } => format!(
+            "--room-size {size}: give the inner side of a room in metres, {min} to 100{}",
+            if *furniture {
+                " (the furniture needs 5.7; --no-furniture allows 2.5)"
+            } else {
+                ""
+            }
+        ),
+        BuildingError::Height(h) => {
+            format!("--height {h}: give the floor-to-ceiling height in metres, 2.4 to 20")
+        }
+        BuildingError::MaxPatchArea(a) => format!(
+            "--max-area {a}: give the largest element area in square metres, a number above 0"
+        ),
+        BuildingError::IntegralSteps => {
+            "--steps 0: give the points along each axis of an element, at least 1".to_string()
+        }
+        BuildingError::Light(l) => format!(
+            "--light {l}: give the ceiling panels' exitance in lm/m^2, a number of at least 0"
+        ),
+        BuildingError::TooManyRooms(n) => format!(
+            "--floors x --rooms-x x --rooms-z make {n} rooms, more than the limit of {}",
+            scene::BuildingParams::MAX_ROOMS
+        ),
+    }
+}
 
 pub fn building(args: BuildingArgs) -> Result<()> {
     let params = scene::BuildingParams {
@@ -23,15 +67,16 @@ pub fn building(args: BuildingArgs) -> Result<()> {
     };
     // The other commands read a scene by its extension (QA of issue #16: `-o b.txt` was
     // written, then refused by every command that read it).
-    crate::setup::output_extension(
+    crate::setup::check_output(
         &args.output,
         "-o",
         "the building is written in the scene format (Appendix A), which the other \
          commands read by the extension .scene",
         &["scene"],
+        &[],
     )?;
     if let Err(e) = params.check() {
-        bail!("{e}");
+        bail!("{}", flag_at_fault(&e));
     }
     let built = scene::building(&params);
     scene::write_scene_file(&built.scene, built.settings, &args.output)

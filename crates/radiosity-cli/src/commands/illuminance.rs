@@ -7,7 +7,7 @@ use radiosity::progress::{run_stage, Stage};
 use super::solve_as_asked;
 use crate::args::IlluminanceArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{output_extension, prepare_solve, refuse_overwriting_inputs};
+use crate::setup::{check_output, prepare_solve};
 
 /// The most grid points one run computes.
 const MAX_GRID_POINTS: usize = 1_000_000;
@@ -19,16 +19,21 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         ("points file", args.points.as_deref()),
         ("form-factor file", args.solve.form_factors.as_deref()),
     ];
-    refuse_overwriting_inputs(&args.output, &inputs)?;
-    output_extension(
+    check_output(
         &args.output,
         "-o",
         "the illuminance is written as a CSV table",
         &["csv"],
+        &inputs,
     )?;
     if let Some(png) = &args.png {
-        refuse_overwriting_inputs(png, &inputs)?;
-        output_extension(png, "--png", "the grid's picture is a PNG", &["png"])?;
+        check_output(
+            png,
+            "--png",
+            "the grid's picture is a PNG",
+            &["png"],
+            &inputs,
+        )?;
     }
     let (points, dims) = match (&args.points, args.grid) {
         (Some(path), _) => (illuminance::read_points(path)?, None),
@@ -84,9 +89,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     });
     write(&args, &points, &lux)?;
     reporter.note(&format!(
-        "wrote {} ({} points; lux = lm/m^2 with scene lengths in metres; the scene's unit: {})",
+        "wrote {} ({} points; {}; the scene's unit: {})",
         args.output.display(),
         points.len(),
+        crate::setup::LUX_NOTE,
         crate::setup::scene_unit()
     ));
     if let (Some(png), Some(dims)) = (&args.png, dims) {

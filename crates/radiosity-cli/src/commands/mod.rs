@@ -210,9 +210,10 @@ pub fn exposure_note(
     }
     let brightest = lit_radiosity_top_mean(&prepared.scene, mesh, element_b, 0.0).unwrap_or(0.0);
     format!(
-        "exposure scale {scale} (auto: {:.4}, the mean radiosity of the brightest {} % of \
+        "exposure scale {} (auto: {:.4}, the mean radiosity of the brightest {} % of \
          the non-emitting area, is white; the brightest non-emitting element is {:.4}, \
          {:.2} x white)",
+        crate::report::significant(scale, 4),
         1.0 / scale,
         100.0 * AUTO_EXPOSURE_TOP_AREA,
         brightest,

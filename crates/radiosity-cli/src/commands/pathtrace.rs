@@ -151,6 +151,12 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     outputs.extend(args.save_reference.clone());
     for out in &outputs {
         setup::refuse_overwriting_inputs(out, &inputs)?;
+        let flag = if args.save_reference.as_ref() == Some(out) {
+            "--save-reference"
+        } else {
+            "-o"
+        };
+        setup::output_directory(out, flag)?;
     }
 
     // The path-traced view: traced, or read back.
@@ -203,8 +209,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             reporter.print_timings();
             return Ok(());
         }
+        let shown = report::significant(scale, 4);
         reporter.note(&format!(
-            "exposure scale {scale} (`render --exposure {scale}` shows a render with it)"
+            "exposure scale {shown} (`render --exposure {shown}` shows a render with it)"
         ));
         write_image(
             &tonemap::to_image(view.film(), scale, gamma),
@@ -266,14 +273,16 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     )?;
     if args.tone.exposure == Exposure::Auto {
         reporter.note(&format!(
-            "exposure scale {scale} (auto, the radiosity solution's); the path-traced view's \
+            "exposure scale {} (auto, the radiosity solution's); the path-traced view's \
              own auto exposure would be {}",
-            view.auto_exposure_scale()
+            report::significant(scale, 4),
+            report::significant(view.auto_exposure_scale(), 4)
         ));
     }
     reporter.note(&format!(
-        "exposure scale {scale} for both; error map: white 0, blue darker and red brighter \
+        "exposure scale {} for both; error map: white 0, blue darker and red brighter \
          than the path tracer, full colour at {} % of its RMS luminance, black left out",
+        report::significant(scale, 4),
         100.0 * args.error_scale
     ));
     reporter.print_timings();

@@ -12,12 +12,26 @@ use super::{exposure_note, shade_and_render, shade_and_render_linear, solve_scen
 use crate::args::RenderArgs;
 use crate::progress_bar::Reporter;
 use crate::setup::{
-    camera, image_format, prepare_solve, refuse_overwriting_inputs, render_settings, stem_of,
-    ImageFormat,
+    camera, check_scene_flags, check_solve_flags, image_format, output_directory, prepare_solve,
+    refuse_overwriting_inputs, render_settings, stem_of, ImageFormat,
 };
 
-pub fn run(args: RenderArgs) -> Result<()> {
-    let reporter = Reporter::new(args.scene.quiet);
+/// What [`check`] found `render`'s flags to ask for.
+pub struct Checked {
+    /// The image to write (`-o`, default `<scene>.png`).
+    pub output: PathBuf,
+    /// The render settings of the flags.
+    pub settings: render::RenderSettings,
+    /// PNG or OpenEXR, by the output's extension.
+    pub format: ImageFormat,
+}
+
+/// `render`'s output and the flags that need no scene, checked before any work: the
+/// output's name ([`image_format`], [`output_directory`], not an input), the render
+/// settings, `--false-colour` and `--snapshot-every` against the others, and the scene's
+/// and solver's numbers. `radiosity-mpi render` checks them so too, before any rank reads
+/// the scene.
+pub fn check(args: &RenderArgs) -> Result<Checked> {
     let output = args
         .output
         .clone()
@@ -29,8 +43,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
             ("form-factor file", args.solve.form_factors.as_deref()),
         ],
     )?;
-    let settings = render_settings(&args)?;
+    let settings = render_settings(args)?;
     let format = image_format(Some(&output))?;
+    output_directory(&output, "-o")?;
     if format == ImageFormat::Exr && settings.shading == render::Shading::Wireframe {
         bail!(
             "{}: a wireframe has no light to write as linear radiance; give --shading smooth \
@@ -61,6 +76,22 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if args.snapshot_every == 0 {
         bail!("--snapshot-every must be at least 1");
     }
+    check_scene_flags(&args.scene)?;
+    check_solve_flags(&args.solve)?;
+    Ok(Checked {
+        output,
+        settings,
+        format,
+    })
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let Checked {
+        output,
+        settings,
+        format,
+    } = check(&args)?;
     if args.snapshots.is_none() && args.snapshot_every != RenderArgs::SNAPSHOT_EVERY {
         // Printed even with --quiet: the run does not do what the flags say.
         errln!("warning: --snapshot-every ignored: no --snapshots DIR to write snapshots to");
@@ -129,7 +160,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
         return Err(e);
     }
     if let Some(dir) = &args.snapshots {
-        reporter.note(&format!("wrote {written} snapshots to {}", dir.display()));
+        reporter.note(&format!(
+            "wrote {written} snapshot{} to {}",
+            if written == 1 { "" } else { "s" },
+            dir.display()
+        ));
     }
     if args.false_colour {
         return false_colour(
@@ -266,13 +301,14 @@ fn false_colour(
     .with_context(|| format!("cannot write {}", output.display()))?;
     reporter.note(&format!(
         "wrote {} ({} x {} and a {} pixel scale bar; false colour from 0 to {} lx, the \
-         largest element illuminance is {} lx; lux = lm/m^2 with scene lengths in metres)",
+         largest element illuminance is {} lx; {})",
         output.display(),
         camera.width,
         camera.height,
         radiosity::illuminance::SCALE_BAR_WIDTH,
         radiosity::illuminance::lux_label(max),
         radiosity::illuminance::lux_label(largest),
+        crate::setup::LUX_NOTE,
     ));
     reporter.print_timings();
     Ok(())

@@ -8,10 +8,12 @@ use radiosity::progress::{run_stage, Stage};
 use super::solve_as_asked;
 use crate::args::SolveArgs;
 use crate::progress_bar::Reporter;
-use crate::setup::{output_extension, prepare_solve, refuse_overwriting_inputs, stem_of};
+use crate::setup::{check_output, check_scene_flags, check_solve_flags, prepare_solve, stem_of};
 
-pub fn run(args: SolveArgs) -> Result<()> {
-    let reporter = Reporter::new(args.scene.quiet);
+/// The outputs `args` name (`-o`, default `<scene>.csv`, and `--report`), checked before
+/// any work ([`check_output`]), with the flags' numbers; `radiosity-mpi solve` checks them
+/// so too, before any rank reads the scene.
+pub fn outputs(args: &SolveArgs) -> Result<PathBuf> {
     let output = args
         .output
         .clone()
@@ -20,20 +22,20 @@ pub fn run(args: SolveArgs) -> Result<()> {
         ("scene file", args.scene.scene.as_deref()),
         ("form-factor file", args.solve.form_factors.as_deref()),
     ];
-    refuse_overwriting_inputs(&output, &inputs)?;
-    output_extension(
+    check_output(
         &output,
         "-o",
         "the element radiosities are written as CSV, or JSON for a .json name",
         &["csv", "json"],
+        &inputs,
     )?;
     if let Some(report) = &args.report {
-        refuse_overwriting_inputs(report, &inputs)?;
-        output_extension(
+        check_output(
             report,
             "--report",
             "the per-surface report is a CSV table",
             &["csv"],
+            &inputs,
         )?;
         if radiosity::io::is_same_file(report, &output) || report == &output {
             bail!(
@@ -42,6 +44,14 @@ pub fn run(args: SolveArgs) -> Result<()> {
             );
         }
     }
+    check_scene_flags(&args.scene)?;
+    check_solve_flags(&args.solve)?;
+    Ok(output)
+}
+
+pub fn run(args: SolveArgs) -> Result<()> {
+    let reporter = Reporter::new(args.scene.quiet);
+    let output = outputs(&args)?;
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let solution = solve_as_asked(&prepared, solver, &args.solve, &reporter)?;
     run_stage(&reporter, Stage::Write, 0, || {

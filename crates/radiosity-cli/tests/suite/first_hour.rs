@@ -1137,3 +1137,347 @@ fn an_obj_export_says_which_solve_and_camera_flags_it_ignores() {
     assert_eq!(stderr(&out), "");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn flag_numbers_are_refused_before_the_scene_is_read() {
+    // QA of issue #16: `--max-area 0` was refused as "MAX_PATCH_AREA must be a positive
+    // number" and `--scale 0` as "the scale", and `--epsilon -1` or `--max-shots 0` only
+    // after the meshing and contact refinement. The scene named does not exist: a refusal
+    // that names the flag, not the missing file, was made before the scene was read.
+    let dir = scratch_dir("flag-numbers");
+    for (args, needle) in [
+        (
+            vec!["check", "absent.scene", "--max-area", "0"],
+            "--max-area 0: give the largest element area",
+        ),
+        (
+            vec!["formfactors", "absent.scene", "--max-area", "-1"],
+            "--max-area -1: give the largest element area",
+        ),
+        (
+            vec!["render", "absent.scene", "--steps", "0"],
+            "--steps 0: give the points along each axis",
+        ),
+        (
+            vec!["check", "absent.scene", "--scale", "NaN"],
+            "--scale NaN: give the factor",
+        ),
+        (
+            vec!["solve", "absent.scene", "--epsilon", "-1"],
+            "--epsilon must be a positive number, got -1",
+        ),
+        (
+            vec!["solve", "absent.scene", "--max-shots", "0"],
+            "--max-shots must be at least 1",
+        ),
+        (
+            vec!["render", "absent.scene", "--gather-points", "0"],
+            "--gather-points must be at least 1",
+        ),
+        (
+            vec!["render", "absent.scene", "--adapt-contrast", "0"],
+            "--adapt-contrast must be a positive number",
+        ),
+        (
+            vec!["check", "absent.scene", "--min-area", "inf"],
+            "--min-area must be a positive number, got inf",
+        ),
+        (
+            vec![
+                "solve",
+                "absent.scene",
+                "--solver",
+                "hierarchical",
+                "--tolerance",
+                "2",
+            ],
+            "--tolerance must be a number in (0, 1) for --solver hierarchical",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(
+            !err.contains("absent.scene"),
+            "{args:?} read the scene first: {err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn outputs_that_cannot_be_written_are_refused_before_any_work() {
+    // QA of issue #16: `solve -o nowhere/x.csv` solved the scene, then failed to write. The
+    // scene named does not exist, so a refusal naming the output came before it was read.
+    let dir = scratch_dir("output-dirs");
+    std::fs::create_dir(dir.join("taken.csv")).unwrap();
+    for (args, needle) in [
+        (
+            vec!["solve", "absent.scene", "-o", "nowhere/x.csv"],
+            "-o nowhere/x.csv: the directory nowhere does not exist",
+        ),
+        (
+            vec![
+                "solve",
+                "absent.scene",
+                "-o",
+                "x.csv",
+                "--report",
+                "no/r.csv",
+            ],
+            "--report no/r.csv: the directory no does not exist",
+        ),
+        (
+            vec!["solve", "absent.scene", "-o", "taken.csv"],
+            "-o taken.csv: is a directory",
+        ),
+        (
+            vec!["render", "absent.scene", "-o", "nowhere/x.png"],
+            "the directory nowhere does not exist",
+        ),
+        (
+            vec!["formfactors", "absent.scene", "-o", "nowhere/x.ff"],
+            "the directory nowhere does not exist",
+        ),
+        (
+            vec!["export", "absent.scene", "-o", "nowhere/x.glb"],
+            "the directory nowhere does not exist",
+        ),
+        (
+            vec![
+                "illuminance",
+                "absent.scene",
+                "--points",
+                "p.csv",
+                "-o",
+                "nowhere/l.csv",
+            ],
+            "the directory nowhere does not exist",
+        ),
+        (
+            vec!["generate", "building", "-o", "nowhere/b.scene"],
+            "the directory nowhere does not exist",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(
+            !err.contains("absent.scene"),
+            "{args:?} read the scene first: {err}"
+        );
+    }
+    assert!(!dir.join("nowhere").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn generate_refusals_name_the_flag_at_fault() {
+    // QA of issue #16: `--rooms-z 0` was "floors, rooms-x and rooms-z must be at least 1",
+    // `--max-area 0` "MAX_PATCH_AREA must be a positive number".
+    let dir = scratch_dir("generate-flags");
+    for (flags, needle) in [
+        (
+            vec!["--rooms-z", "0"],
+            "--rooms-z 0: a building needs at least 1 room along z",
+        ),
+        (
+            vec!["--floors", "0"],
+            "--floors 0: a building needs at least 1 floor",
+        ),
+        (
+            vec!["--room-size", "3"],
+            "--room-size 3: give the inner side of a room in metres, 5.7 to 100",
+        ),
+        (
+            vec!["--room-size", "2", "--no-furniture"],
+            "--room-size 2: give the inner side of a room in metres, 2.5 to 100",
+        ),
+        (
+            vec!["--height", "30"],
+            "--height 30: give the floor-to-ceiling height",
+        ),
+        (
+            vec!["--max-area", "0"],
+            "--max-area 0: give the largest element area",
+        ),
+        (
+            vec!["--steps", "0"],
+            "--steps 0: give the points along each axis",
+        ),
+        (
+            vec!["--light", "-1"],
+            "--light -1: give the ceiling panels' exitance",
+        ),
+        (
+            vec!["--rooms-x", "1000", "--rooms-z", "1000"],
+            "make 2000000 rooms, more than the limit of 100000",
+        ),
+    ] {
+        let mut args = vec!["generate", "building", "-o", "b.scene"];
+        args.extend(&flags);
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{flags:?}: {err}");
+        assert!(err.contains(needle), "{flags:?}: {err}");
+        assert!(!dir.join("b.scene").exists(), "{flags:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The number after `key` on the first line of `text` that has it.
+fn number_after(text: &str, key: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.contains(key))
+        .unwrap_or_else(|| panic!("no {key:?} in {text}"));
+    let rest = &line[line.find(key).unwrap() + key.len()..];
+    rest.split_whitespace()
+        .next()
+        .and_then(|w| w.trim_end_matches([',', ';', ')']).parse().ok())
+        .unwrap_or_else(|| panic!("no number after {key:?} in {line:?}"))
+}
+
+#[test]
+fn check_gives_plain_numbers_with_units_and_lists_that_add_up() {
+    // QA of issue #16: `check` printed "buried and left out: 7.2977e0 area" and
+    // "emitted 2.000000e1"; its five "escaped from" shares did not make the escaped share,
+    // with no word that the list was the largest five.
+    let dir = scratch_dir("check-numbers");
+    let out = radiosity(&["check", &crate::fixtures::example("room.scene")], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = crate::fixtures::stdout(&out);
+    for key in ["total area", "contacts", "lying on", "energy (R)"] {
+        let line = text.lines().find(|l| l.starts_with(key)).unwrap();
+        let figures = line.split("relative error").next().unwrap();
+        assert!(!figures.contains("e0") && !figures.contains("e1"), "{line}");
+    }
+    assert!(
+        text.contains("square scene units (of the grid's elements)"),
+        "{text}"
+    );
+    assert!(
+        text.contains(": gap 0.005 scene units, covering 3.08 square scene units"),
+        "{text}"
+    );
+    // The lists: the largest five of how many, all of them together, and that total less
+    // the part counted twice is the energy line's escaped share (to the 0.01 % printed).
+    let escaped_line = text.lines().find(|l| l.starts_with("energy (R)")).unwrap();
+    assert_eq!(number_after(escaped_line, "emitted "), 20.0, "{text}");
+    let escaped = number_after(escaped_line, "escaped ");
+    let escaped_percent: f64 = escaped_line
+        .split("escaped ")
+        .nth(1)
+        .and_then(|r| r.split('(').nth(1))
+        .and_then(|p| p.split_whitespace().next())
+        .and_then(|p| p.parse().ok())
+        .unwrap();
+    assert!(escaped > 0.0);
+    let from = text
+        .lines()
+        .find(|l| l.starts_with("escaped from"))
+        .unwrap();
+    assert!(from.contains("the 5 largest of"), "{from}");
+    let out_all = number_after(from, "surfaces, ");
+    let twice = number_after(from, "less ");
+    let net = number_after(from, "counted twice below: ");
+    assert!(
+        ((out_all - twice) - net).abs() <= 0.011,
+        "{out_all} - {twice} != {net}"
+    );
+    assert!(
+        (net - escaped_percent).abs() <= 0.011,
+        "{net} % != {escaped_percent} %"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_exposure_scale_is_printed_to_four_figures() {
+    // QA of issue #16: "exposure scale 0.5080691785954333".
+    let dir = scratch_dir("exposure-digits");
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--supersample",
+            "1",
+            "-o",
+            "e.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let scale = err
+        .split("exposure scale ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .unwrap_or_else(|| panic!("no scale in {err}"));
+    let digits = scale.chars().filter(char::is_ascii_digit).count();
+    let leading = scale.trim_start_matches(['0', '.']).len();
+    assert!(leading <= 4 && digits <= 6, "{scale}");
+    assert!(scale.parse::<f64>().unwrap() > 0.0, "{scale}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn illuminance_says_when_its_figures_are_lux() {
+    // QA of issue #16: the note said lux needed scene lengths in metres, and the built-in
+    // box, in millimetres, printed lux: the surfaces' light reaches a point through form
+    // factors, which have no unit; only point luminaires and FLUX depend on lengths.
+    let dir = scratch_dir("lux-note");
+    let out = radiosity(
+        &[
+            "illuminance",
+            "--max-area",
+            "20000",
+            "--grid",
+            "200,1,200:300,1,300:100",
+            "--normal",
+            "0,1,0",
+            "-o",
+            "lux.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("lux where Er Eg Eb are in lm/m^2, whatever the length unit")
+            && err.contains("point luminaires and FLUX need lengths in metres"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn help_texts_give_the_ranges_and_units_the_commands_hold_to() {
+    let dir = scratch_dir("help-ranges");
+    let out = radiosity(&["generate", "building", "--help"], &dir);
+    let help = crate::fixtures::stdout(&out);
+    assert!(help.contains("2.4 to 20"), "{help}");
+    assert!(
+        help.contains("5.7 to 100 with furniture, from 2.5 without"),
+        "{help}"
+    );
+    assert!(help.contains("(lm/m^2"), "{help}");
+    assert!(!help.contains("W/m^2"), "{help}");
+    // --gather-points: the times measured, not "about a minute of CPU" (the building's
+    // gather took about 110 s of CPU).
+    let out = radiosity(&["render", "--help"], &dir);
+    let help = crate::fixtures::stdout(&out);
+    assert!(!help.contains("about a minute of CPU"), "{help}");
+    assert!(
+        help.contains("236,916 points in about 110 s of CPU"),
+        "{help}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

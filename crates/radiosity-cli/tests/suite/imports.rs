@@ -70,7 +70,7 @@ fn scale_is_checked_and_needs_a_file() {
     assert!(!out.status.success());
     assert_eq!(
         stderr(&out).trim_end(),
-        "error: the scale must be a positive finite number, found 0"
+        "error: --scale 0: give the factor every coordinate is multiplied by, a number above 0"
     );
     let out = radiosity(&["check", "--scale", "2"], &dir);
     assert!(!out.status.success());

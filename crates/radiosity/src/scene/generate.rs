@@ -105,8 +105,9 @@ pub struct BuildingParams {
     pub max_patch_area: f64,
     /// The scene's `INTEGRAL_STEPS`.
     pub integral_steps: u32,
-    /// Exitance of the ceiling panels (W/m^2, white of 1.0, 0.95, 0.85 times this); the
-    /// windows emit 0.6 times this, tinted 0.75, 0.85, 1.0.
+    /// Exitance of the ceiling panels (lm/m^2, as every exitance of the scene format; white
+    /// of 1.0, 0.95, 0.85 times this); the windows emit 0.6 times this, tinted 0.75, 0.85,
+    /// 1.0.
     pub light: f64,
 }
 
@@ -129,61 +130,87 @@ impl Default for BuildingParams {
     }
 }
 
+/// Why [`BuildingParams::check`] refused a building.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BuildingError {
+    /// No floors, or no rooms along one axis (the field named).
+    #[error("{0} must be at least 1")]
+    NoRooms(&'static str),
+    /// The room side (m) is not a number, is below what holds the furniture (or 2.5 m
+    /// without), or above 100 m.
+    #[error(
+        "the room size must be between {min} m{} and 100 m, got {size}",
+        if *furniture { " (with furniture)" } else { "" }
+    )]
+    RoomSize {
+        /// The side given.
+        size: f64,
+        /// The smallest allowed.
+        min: f64,
+        /// Whether the rooms are furnished.
+        furniture: bool,
+    },
+    /// The floor-to-ceiling height (m) is outside 2.4 to 20.
+    #[error("the height must be between 2.4 and 20 m, got {0}")]
+    Height(f64),
+    /// MAX_PATCH_AREA is not a positive number.
+    #[error("MAX_PATCH_AREA must be a positive number, got {0}")]
+    MaxPatchArea(f64),
+    /// INTEGRAL_STEPS is 0.
+    #[error("INTEGRAL_STEPS must be at least 1")]
+    IntegralSteps,
+    /// The panels' exitance is negative or not a number.
+    #[error("the light panels' exitance must be a number of at least 0, got {0}")]
+    Light(f64),
+    /// More rooms than [`BuildingParams::MAX_ROOMS`].
+    #[error("{0} rooms is more than the limit of {max}", max = BuildingParams::MAX_ROOMS)]
+    TooManyRooms(u64),
+}
+
 impl BuildingParams {
     /// The smallest room side that holds the furniture.
     pub const MIN_ROOM_SIZE: f64 = 5.7;
+    /// The most rooms a building may have (floors x rooms along x x rooms along z).
+    pub const MAX_ROOMS: u64 = 100_000;
 
-    /// An error message when the parameters cannot make a building.
-    pub fn check(&self) -> Result<(), String> {
-        if self.floors == 0 || self.rooms_x == 0 || self.rooms_z == 0 {
-            return Err("floors, rooms-x and rooms-z must be at least 1".into());
+    /// Refuses parameters that cannot make a building, saying which and why.
+    pub fn check(&self) -> Result<(), BuildingError> {
+        if self.floors == 0 {
+            return Err(BuildingError::NoRooms("floors"));
         }
-        let min_size = if self.furniture {
+        if self.rooms_x == 0 {
+            return Err(BuildingError::NoRooms("rooms along x"));
+        }
+        if self.rooms_z == 0 {
+            return Err(BuildingError::NoRooms("rooms along z"));
+        }
+        let min = if self.furniture {
             Self::MIN_ROOM_SIZE
         } else {
             2.5
         };
-        if !(self.room_size.is_finite() && self.room_size >= min_size) {
-            return Err(format!(
-                "room size must be at least {min_size} m{}, got {}",
-                if self.furniture {
-                    " with furniture"
-                } else {
-                    ""
-                },
-                self.room_size
-            ));
-        }
-        if self.room_size > 100.0 {
-            return Err(format!(
-                "room size must be at most 100 m, got {}",
-                self.room_size
-            ));
+        if !(self.room_size.is_finite() && self.room_size >= min && self.room_size <= 100.0) {
+            return Err(BuildingError::RoomSize {
+                size: self.room_size,
+                min,
+                furniture: self.furniture,
+            });
         }
         if !(self.height.is_finite() && (2.4..=20.0).contains(&self.height)) {
-            return Err(format!(
-                "height must be between 2.4 and 20 m, got {}",
-                self.height
-            ));
+            return Err(BuildingError::Height(self.height));
         }
         if !(self.max_patch_area.is_finite() && self.max_patch_area > 0.0) {
-            return Err(format!(
-                "MAX_PATCH_AREA must be a positive number, got {}",
-                self.max_patch_area
-            ));
+            return Err(BuildingError::MaxPatchArea(self.max_patch_area));
         }
         if self.integral_steps == 0 {
-            return Err("INTEGRAL_STEPS must be at least 1".into());
+            return Err(BuildingError::IntegralSteps);
         }
         if !(self.light.is_finite() && self.light >= 0.0) {
-            return Err(format!(
-                "light must be a non-negative number, got {}",
-                self.light
-            ));
+            return Err(BuildingError::Light(self.light));
         }
         let rooms = self.floors as u64 * self.rooms_x as u64 * self.rooms_z as u64;
-        if rooms > 100_000 {
-            return Err(format!("{rooms} rooms is more than the limit of 100000"));
+        if rooms > Self::MAX_ROOMS {
+            return Err(BuildingError::TooManyRooms(rooms));
         }
         Ok(())
     }

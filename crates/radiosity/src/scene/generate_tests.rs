@@ -292,18 +292,26 @@ fn no_coplanar_surfaces_overlap() {
 
 #[test]
 fn bad_parameters_are_refused() {
-    assert!(BuildingParams {
-        floors: 0,
-        ..BuildingParams::default()
-    }
-    .check()
-    .is_err());
-    assert!(BuildingParams {
-        room_size: 4.0,
-        ..BuildingParams::default()
-    }
-    .check()
-    .is_err());
+    assert_eq!(
+        BuildingParams {
+            floors: 0,
+            ..BuildingParams::default()
+        }
+        .check(),
+        Err(BuildingError::NoRooms("floors"))
+    );
+    assert_eq!(
+        BuildingParams {
+            room_size: 4.0,
+            ..BuildingParams::default()
+        }
+        .check(),
+        Err(BuildingError::RoomSize {
+            size: 4.0,
+            min: BuildingParams::MIN_ROOM_SIZE,
+            furniture: true
+        })
+    );
     let bare = BuildingParams {
         room_size: 2.5,
         furniture: false,

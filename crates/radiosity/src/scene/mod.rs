@@ -24,7 +24,7 @@ pub mod overlap;
 pub(crate) mod shape;
 
 pub use builtin::cornell_box;
-pub use generate::{building, BuildingParams};
+pub use generate::{building, BuildingError, BuildingParams};
 pub use overlap::{lying_on, Overlap};
 
 /// The scene file's reader, writer, contents and error, at the paths the command line and
