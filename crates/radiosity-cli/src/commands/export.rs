@@ -96,6 +96,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
             Exposure::Fixed(_) => "fixed",
         },
         camera: &camera,
+        settings: prepared.settings,
     };
     run_stage(&reporter, Stage::Write, 0, || match format {
         Format::Glb => gltf::write_glb(output, &bake),

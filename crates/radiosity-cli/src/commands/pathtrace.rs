@@ -316,15 +316,17 @@ fn write_linear(
             &film.pixel_means(),
             camera,
             "radiosity pathtrace",
+            &crate::setup::scene_unit(),
         )
     })
     .with_context(|| format!("cannot write {}", path.display()))?;
     reporter.note(&format!(
         "wrote {} ({} x {}, linear radiance = radiosity / pi in the scene's units per \
-         steradian; --exposure and --gamma are not applied)",
+         steradian, lengths in {}; --exposure and --gamma are not applied)",
         path.display(),
         film.width(),
-        film.height()
+        film.height(),
+        crate::setup::scene_unit()
     ));
     Ok(())
 }

@@ -189,15 +189,17 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 &pixels,
                 &camera,
                 "radiosity render",
+                &crate::setup::scene_unit(),
             )
         })
         .with_context(|| format!("cannot write {}", output.display()))?;
         reporter.note(&format!(
             "wrote {} ({} x {}, linear radiance = radiosity / pi in the scene's units per \
-             steradian; --exposure and --gamma are not applied)",
+             steradian, lengths in {}; --exposure and --gamma are not applied)",
             output.display(),
             camera.width,
-            camera.height
+            camera.height,
+            crate::setup::scene_unit()
         ));
         reporter.print_timings();
         return Ok(());

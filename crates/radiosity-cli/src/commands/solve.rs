@@ -60,13 +60,16 @@ pub fn run(args: SolveArgs) -> Result<()> {
             &prepared.scene,
             &solution.mesh,
             solution.element_rgb(),
+            &crate::setup::scene_unit(),
         )
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
     reporter.note(&format!(
-        "wrote {} ({} elements)",
+        "wrote {} ({} elements; radiosity in the scene's emission units, W/m^2 or lm/m^2 \
+         as the scene gives E; area and centroids in {})",
         output.display(),
-        solution.mesh.len()
+        solution.mesh.len(),
+        crate::setup::scene_unit()
     ));
     if let Some(report) = &args.report {
         run_stage(&reporter, Stage::Write, 0, || {

@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
-use crate::fixtures::{radiosity, scratch_dir, stderr};
+use crate::fixtures::{example, radiosity, scratch_dir, stderr, stdout};
 
 /// A closed unit cube seen from inside, every face emitting E = (1, 0.5, 0.25) and
 /// reflecting rho = (0.5, 0.5, 0.75): B = E + rho B everywhere, so B = E / (1 - rho) =
@@ -86,6 +86,11 @@ fn render_and_pathtrace_write_linear_radiance_exr() {
         assert!(out.status.success(), "{extra:?}: {}", stderr(&out));
         assert_furnace_radiance(&dir.join("furnace.exr"), (12, 10), 1e-3);
     }
+    // The units are attributes (issue #13): the radiance's, and the scene's length unit
+    // as the reader gives it (a .scene file states none).
+    let attributes = radiosity::io::exr::text_attributes(&dir.join("furnace.exr")).unwrap();
+    assert_eq!(attributes["radiosity.unit"], radiosity::io::exr::UNIT);
+    assert_eq!(attributes["radiosity.lengthUnit"], "scene units");
     // The path tracer: unbiased but noisy per pixel (the roulette weights of blue's long
     // paths, rho 0.75, spread a pixel's paths by tens of per cent), so the image mean over
     // 120 pixels x 256 paths is what is tested (the image is the same for the fixed seed;
@@ -98,6 +103,9 @@ fn render_and_pathtrace_write_linear_radiance_exr() {
     assert!(out.status.success(), "{}", stderr(&out));
     let (w, h, pixels) = radiosity::io::exr::read_rgb(&dir.join("pt.exr")).unwrap();
     assert_eq!((w, h), (12, 10));
+    let attributes = radiosity::io::exr::text_attributes(&dir.join("pt.exr")).unwrap();
+    assert_eq!(attributes["radiosity.unit"], radiosity::io::exr::UNIT);
+    assert_eq!(attributes["radiosity.lengthUnit"], "scene units");
     for k in 0..3 {
         let mean = pixels.iter().map(|p| p[k] as f64).sum::<f64>() / pixels.len() as f64;
         let expect = FURNACE_B[k] / PI;
@@ -382,5 +390,34 @@ fn cornell_box_exported_as_obj_solves_to_the_same_csv() {
         direct,
         std::fs::read_to_string(dir.join("via-obj.csv")).unwrap()
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Issue #13: `export -o out.glb` then `check out.glb` gives the exported scene's surfaces,
+/// area, settings and elements (its polygons and meshing settings are in the file's
+/// extras), not its mesh's triangles (before: the furnished room's 63 surfaces and 899
+/// elements came back as 234 and 10,172).
+#[test]
+fn exported_glb_checks_as_the_scene_it_came_from() {
+    let dir = scratch_dir("export-round-trip");
+    let room = example("room.scene");
+    let out = radiosity(&["export", &room, "-o", "room.glb", "-q"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let lines = |scene: &str| -> Vec<String> {
+        let out = radiosity(&["check", scene], &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out)
+            .lines()
+            .filter(|l| {
+                ["surfaces ", "elements ", "total area ", "MAX_PATCH_AREA "]
+                    .iter()
+                    .any(|k| l.starts_with(k))
+            })
+            .map(str::to_string)
+            .collect()
+    };
+    let want = lines(&room);
+    assert_eq!(want.len(), 4, "{want:?}");
+    assert_eq!(lines("room.glb"), want);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -12,8 +12,11 @@
 //! itself, as the comparison needs; they are another format.)
 //!
 //! Layer attributes say what the file holds: `radiosity.quantity` ("radiance = radiosity
-//! / pi, scene emission units per steradian"), the camera (`radiosity.eye.x` ...
-//! `radiosity.fovY`, as in the reference files) and the software.
+//! / pi, scene emission units per steradian"), `radiosity.unit` ([`UNIT`]: the values'
+//! unit, cd/m^2 for a photometric scene), `radiosity.lengthUnit` (the scene's length unit
+//! in words, as the importers give it: `scene units`, `metres (glTF's unit) x 0.001`, ...),
+//! the camera (`radiosity.eye.x` ... `radiosity.fovY`, as in the reference files) and the
+//! software.
 
 use std::collections::HashMap;
 use std::io;
@@ -28,6 +31,10 @@ use crate::render::Camera;
 
 /// The `radiosity.quantity` attribute of a linear image.
 pub const QUANTITY: &str = "radiance = radiosity / pi, scene emission units per steradian";
+
+/// The `radiosity.unit` attribute of a linear image: the unit of its values.
+pub const UNIT: &str = "the scene's emission unit per steradian: cd/m^2 where E is in lm/m^2 \
+                        (photometric scenes), W/(m^2 sr) where E is in W/m^2";
 
 /// Writes `image` (a layer with its attributes) to `path`, atomically (see
 /// [`crate::io::write_atomically`]); the `exr` crate's errors become I/O errors.
@@ -45,7 +52,8 @@ pub(crate) fn write_image(
 
 /// Writes a `width` x `height` linear image whose pixels (row by row from the top left)
 /// hold the radiosity `film_b` seen through them, as radiance `film_b / pi` (module
-/// documentation), at `path`, atomically. `camera` and `software` go into the attributes.
+/// documentation), at `path`, atomically. `camera`, `software` and the scene's length unit
+/// in words, `length_unit`, go into the attributes.
 ///
 /// Returns an `InvalidInput` error, writing nothing, when `film_b` does not have
 /// `width * height` pixels.
@@ -56,6 +64,7 @@ pub fn write_radiance(
     film_b: &[[f64; 3]],
     camera: &Camera,
     software: &str,
+    length_unit: &str,
 ) -> io::Result<()> {
     if film_b.len() != width * height {
         return Err(io::Error::new(
@@ -84,6 +93,14 @@ pub fn write_radiance(
     other.insert(
         Text::from("radiosity.quantity"),
         AttributeValue::Text(Text::from(QUANTITY)),
+    );
+    other.insert(
+        Text::from("radiosity.unit"),
+        AttributeValue::Text(Text::from(UNIT)),
+    );
+    other.insert(
+        Text::from("radiosity.lengthUnit"),
+        AttributeValue::Text(Text::from(length_unit)),
     );
     attributes.other = other;
     let layer = Layer::new(
@@ -115,6 +132,21 @@ pub fn read_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), exr::error
     Ok((size.width(), size.height(), pixels))
 }
 
+/// The text attributes of the first layer of the OpenEXR file at `path` (name -> value),
+/// for tests and scripts.
+pub fn text_attributes(path: &Path) -> Result<HashMap<String, String>, exr::error::Error> {
+    let meta = exr::meta::MetaData::read_from_file(path, false)?;
+    let mut out = HashMap::new();
+    if let Some(header) = meta.headers.first() {
+        for (name, value) in &header.own_attributes.other {
+            if let AttributeValue::Text(t) = value {
+                out.insert(name.to_string(), t.to_string());
+            }
+        }
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,7 +168,11 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("view.exr");
-        write_radiance(&path, 3, 2, &film, &camera, "test").unwrap();
+        write_radiance(&path, 3, 2, &film, &camera, "test", "metres x 0.001").unwrap();
+        let attributes = text_attributes(&path).unwrap();
+        assert_eq!(attributes["radiosity.quantity"], QUANTITY);
+        assert_eq!(attributes["radiosity.unit"], UNIT);
+        assert_eq!(attributes["radiosity.lengthUnit"], "metres x 0.001");
         let (w, h, pixels) = read_rgb(&path).unwrap();
         assert_eq!((w, h), (3, 2));
         for (i, p) in pixels.iter().enumerate() {
@@ -156,7 +192,7 @@ mod tests {
         }
         // A pixel count that is not the size's is refused, and nothing is written.
         let other = dir.path().join("bad.exr");
-        let err = write_radiance(&other, 2, 2, &film, &camera, "test").unwrap_err();
+        let err = write_radiance(&other, 2, 2, &film, &camera, "test", "metres").unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
         assert!(!other.exists());
     }

@@ -12,7 +12,9 @@
 //!   take every T-vertex of the mesh as a corner, so the colours meet without cracks;
 //!   vertices are shared within a surface, so a surface shades smooth (Gouraud) as in
 //!   `render --shading smooth`, and each surface keeps its own vertices, so the colours
-//!   may step where surfaces meet, as they do in the solution;
+//!   may step where surfaces meet, as they do in the solution; a surface with no elements
+//!   (buried whole under another, which the contact refinement drops) is written as its
+//!   own polygon in triangles, coloured by its emission, so that every surface is there;
 //! * `COLOR_0` = min(1, s B) per band, linear (not sRGB-encoded): B the vertex radiosity
 //!   ([`crate::shade::vertex_radiosity`]) and s the exposure scale (`render`'s automatic
 //!   exposure unless one is given), clamped as `render` clamps, so that lights are white.
@@ -26,7 +28,14 @@
 //!   units, full precision) are in the material's `extras.radiosity` (`reflectance`,
 //!   `emission`), which the glTF reader takes back, so that `export` then import keeps
 //!   the scene's colours, not only its picture (`crate::io::import::gltf`);
-//! * a perspective camera node for the given view (`render`'s camera for the same flags).
+//! * a perspective camera node for the given view (`render`'s camera for the same flags);
+//! * what rebuilds the scene rather than the mesh: each mesh's `extras.radiosity.polygon`
+//!   is its surface's corners (scene units, full precision, in order: counter-clockwise
+//!   from the front) and `asset.extras.radiosity.meshSettings` the settings it was meshed
+//!   with (`maxPatchArea`, `integralSteps`), which the glTF reader takes instead of the
+//!   triangles, so that `export` then import gives the same surfaces, and so the same
+//!   elements, as the scene exported (the triangles alone join back into several polygons
+//!   per surface: the Cornell box's 20 surfaces came back as about 520).
 //!
 //! The JSON is written with `serde_json`: the document is one mesh per surface and four
 //! buffer views, small enough that the typed builder of `gltf-json` would add a dependency
@@ -39,7 +48,7 @@ use std::path::Path;
 use glam::{DMat3, DQuat, DVec3};
 use serde_json::{json, Value};
 
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshSettings};
 use crate::render::Camera;
 use crate::scene::Scene;
 
@@ -58,6 +67,9 @@ pub struct Bake<'a> {
     pub exposure: &'a str,
     /// The view the camera node shows.
     pub camera: &'a Camera,
+    /// The settings the mesh was cut with, written so that the file reads back meshing
+    /// the same.
+    pub settings: MeshSettings,
 }
 
 const ARRAY_BUFFER: u32 = 34962;
@@ -103,26 +115,41 @@ pub fn document(bake: &Bake, uri: Option<&str>) -> (Value, Vec<u8>) {
                 }
             }
         }
-        if used.is_empty() {
-            continue;
-        }
+        // Each vertex's position and radiosity. A surface with no elements (buried whole
+        // under another, as the base of a box standing on the floor) is written as its
+        // own polygon, fanned into triangles, showing its emission (what its radiosity
+        // would be: no light reaches it), so that the file still holds every surface.
+        let corners: Vec<(DVec3, [f64; 3])> = if used.is_empty() {
+            let n = surface.vertices.len() as u32;
+            indices.extend((1..n.saturating_sub(1)).flat_map(|k| [0, k, k + 1]));
+            surface
+                .vertices
+                .iter()
+                .map(|&p| (p, surface.emission.0))
+                .collect()
+        } else {
+            used.iter()
+                .map(|&v| {
+                    local[v as usize] = u32::MAX;
+                    (mesh.vertices[v as usize], bake.vertex_b[v as usize])
+                })
+                .collect()
+        };
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for &v in &used {
-            let p = mesh.vertices[v as usize];
+        for (p, b) in &corners {
             let pf = p.as_vec3();
             positions.extend(pf.to_array());
             lo = lo.min(pf.as_dvec3());
             hi = hi.max(pf.as_dvec3());
-            let exposed = bake.vertex_b[v as usize].map(|b| b * bake.exposure_scale);
+            let exposed = b.map(|b| b * bake.exposure_scale);
             for x in exposed {
                 if x.is_finite() {
                     max_exposed = max_exposed.max(x);
                 }
             }
             colours.extend(exposed.map(|x| if x > 0.0 { x.min(1.0) as f32 } else { 0.0 }));
-            local[v as usize] = u32::MAX;
         }
-        let count = used.len();
+        let count = corners.len();
         let a = accessors.len();
         accessors.push(json!({
             "bufferView": 0, "byteOffset": first_vertex * 12, "componentType": FLOAT,
@@ -152,8 +179,10 @@ pub fn document(bake: &Bake, uri: Option<&str>) -> (Value, Vec<u8>) {
             }));
             materials.len() - 1
         });
+        let polygon: Vec<[f64; 3]> = surface.vertices.iter().map(|v| v.to_array()).collect();
         meshes.push(json!({
             "name": surface.name,
+            "extras": { "radiosity": { "polygon": polygon } },
             "primitives": [{
                 "attributes": { "POSITION": a, "COLOR_0": a + 1 },
                 "indices": a + 2,
@@ -214,6 +243,10 @@ pub fn document(bake: &Bake, uri: Option<&str>) -> (Value, Vec<u8>) {
                 "colour": "COLOR_0 = min(1, exposureScale x B) per band, linear; B the vertex \
                            radiosity in the scene's emission units",
                 "units": "positions in scene units, untransformed",
+                "meshSettings": {
+                    "maxPatchArea": bake.settings.max_patch_area,
+                    "integralSteps": bake.settings.integral_steps,
+                },
             }},
         },
         "extensionsUsed": ["KHR_materials_unlit"],
@@ -419,6 +452,10 @@ mod tests {
             exposure_scale: 0.5,
             exposure: "fixed",
             camera: &camera,
+            settings: MeshSettings {
+                max_patch_area: 0.5,
+                integral_steps: 2,
+            },
         };
         let dir = tempfile::tempdir().unwrap();
         let glb = dir.path().join("out.glb");

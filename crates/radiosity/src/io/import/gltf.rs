@@ -23,9 +23,22 @@
 //!   format needs it below 1. Emission is `emissiveFactor` times
 //!   `KHR_materials_emissive_strength` (1 without it), taken as the exitance in the
 //!   scene's emission units, as OBJ's `Ke` is;
+//! * vertex colours (`COLOR_0`) on a lit material multiply its base colour face by face:
+//!   each face (after the joining, which goes by geometry alone) takes the mean of
+//!   `COLOR_0` over its corners (a corner where vertices of several colours meet counting
+//!   with their mean), its reflectance the base colour times that mean, capped at
+//!   [`MAX_REFLECTANCE`] where it reaches 1 (one warning counts the faces), a material
+//!   of its own per distinct colour;
 //! * a material with `extras.radiosity` (`reflectance` and `emission`, three numbers
 //!   each, as `radiosity export` writes them) has exactly those, and nothing above is
 //!   read for it: an exported scene read back has its own colours and lights;
+//! * a mesh with `extras.radiosity.polygon` (its one primitive's surface's corners, as
+//!   `radiosity export` writes them) is read as that polygon, placed by the node, instead
+//!   of its triangles, and `asset.extras.radiosity.meshSettings` (`maxPatchArea`,
+//!   `integralSteps`) gives the meshing settings (the area times the scale squared;
+//!   [`super::ImportOptions::settings`] wins): an exported scene reads back with the same
+//!   surfaces and settings, so the same elements. A polygon that is not one is warned
+//!   about and the triangles read instead;
 //! * an unlit material (`KHR_materials_unlit`) without them holds baked light, not a
 //!   reflectance: what it shows is what it sends out. It is taken as an emitter that
 //!   reflects nothing, its emission the base colour (times the texture mean) times the
@@ -39,7 +52,7 @@
 //! mesh, or `node N`). Unit: metres, glTF's unit, times [`super::ImportOptions::scale`].
 //!
 //! Ignored: cameras and lights (`KHR_lights_punctual`), normals, UVs beyond the texture
-//! mean, vertex colours on lit materials, the emissive texture, metallic-roughness, alpha and
+//! mean, the emissive texture, metallic-roughness, alpha and
 //! `doubleSided` (every surface is one-sided: it reflects on its front only), morph
 //! targets and skins, animations. Sparse accessors and quantized positions
 //! (`KHR_mesh_quantization`) are refused with an error.
@@ -59,6 +72,7 @@ use super::{
 };
 use crate::io::scene_file::SceneFile;
 use crate::light::Rgb;
+use crate::mesh::MeshSettings;
 
 /// The reflectance a colour of 1 or more becomes (glTF's default material is white, 1).
 pub const MAX_REFLECTANCE: f64 = 0.99;
@@ -95,14 +109,28 @@ pub fn parse(
         warnings: Vec::new(),
         buffers: Vec::new(),
         baked: Vec::new(),
+        lit: Vec::new(),
+        white: Vec::new(),
+        capped_faces: 0,
         exposure_scale: 1.0,
         derived: Vec::new(),
+        settings: None,
     };
     let (soup, format) = reader.soup(bytes)?;
     let (scene, mut warnings) = soup.to_scene(options.scale)?;
     let mut all = std::mem::take(&mut reader.warnings);
     all.append(&mut warnings);
-    let settings = options.settings.unwrap_or_else(|| default_settings(&scene));
+    // Settings given win; then those a radiosity export wrote (its area in the file's
+    // units squared, scaled as the coordinates are); then the defaults.
+    let settings = options
+        .settings
+        .or_else(|| {
+            reader.settings.map(|m| MeshSettings {
+                max_patch_area: m.max_patch_area * options.scale * options.scale,
+                ..m
+            })
+        })
+        .unwrap_or_else(|| default_settings(&scene));
     Ok(Imported {
         file: SceneFile { settings, scene },
         warnings: all,
@@ -121,12 +149,24 @@ struct Reader<'a> {
     /// colours (`extras.radiosity`), so that it is taken as baked light: its emission
     /// before a primitive's `COLOR_0` mean multiplies it.
     baked: Vec<Option<[f64; 3]>>,
+    /// Per material of the file: `Some(base colour)` (times the texture mean, before the
+    /// cap at [`MAX_REFLECTANCE`]) where it is lit and without the scene's own colours, so
+    /// that a primitive's `COLOR_0` can multiply it face by face.
+    lit: Vec<Option<[f64; 3]>>,
+    /// Per material of the file: the warning that its base colour was capped, given when
+    /// a primitive without `COLOR_0` first uses it (with `COLOR_0` each face is capped,
+    /// and counted, on its own).
+    white: Vec<Option<String>>,
+    /// Faces whose base colour times their `COLOR_0` mean was capped.
+    capped_faces: usize,
     /// The exposure a radiosity export applied (`asset.extras.radiosity.exposureScale`),
     /// 1 in other files.
     exposure_scale: f64,
     /// Materials made for single primitives (baked light times their `COLOR_0` mean),
     /// numbered [`DERIVED`] + k in the faces until they are placed after the file's own.
     derived: Vec<SoupMaterial>,
+    /// The meshing settings a radiosity export wrote (`asset.extras.radiosity.meshSettings`).
+    settings: Option<MeshSettings>,
 }
 
 /// The bit that marks a face's material as one of [`Reader::derived`] during the walk.
@@ -183,6 +223,7 @@ impl Reader<'_> {
             ..FaceSoup::default()
         };
         self.exposure_scale = exposure_scale(doc);
+        self.settings = exported_settings(doc);
         let materials: Vec<SoupMaterial> = doc
             .materials()
             .map(|m| self.material(doc, &m))
@@ -202,6 +243,7 @@ impl Reader<'_> {
         }
         let mut counts = Counts::default();
         let mut triangles_total = 0usize;
+        let mut bad_polygons: Vec<String> = Vec::new();
         // Depth-first over the tree, each node with its parent's global transform.
         let mut stack: Vec<(gltf::Node, DMat4)> = roots
             .into_iter()
@@ -223,14 +265,31 @@ impl Reader<'_> {
             if let Some(mesh) = node.mesh() {
                 let object = soup.objects.len() as u32;
                 soup.objects.push(object_name(&node, &mesh));
+                // A radiosity export's surface polygon, in place of its triangles (the
+                // mesh's one primitive, its material the scene's own colours).
+                let polygon = match exported_polygon(&mesh) {
+                    Some(Ok(p)) if mesh.primitives().len() == 1 => Some(p),
+                    Some(Err(why)) => {
+                        bad_polygons.push(format!("mesh {} ({why})", mesh.index()));
+                        None
+                    }
+                    _ => None,
+                };
                 for prim in mesh.primitives() {
                     let material = match prim.material().index() {
                         Some(i) => i as u32,
                         None => {
-                            default_used = true;
+                            // With COLOR_0 the faces get materials of their own.
+                            default_used |= prim.get(&gltf::Semantic::Colors(0)).is_none();
                             default_material
                         }
                     };
+                    let baked = matches!(self.baked.get(material as usize), Some(Some(_)));
+                    if let Some(polygon) = polygon.as_ref().filter(|_| !baked) {
+                        self.place_polygon(polygon, &node, &global, object, material, &mut soup)?;
+                        triangles_total += polygon.len() - 2;
+                        continue;
+                    }
                     let n = self.primitive(
                         &prim,
                         &node,
@@ -258,6 +317,39 @@ impl Reader<'_> {
             }
         }
         soup.materials.append(&mut self.derived);
+        if self.capped_faces > 0 {
+            self.warn(format!(
+                "{} face{} whose base colour times the mean of {} COLOR_0 is 1 or more in \
+                 some band taken as reflectance {MAX_REFLECTANCE} there (a surface cannot \
+                 reflect all the light it receives)",
+                self.capped_faces,
+                plural(self.capped_faces),
+                if self.capped_faces == 1 {
+                    "its"
+                } else {
+                    "their"
+                }
+            ));
+        }
+        if !bad_polygons.is_empty() {
+            self.warn(format!(
+                "{} mesh{} with an extras.radiosity.polygon that is not one (three or more \
+                 corners of three finite numbers each) read from {} triangles instead: {}",
+                bad_polygons.len(),
+                if bad_polygons.len() == 1 { "" } else { "es" },
+                if bad_polygons.len() == 1 {
+                    "its"
+                } else {
+                    "their"
+                },
+                bad_polygons
+                    .iter()
+                    .take(3)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
         if counts.converted > 0 {
             self.warn(format!(
                 "{} triangle strip or fan primitive{} converted to triangles",
@@ -430,6 +522,8 @@ impl Reader<'_> {
         );
         if let Some((reflectance, emission)) = self.scene_colours(&name, m)? {
             self.baked.push(None);
+            self.lit.push(None);
+            self.white.push(None);
             return Ok(SoupMaterial {
                 name,
                 reflectance: Rgb(reflectance),
@@ -461,6 +555,8 @@ impl Reader<'_> {
             let s = self.exposure_scale;
             let emission = reflectance.map(|c| c / s);
             self.baked.push(Some(emission));
+            self.lit.push(None);
+            self.white.push(None);
             return Ok(SoupMaterial {
                 name,
                 reflectance: Rgb([0.0; 3]),
@@ -469,14 +565,17 @@ impl Reader<'_> {
             });
         }
         self.baked.push(None);
+        self.lit.push(Some(reflectance));
         if reflectance.iter().any(|&r| r >= 1.0) {
-            self.warn(format!(
+            self.white.push(Some(format!(
                 "material \"{name}\": a base colour of 1 or more is taken as reflectance \
                  {MAX_REFLECTANCE} (a surface cannot reflect all the light it receives)"
-            ));
+            )));
             for r in &mut reflectance {
                 *r = r.min(MAX_REFLECTANCE);
             }
+        } else {
+            self.white.push(None);
         }
         let strength = f64::from(m.emissive_strength().unwrap_or(1.0));
         let emission = m.emissive_factor().map(|e| f64::from(e) * strength);
@@ -522,15 +621,93 @@ impl Reader<'_> {
         Ok(Some((band("reflectance")?, band("emission")?)))
     }
 
-    /// The mean of a primitive's `COLOR_0` over the vertices its triangles use (RGB; alpha
-    /// ignored), or `None` where it has none. Floats, and normalized unsigned bytes and
-    /// shorts, as the specification allows.
-    fn colour_mean(
+    /// The faces `polygons` (indices into the primitive's points, to which `remap` takes
+    /// each of its vertices) of a lit primitive with vertex colours `colours` (per vertex,
+    /// `None` where no triangle uses it): each face's reflectance is `base` times the mean
+    /// of `COLOR_0` over its corners (a corner where vertices of several colours meet
+    /// taking their mean), capped at [`MAX_REFLECTANCE`] (counted), a material of its own
+    /// per distinct colour (derived from `material`, keeping its emission).
+    #[allow(clippy::too_many_arguments)]
+    fn coloured_faces(
+        &mut self,
+        polygons: &[Vec<u32>],
+        colours: &[Option<[f64; 3]>],
+        remap: &[u32],
+        base: [f64; 3],
+        material: u32,
+        object: u32,
+        soup: &mut FaceSoup,
+        place: &str,
+    ) {
+        let points = remap
+            .iter()
+            .filter(|&&r| r != u32::MAX)
+            .max()
+            .map_or(0, |&m| m as usize + 1);
+        let mut sum = vec![([0.0f64; 3], 0usize); points];
+        for (k, c) in colours.iter().enumerate() {
+            if let (Some(c), Some(&r)) = (c, remap.get(k)) {
+                if r != u32::MAX {
+                    let (s, n) = &mut sum[r as usize];
+                    for (s, x) in s.iter_mut().zip(c) {
+                        *s += x;
+                    }
+                    *n += 1;
+                }
+            }
+        }
+        let point_colour: Vec<[f64; 3]> = sum
+            .iter()
+            .map(|(s, n)| s.map(|x| x / (*n).max(1) as f64))
+            .collect();
+        let (name, emission) = match soup.materials.get(material as usize) {
+            Some(m) => (m.name.clone(), m.emission),
+            None => ("(default material)".to_string(), Rgb([0.0; 3])),
+        };
+        let base_index = soup.vertices.len() as u32;
+        let mut made: HashMap<[u64; 3], u32> = HashMap::new();
+        for poly in polygons {
+            let mut mean = [0.0; 3];
+            for &i in poly {
+                for (m, x) in mean.iter_mut().zip(point_colour[i as usize]) {
+                    *m += x / poly.len() as f64;
+                }
+            }
+            let mut reflectance = [0, 1, 2].map(|b| base[b] * mean[b]);
+            if reflectance.iter().any(|&r| r >= 1.0) {
+                self.capped_faces += 1;
+                reflectance = reflectance.map(|r| r.min(MAX_REFLECTANCE));
+            }
+            let key = reflectance.map(f64::to_bits);
+            let face_material = *made.entry(key).or_insert_with(|| {
+                self.derived.push(SoupMaterial {
+                    name: format!("{name} x COLOR_0 ({place})"),
+                    reflectance: Rgb(reflectance),
+                    emission,
+                    defined_at: None,
+                });
+                DERIVED | (self.derived.len() - 1) as u32
+            });
+            soup.faces.push(SoupFace {
+                object,
+                material: face_material,
+                first: soup.indices.len(),
+                count: poly.len() as u32,
+                line: 0,
+            });
+            soup.indices.extend(poly.iter().map(|&i| base_index + i));
+        }
+    }
+
+    /// A primitive's `COLOR_0` per vertex (RGB, alpha ignored; `None` at the vertices no
+    /// triangle uses, `used` false), or `None` where it has none. Floats, and normalized
+    /// unsigned bytes and shorts, as the specification allows.
+    fn colours(
         &self,
         prim: &gltf::Primitive,
         place: &str,
         used: &[bool],
-    ) -> Result<Option<[f64; 3]>, ImportError> {
+    ) -> Result<Option<Vec<Option<[f64; 3]>>>, ImportError> {
         let Some(acc) = prim.get(&gltf::Semantic::Colors(0)) else {
             return Ok(None);
         };
@@ -567,19 +744,52 @@ impl Reader<'_> {
                 used.len()
             )));
         }
-        let (mut sum, mut n) = ([0.0f64; 3], 0usize);
-        for (e, _) in elements.iter().zip(used).filter(|(_, &u)| u) {
-            for (k, s) in sum.iter_mut().enumerate() {
-                let c = read(&e[k * size..]);
-                if !c.is_finite() {
+        let mut out = Vec::with_capacity(used.len());
+        for (e, &u) in elements.iter().zip(used) {
+            if !u {
+                out.push(None);
+                continue;
+            }
+            let mut c = [0.0; 3];
+            for (k, x) in c.iter_mut().enumerate() {
+                *x = read(&e[k * size..]);
+                if !x.is_finite() {
                     return Err(ImportError::NotFinite {
                         file: self.file.clone(),
                         line: 0,
                         element: format!("{place}, COLOR_0"),
-                        value: c,
+                        value: *x,
                     });
                 }
-                *s += c;
+                if *x < 0.0 {
+                    return Err(self.error(format!(
+                        "{place}: COLOR_0 (accessor {}) holds {x}, below 0 (colours run from \
+                         0 to 1)",
+                        acc.index()
+                    )));
+                }
+            }
+            out.push(Some(c));
+        }
+        Ok(Some(out))
+    }
+
+    /// The mean of a primitive's `COLOR_0` over the vertices its triangles use (RGB; alpha
+    /// ignored), or `None` where it has none. Floats, and normalized unsigned bytes and
+    /// shorts, as the specification allows.
+    fn colour_mean(
+        &self,
+        prim: &gltf::Primitive,
+        place: &str,
+        used: &[bool],
+    ) -> Result<Option<[f64; 3]>, ImportError> {
+        let Some(colours) = self.colours(prim, place, used)? else {
+            return Ok(None);
+        };
+        let (mut sum, mut n) = ([0.0f64; 3], 0usize);
+        for c in colours.iter().flatten() {
+            for (s, x) in sum.iter_mut().zip(c) {
+                *s += x;
             }
             n += 1;
         }
@@ -696,6 +906,55 @@ impl Reader<'_> {
             out.push(e);
         }
         Ok(out)
+    }
+
+    /// A radiosity export's surface polygon (`extras.radiosity.polygon`), placed by the
+    /// node's transform (its order turned where the transform mirrors), as one face.
+    fn place_polygon(
+        &mut self,
+        polygon: &[DVec3],
+        node: &gltf::Node,
+        global: &DMat4,
+        object: u32,
+        material: u32,
+        soup: &mut FaceSoup,
+    ) -> Result<(), ImportError> {
+        let mut placed = Vec::with_capacity(polygon.len());
+        for (k, p) in polygon.iter().enumerate() {
+            let q = global.transform_point3(*p);
+            if !q.is_finite() {
+                return Err(ImportError::NotFinite {
+                    file: self.file.clone(),
+                    line: 0,
+                    element: format!(
+                        "node {}, extras.radiosity.polygon corner {k} ({p}) placed by the \
+                         node's transform",
+                        describe_node(node)
+                    ),
+                    value: q
+                        .to_array()
+                        .into_iter()
+                        .find(|x| !x.is_finite())
+                        .unwrap_or(f64::NAN),
+                });
+            }
+            placed.push(q);
+        }
+        if global.determinant() < 0.0 {
+            placed.reverse();
+        }
+        let base = soup.vertices.len() as u32;
+        soup.faces.push(SoupFace {
+            object,
+            material,
+            first: soup.indices.len(),
+            count: placed.len() as u32,
+            line: 0,
+        });
+        soup.indices
+            .extend((0..placed.len() as u32).map(|i| base + i));
+        soup.vertices.extend(placed);
+        Ok(())
     }
 
     /// One primitive's triangles into the soup; returns how many.
@@ -856,6 +1115,12 @@ impl Reader<'_> {
             }
         }
         let n = triangles.len();
+        // Lit (a file's material, or the default one placed after them) or not, before a
+        // baked material is swapped for one of its own below.
+        let lit = match self.lit.get(material as usize) {
+            Some(&base) => base,
+            None => Some([1.0; 3]),
+        };
         let mut material = material;
         if let Some(&Some(emission)) = self.baked.get(material as usize) {
             // Baked light with vertex colours: the colours' mean multiplies the material's
@@ -873,7 +1138,22 @@ impl Reader<'_> {
                 self.derived.push(derived);
             }
         }
-        for poly in join_coplanar(&points, &triangles) {
+        let polygons = join_coplanar(&points, &triangles);
+        if let Some(base) = lit {
+            let used: Vec<bool> = remap.iter().map(|&r| r != u32::MAX).collect();
+            if let Some(colours) = self.colours(prim, &place, &used)? {
+                self.coloured_faces(
+                    &polygons, &colours, &remap, base, material, object, soup, &place,
+                );
+                soup.vertices.extend(points);
+                return Ok(n);
+            }
+            // Without COLOR_0: the material as it is, its cap told once.
+            if let Some(Some(w)) = self.white.get_mut(material as usize).map(Option::take) {
+                self.warn(w);
+            }
+        }
+        for poly in polygons {
             soup.faces.push(SoupFace {
                 object,
                 material,
@@ -899,6 +1179,61 @@ fn exposure_scale(doc: &gltf::Document) -> f64 {
         .and_then(|v| v["radiosity"]["exposureScale"].as_f64())
         .filter(|s| s.is_finite() && *s > 0.0)
         .unwrap_or(1.0)
+}
+
+/// The largest polygon `extras.radiosity.polygon` may give (the scene format's polygons
+/// are meshed into at most this many corners' worth of triangles; a larger one is taken
+/// as malformed).
+const MAX_POLYGON_CORNERS: usize = 4096;
+
+/// A mesh's `extras.radiosity.polygon` as a radiosity export writes it (the surface's
+/// corners, in the mesh's coordinates): `None` where the mesh has none, an error in words
+/// where it has one that is not a polygon.
+fn exported_polygon(mesh: &gltf::Mesh) -> Option<Result<Vec<DVec3>, String>> {
+    let raw = mesh.extras().as_ref()?;
+    let extras: serde_json::Value = serde_json::from_str(raw.get()).ok()?;
+    let polygon = extras.get("radiosity")?.get("polygon")?;
+    let Some(corners) = polygon.as_array() else {
+        return Some(Err("not an array".into()));
+    };
+    if corners.len() < 3 || corners.len() > MAX_POLYGON_CORNERS {
+        return Some(Err(format!(
+            "{} corners, not 3 to {MAX_POLYGON_CORNERS}",
+            corners.len()
+        )));
+    }
+    let mut out = Vec::with_capacity(corners.len());
+    for (k, c) in corners.iter().enumerate() {
+        let xyz: Option<Vec<f64>> = c
+            .as_array()
+            .and_then(|a| a.iter().map(serde_json::Value::as_f64).collect());
+        match xyz.as_deref() {
+            Some(&[x, y, z]) if x.is_finite() && y.is_finite() && z.is_finite() => {
+                out.push(DVec3::new(x, y, z));
+            }
+            _ => return Some(Err(format!("corner {k} is {c}"))),
+        }
+    }
+    Some(Ok(out))
+}
+
+/// The meshing settings a radiosity export wrote (`asset.extras.radiosity.meshSettings`:
+/// `maxPatchArea` > 0 and finite, `integralSteps` a whole number of at least 1), if it did.
+fn exported_settings(doc: &gltf::Document) -> Option<MeshSettings> {
+    let raw = doc.as_json().asset.extras.as_ref()?;
+    let v: serde_json::Value = serde_json::from_str(raw.get()).ok()?;
+    let m = &v["radiosity"]["meshSettings"];
+    let max_patch_area = m["maxPatchArea"]
+        .as_f64()
+        .filter(|a| a.is_finite() && *a > 0.0)?;
+    let integral_steps = m["integralSteps"]
+        .as_u64()
+        .filter(|&k| k >= 1)
+        .and_then(|k| u32::try_from(k).ok())?;
+    Some(MeshSettings {
+        max_patch_area,
+        integral_steps,
+    })
 }
 
 /// How many triangles the nodes under `roots` ask for, from their accessors' counts,

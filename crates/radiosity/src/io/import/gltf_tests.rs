@@ -62,6 +62,27 @@ impl Builder {
         self.accessors.len() - 1
     }
 
+    /// A VEC3 float accessor of vertex colours.
+    pub fn colours_f32(&mut self, c: &[[f32; 3]]) -> usize {
+        let bytes: Vec<u8> = c.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+        let view = self.view(&bytes, 34962);
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": 5126, "count": c.len(), "type": "VEC3"
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// A VEC4 accessor of normalized unsigned-byte vertex colours (RGBA).
+    pub fn colours_u8(&mut self, c: &[[u8; 4]]) -> usize {
+        let bytes: Vec<u8> = c.iter().flatten().copied().collect();
+        let view = self.view(&bytes, 34962);
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": 5121, "normalized": true, "count": c.len(),
+            "type": "VEC4"
+        }));
+        self.accessors.len() - 1
+    }
+
     /// A buffer view holding `bytes` (an image).
     pub fn raw_view(&mut self, bytes: &[u8]) -> usize {
         while self.bin.len() % 4 != 0 {
@@ -206,6 +227,150 @@ fn committed_cornell_box_gltf_is_the_scene_files_box() {
         "tests/data/cornell_box.gltf is not what scene_to_gltf makes of \
          examples/cornell_box.scene; rewrite it with the ignored test write_cornell_box_gltf"
     );
+}
+
+/// The committed `tests/data/vertex_colours.gltf`: three lit squares with `COLOR_0`, the
+/// colours chosen so that each face's mean is exact in binary.
+///
+/// * `Floor` (y = 0, facing up): white base colour (glTF's 1), float colours (0.25, 0.5,
+///   0.75), (0.5, 0.5, 0.75), (0.75, 0.5, 0.75), (0.5, 0.5, 0.75) at its corners, shared by
+///   its two triangles: reflectance their mean, (0.5, 0.5, 0.75);
+/// * `Wall` (z = 0, facing +z): base 0.5, two triangles with vertices of their own, one
+///   red and one blue (normalized bytes, RGBA): joined back into the quad, whose corners
+///   on the diagonal are both colours (mean (0.5, 0, 0.5)), the others red and blue, so
+///   the face's mean is (0.5, 0, 0.5) and its reflectance (0.25, 0, 0.25);
+/// * `Lamp` (y = 1, facing down): base 1 and colours 1, so 1 and capped at 0.99 (counted
+///   in a warning), emitting `emissiveFactor` 1 x strength 10.
+fn vertex_colours_gltf_text() -> String {
+    let mut b = Builder::default();
+    let floor_pos = b.positions(&[
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+    ]);
+    let floor_col = b.colours_f32(&[
+        [0.25, 0.5, 0.75],
+        [0.5, 0.5, 0.75],
+        [0.75, 0.5, 0.75],
+        [0.5, 0.5, 0.75],
+    ]);
+    let floor_ind = b.indices(&[0, 1, 2, 0, 2, 3]);
+    let (p0, p1, p2, p3) = (
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    );
+    let wall_pos = b.positions(&[p0, p1, p2, p0, p2, p3]);
+    let (red, blue) = ([255, 0, 0, 255], [0, 0, 255, 255]);
+    let wall_col = b.colours_u8(&[red, red, red, blue, blue, blue]);
+    let wall_ind = b.indices(&[0, 1, 2, 3, 4, 5]);
+    let lamp_pos = b.positions(&[
+        [0.25, 1.0, 0.25],
+        [0.75, 1.0, 0.25],
+        [0.75, 1.0, 0.75],
+        [0.25, 1.0, 0.75],
+    ]);
+    let lamp_col = b.colours_f32(&[[1.0; 3]; 4]);
+    let lamp_ind = b.indices(&[0, 1, 2, 0, 2, 3]);
+    let prim = |pos: usize, col: usize, ind: usize, material: usize| {
+        json!({ "attributes": { "POSITION": pos, "COLOR_0": col }, "indices": ind,
+                "material": material })
+    };
+    let rest = json!({
+        "extensionsUsed": ["KHR_materials_emissive_strength"],
+        "scene": 0,
+        "scenes": [{ "name": "vertex colours", "nodes": [0, 1, 2] }],
+        "nodes": [
+            { "name": "Floor", "mesh": 0 },
+            { "name": "Wall", "mesh": 1 },
+            { "name": "Lamp", "mesh": 2 },
+        ],
+        "meshes": [
+            { "name": "Floor", "primitives": [prim(floor_pos, floor_col, floor_ind, 0)] },
+            { "name": "Wall", "primitives": [prim(wall_pos, wall_col, wall_ind, 1)] },
+            { "name": "Lamp", "primitives": [prim(lamp_pos, lamp_col, lamp_ind, 2)] },
+        ],
+        "materials": [
+            { "name": "white", "pbrMetallicRoughness": { "metallicFactor": 0.0 } },
+            { "name": "grey", "pbrMetallicRoughness": {
+                "baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0 } },
+            { "name": "lamp", "pbrMetallicRoughness": { "metallicFactor": 0.0 },
+              "emissiveFactor": [1.0, 1.0, 1.0],
+              "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 10.0 } } },
+        ],
+    });
+    serde_json::to_string_pretty(&b.json(rest, Some(""))).unwrap() + "\n"
+}
+
+/// Rewrites `tests/data/vertex_colours.gltf` (run with `--ignored`).
+#[test]
+#[ignore]
+fn write_vertex_colours_gltf() {
+    std::fs::write(
+        repo_file("tests/data/vertex_colours.gltf"),
+        vertex_colours_gltf_text(),
+    )
+    .unwrap();
+}
+
+/// Issue #13: a foreign file's `COLOR_0` on lit materials multiplies the base colour, one
+/// mean per face (tests/data/vertex_colours.gltf, described at
+/// [`vertex_colours_gltf_text`]).
+#[test]
+fn vertex_colours_multiply_the_base_colour_face_by_face() {
+    let path = repo_file("tests/data/vertex_colours.gltf");
+    let committed = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        committed == vertex_colours_gltf_text(),
+        "tests/data/vertex_colours.gltf is not what vertex_colours_gltf_text makes; rewrite \
+         it with the ignored test write_vertex_colours_gltf"
+    );
+    let got = read_any_scene(&path, &ImportOptions::default()).unwrap();
+    let names: Vec<&str> = got
+        .file
+        .scene
+        .surfaces
+        .iter()
+        .map(|s| s.name.as_str())
+        .collect();
+    // The wall's two triangles joined back into one face, whatever their colours.
+    assert_eq!(names, ["Floor", "Wall", "Lamp"]);
+    let surfaces = &got.file.scene.surfaces;
+    // The colours and their means are exact in binary (quarters; bytes 0 and 255 are 0
+    // and 1 exactly), so the products are exact.
+    assert_eq!(surfaces[0].reflectance, Rgb([0.5, 0.5, 0.75]));
+    assert_eq!(surfaces[1].reflectance, Rgb([0.25, 0.0, 0.25]));
+    assert_eq!(surfaces[2].reflectance, Rgb([MAX_REFLECTANCE; 3]));
+    assert_eq!(surfaces[2].emission, Rgb([10.0; 3]));
+    assert_eq!(surfaces[0].emission, Rgb([0.0; 3]));
+    // One warning: the lamp's face capped. The white base of the floor is no warning:
+    // its colours bring it below 1.
+    assert_eq!(got.warnings.len(), 1, "{:?}", got.warnings);
+    assert!(
+        got.warnings[0]
+            .message
+            .starts_with("1 face whose base colour times the mean of its COLOR_0 is 1 or more"),
+        "{}",
+        got.warnings[0]
+    );
+    // Without COLOR_0 the same file reads as before: the base colours, white capped with
+    // the material's warning.
+    let mut doc: Value = serde_json::from_str(&committed).unwrap();
+    for m in doc["meshes"].as_array_mut().unwrap() {
+        m["primitives"][0]["attributes"]
+            .as_object_mut()
+            .unwrap()
+            .remove("COLOR_0");
+    }
+    let plain = read_doc(&doc).unwrap();
+    let s = &plain.file.scene.surfaces;
+    assert_eq!(s.len(), 3);
+    assert_eq!(s[0].reflectance, Rgb([MAX_REFLECTANCE; 3]));
+    assert_eq!(s[1].reflectance, Rgb([0.5; 3]));
+    assert_eq!(plain.warnings.len(), 2, "{:?}", plain.warnings);
+    assert!(plain.warnings[0].message.contains("material \"white\""));
 }
 
 /// The surfaces of `got` are those of `want`: same names, order and colours, corners
@@ -838,6 +1003,7 @@ fn export_cornell_box(dir: &std::path::Path) -> Exported {
         exposure_scale: scale,
         exposure: "fixed",
         camera: &camera,
+        settings: coarse_settings(),
     };
     let glb = dir.join("box.glb");
     let gltf = dir.join("box.gltf");
@@ -906,11 +1072,112 @@ fn groups_by_name(imported: &Scene, original: &Scene) -> Vec<Vec<usize>> {
         .collect()
 }
 
+/// Removes what a radiosity export writes to rebuild the scene (each mesh's
+/// `extras.radiosity.polygon`, the asset's `meshSettings`) from the `.gltf` at `path`, as a
+/// tool that keeps only the geometry would.
+fn strip_polygons(path: &std::path::Path) {
+    let mut doc: Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    for m in doc["meshes"].as_array_mut().unwrap() {
+        m.as_object_mut().unwrap().remove("extras");
+    }
+    doc["asset"]["extras"]["radiosity"]
+        .as_object_mut()
+        .unwrap()
+        .remove("meshSettings");
+    std::fs::write(path, serde_json::to_vec(&doc).unwrap()).unwrap();
+}
+
+/// Issue #13: an exported file read back is the scene exported, not its mesh: the same
+/// surfaces (names, corners to the last bit, colours), the same meshing settings, so the
+/// same elements, and the same light. (Before, the triangles joined back into 113 polygons
+/// at these coarse settings, and `radiosity export` of the default box then `check` gave
+/// 535 surfaces and 18,608 elements for 20 and 2,484.)
 #[test]
-fn exported_glb_reads_back_with_the_scenes_geometry_and_colours() {
+fn exported_glb_reads_back_as_the_scene_it_was_baked_from() {
     let dir = tempfile::tempdir().unwrap();
     let ex = export_cornell_box(dir.path());
+    let want_prepared = Prepared::new(ex.scene.clone(), coarse_settings(), &NoProgress).unwrap();
     for path in [&ex.glb, &ex.gltf] {
+        let imported = read_any_scene(path, &ImportOptions::default()).unwrap();
+        assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
+        let got = &imported.file.scene;
+        assert_eq!(got.surfaces.len(), ex.scene.surfaces.len());
+        for (g, w) in got.surfaces.iter().zip(&ex.scene.surfaces) {
+            // JSON keeps an f64 exactly (serde_json writes the shortest form that reads
+            // back to the same bits), so the corners and colours are the scene's own.
+            assert_eq!(g.name, w.name);
+            assert_eq!(g.vertices, w.vertices, "{}", w.name);
+            assert_eq!(g.reflectance, w.reflectance, "{}", w.name);
+            assert_eq!(g.emission, w.emission, "{}", w.name);
+        }
+        assert_eq!(imported.file.settings, coarse_settings());
+        let prepared = Prepared::new(got.clone(), imported.file.settings, &NoProgress).unwrap();
+        assert_eq!(prepared.mesh.len(), want_prepared.mesh.len());
+        assert_eq!(got.total_area(), ex.scene.total_area());
+        let groups: Vec<Vec<usize>> = (0..got.surfaces.len()).map(|s| vec![s]).collect();
+        // The same scene and settings: the same solve, to rounding.
+        let again = surface_means(got.clone(), &groups);
+        for ((a, b), s) in again.iter().zip(&ex.surface_b).zip(&ex.scene.surfaces) {
+            for k in 0..3 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-12 * b[k].abs().max(1e-12),
+                    "{}: {a:?} vs {b:?}",
+                    s.name
+                );
+            }
+        }
+    }
+    // --scale scales the corners and the written MAX_PATCH_AREA (by its square), so the
+    // scaled scene meshes into as many elements.
+    let scaled = read_any_scene(
+        &ex.glb,
+        &ImportOptions {
+            scale: 0.001,
+            settings: None,
+        },
+    )
+    .unwrap();
+    let area = coarse_settings().max_patch_area * 1e-6;
+    assert!((scaled.file.settings.max_patch_area - area).abs() <= 1e-15 * area);
+    let prepared =
+        Prepared::new(scaled.file.scene.clone(), scaled.file.settings, &NoProgress).unwrap();
+    assert_eq!(prepared.mesh.len(), want_prepared.mesh.len());
+}
+
+/// A polygon that is not one falls back to the triangles, with a warning naming the mesh.
+#[test]
+fn a_malformed_exported_polygon_reads_the_triangles_instead() {
+    let dir = tempfile::tempdir().unwrap();
+    let ex = export_cornell_box(dir.path());
+    let mut doc: Value = serde_json::from_slice(&std::fs::read(&ex.gltf).unwrap()).unwrap();
+    doc["meshes"][0]["extras"]["radiosity"]["polygon"] = json!([[0, 0, 0], [1, "x", 0], [1, 1, 0]]);
+    std::fs::write(&ex.gltf, serde_json::to_vec(&doc).unwrap()).unwrap();
+    let imported = read_any_scene(&ex.gltf, &ImportOptions::default()).unwrap();
+    assert_eq!(imported.warnings.len(), 1, "{:?}", imported.warnings);
+    let w = imported.warnings[0].to_string();
+    assert!(w.contains("mesh 0 (corner 1 is [1,\"x\",0])"), "{w}");
+    let got = &imported.file.scene;
+    // Every other surface is the scene's; the first came from its triangles, named
+    // after it, covering its meshed area.
+    let first = &ex.scene.surfaces[0].name;
+    let pieces = got
+        .surfaces
+        .iter()
+        .filter(|s| s.name == *first || s.name.starts_with(&format!("{first}.")))
+        .count();
+    assert!(pieces >= 1);
+    assert_eq!(got.surfaces.len(), ex.scene.surfaces.len() - 1 + pieces);
+}
+
+/// A file of triangles alone (the export's polygons taken out, as a tool that keeps only
+/// the geometry would leave it) still reads as before: the triangles joined back.
+#[test]
+fn exported_triangles_without_the_polygons_read_back_joined() {
+    let dir = tempfile::tempdir().unwrap();
+    let ex = export_cornell_box(dir.path());
+    strip_polygons(&ex.gltf);
+    {
+        let path = &ex.gltf;
         let imported = read_any_scene(path, &ImportOptions::default()).unwrap();
         assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
         let got = &imported.file.scene;

@@ -33,9 +33,12 @@
 //!   `NAME.0`, `NAME.1`, ... in file order when it gives several.
 //!
 //! Faces of one object become separate surfaces, and the mesher gives every surface its
-//! own vertices (see [`crate::mesh`]): shading is interpolated within a surface, not
-//! across the edges between the faces of a tessellated object, which therefore shade
-//! faceted.
+//! own vertices (see [`crate::mesh`]); the shading joins them again:
+//! [`crate::shade::smooth_objects`] gives the vertices where facets of one object (`NAME.k`)
+//! meet at less than [`crate::shade::CREASE_DEGREES`] one value, so a tessellated sphere's
+//! radiosity interpolates smoothly. The renderer's per-pixel direct light is gathered on
+//! each facet's own plane, so bands of the facets' orientation remain in it (README,
+//! "Importing scenes").
 //!
 //! # Units and settings
 //!
