@@ -60,7 +60,6 @@ pub fn run(args: SolveArgs) -> Result<()> {
             &prepared.scene,
             &solution.mesh,
             solution.element_rgb(),
-            &crate::setup::scene_unit(),
         )
     })
     .with_context(|| format!("cannot write {}", output.display()))?;

@@ -3,15 +3,14 @@
 //! unnormalised values of the solve, before the display normalisation of paper 2.2 and the
 //! gamma correction of paper 2.7).
 //!
-//! Two formats, chosen by the file name: CSV (RFC 4180) by default, JSON when the name ends
-//! in `.json` (any case). Both use the field names of [`HEADER`].
+//! Two formats, chosen by the file name: CSV (RFC 4180) by default, a JSON array of objects
+//! when the name ends in `.json` (any case). Both use the field names of [`HEADER`].
 //!
 //! Units: areas and centroids in the scene's length unit (squared for areas), radiosity in
-//! the scene's emission units (W/m^2, or lm/m^2 for the photometric scenes; per the length
-//! unit squared). The JSON says so in its fields `unit` ([`UNIT`]) and `length_unit`
-//! beside its `elements`; the CSV's first line is its header (a contract: scripts read line
-//! 1 as the header), so its units are documented (README, "Exporting") and printed by
-//! `solve` on stderr, not written into the file.
+//! the scene's emission units (W/m^2, or lm/m^2 for the photometric scenes). Both shapes
+//! are a contract (issue #2: the CSV's header on line 1, the JSON an array of records with
+//! the same fields), so the units are documented (README, "Exporting") and printed by
+//! `solve` on stderr, not written into the files.
 
 use std::io::{self, Write};
 use std::path::Path;
@@ -24,23 +23,6 @@ use crate::scene::Scene;
 /// The CSV header line (without its line ending); also the JSON field names.
 pub const HEADER: &str =
     "surface,element,area,centroid_x,centroid_y,centroid_z,radiosity_r,radiosity_g,radiosity_b";
-
-/// The JSON's `unit` field: what the radiosity values are in.
-pub const UNIT: &str = "radiosity in the scene's emission units (W/m^2 or lm/m^2, as the \
-                        scene gives E); area in the length unit squared, centroids in the \
-                        length unit";
-
-/// The JSON file: the units and the elements.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SolutionJson {
-    /// [`UNIT`].
-    pub unit: String,
-    /// The scene's length unit in words, as the importers give it (`scene units` for a
-    /// `.scene` file, `metres (glTF's unit) x 0.001`, ...).
-    pub length_unit: String,
-    /// One record per element, in mesh order.
-    pub elements: Vec<ElementRecord>,
-}
 
 /// One element of the solution, as written.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -135,11 +117,9 @@ pub(crate) fn one_per_element(mesh: &Mesh, element_b: &[[f64; 3]]) -> io::Result
 
 /// Writes the solution to `path`: CSV with the header line [`HEADER`] and one row per
 /// element (numbers in Rust's `Display` form, the shortest that reads back exactly, never
-/// with an exponent: 1.5e-7 is written `0.00000015`; lines end in `\n`), or, when the file
-/// name ends in `.json` (any case), a JSON object ([`SolutionJson`]: `unit`, `length_unit`
-/// the scene's length unit `length_unit` in words, and `elements`, an array of objects with
-/// the CSV's fields; non-finite numbers become `null`). The file is written atomically (see
-/// [`crate::io::write_atomically`]).
+/// with an exponent: 1.5e-7 is written `0.00000015`; lines end in `\n`), or, when the file name ends in `.json` (any case), a JSON array of
+/// objects with the same fields (non-finite numbers become `null`). The file is written
+/// atomically (see [`crate::io::write_atomically`]).
 ///
 /// Returns an `InvalidInput` error, writing nothing, when `element_b` does not have one
 /// entry per element of `mesh`.
@@ -148,7 +128,6 @@ pub fn write_solution(
     scene: &Scene,
     mesh: &Mesh,
     element_b: &[[f64; 3]],
-    length_unit: &str,
 ) -> io::Result<()> {
     one_per_element(mesh, element_b)?;
     let rows = records(scene, mesh, element_b);
@@ -157,12 +136,7 @@ pub fn write_solution(
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
     crate::io::write_atomically(path, |w| {
         if json {
-            let doc = SolutionJson {
-                unit: UNIT.to_string(),
-                length_unit: length_unit.to_string(),
-                elements: rows,
-            };
-            serde_json::to_writer_pretty(&mut *w, &doc).map_err(io::Error::other)?;
+            serde_json::to_writer_pretty(&mut *w, &rows).map_err(io::Error::other)?;
             writeln!(w)
         } else {
             let mut csv = csv::Writer::from_writer(w);
@@ -223,7 +197,7 @@ mod tests {
             [1.5e-7, 5.5, 7.0],
         ];
         let path = temp("sol.csv");
-        write_solution(&path, &s, &mesh, &b, "metres").unwrap();
+        write_solution(&path, &s, &mesh, &b).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let lines: Vec<&str> = text.split('\n').collect();
         assert_eq!(
@@ -309,7 +283,7 @@ mod tests {
                 .map(|e| [0, 1, 2].map(|i| values[(k + 3 * e + i) % values.len()]))
                 .collect();
             let path = temp(&format!("bytes-{k}.csv"));
-            write_solution(&path, &s, &mesh, &b, "metres").unwrap();
+            write_solution(&path, &s, &mesh, &b).unwrap();
             let text = std::fs::read_to_string(&path).unwrap();
             assert_eq!(text, old_csv(&records(&s, &mesh, &b)), "{name:?}");
             std::fs::remove_file(&path).unwrap();
@@ -327,12 +301,9 @@ mod tests {
             [1.5e-7, 5.5, 7.0],
         ];
         let path = temp("sol.JSON");
-        write_solution(&path, &s, &mesh, &b, "metres").unwrap();
+        write_solution(&path, &s, &mesh, &b).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
-        let doc: SolutionJson = serde_json::from_str(&text).unwrap();
-        assert_eq!(doc.unit, UNIT);
-        assert_eq!(doc.length_unit, "metres");
-        let back = doc.elements;
+        let back: Vec<ElementRecord> = serde_json::from_str(&text).unwrap();
         assert_eq!(back.len(), 4);
         assert_eq!(back[3].surface, "a, \"b\"\nc");
         assert_eq!(back[3].element, 1);
@@ -343,7 +314,7 @@ mod tests {
         assert_eq!(back[2].area, 1.0);
         // The field names are those of the CSV header, in order.
         let v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        let keys: Vec<&str> = v["elements"][0]
+        let keys: Vec<&str> = v[0]
             .as_object()
             .unwrap()
             .keys()
@@ -356,7 +327,7 @@ mod tests {
         assert_eq!(got, want);
         std::fs::remove_file(&path).unwrap();
         // A wrong radiosity count is refused and writes nothing.
-        let err = write_solution(&path, &s, &mesh, &b[..3], "metres").unwrap_err();
+        let err = write_solution(&path, &s, &mesh, &b[..3]).unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
         assert!(!path.exists());
     }
