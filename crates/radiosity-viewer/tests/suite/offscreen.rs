@@ -42,17 +42,25 @@ fn mean_abs_difference(gpu: &image::RgbaImage, cpu: &image::RgbImage) -> (f64, u
     (sum as f64 / (3 * cpu.width() * cpu.height()) as f64, worst)
 }
 
-#[test]
-fn offscreen_cornell_box_matches_the_cpu_render() {
-    let gpu = match Headless::new() {
-        Ok(gpu) => gpu,
+/// The offscreen device, or None (the test skipped, saying why) where there is no adapter;
+/// with the environment variable `CI` set, a missing adapter fails the test instead.
+fn headless(test: &str) -> Option<Headless> {
+    match Headless::new() {
+        Ok(gpu) => Some(gpu),
         Err(e) => {
             if std::env::var_os("CI").is_some() {
                 panic!("CI is set but no wgpu adapter is available: {e}");
             }
-            eprintln!("SKIPPED offscreen_cornell_box_matches_the_cpu_render: {e}");
-            return;
+            eprintln!("SKIPPED {test}: {e}");
+            None
         }
+    }
+}
+
+#[test]
+fn offscreen_cornell_box_matches_the_cpu_render() {
+    let Some(gpu) = headless("offscreen_cornell_box_matches_the_cpu_render") else {
+        return;
     };
     eprintln!("adapter: {}", gpu.adapter);
     let file = cornell_box();
@@ -150,15 +158,8 @@ fn a_rug_in_the_floors_plane_does_not_flicker_through_it() {
     // seen at 15 degrees from 6 m. Every pixel the rug alone covers (less a pixel at its
     // outline, where coverage differs by rasterisation) must show the rug (red), none the
     // floor (blue) through it.
-    let gpu = match Headless::new() {
-        Ok(gpu) => gpu,
-        Err(e) => {
-            if std::env::var_os("CI").is_some() {
-                panic!("CI is set but no wgpu adapter is available: {e}");
-            }
-            eprintln!("SKIPPED a_rug_in_the_floors_plane_does_not_flicker_through_it: {e}");
-            return;
-        }
+    let Some(gpu) = headless("a_rug_in_the_floors_plane_does_not_flicker_through_it") else {
+        return;
     };
     let camera = Camera {
         eye: glam::dvec3(2.0, 1.5, -4.0),
@@ -240,15 +241,8 @@ fn holes_left_by_buried_pieces_show_light_as_in_the_cpu_render() {
     // seat under its back): the pixels the GPU shows black where
     // the CPU render shows light are counted, without the cover (they must be there, or the
     // view shows no hole) and with it.
-    let gpu = match Headless::new() {
-        Ok(gpu) => gpu,
-        Err(e) => {
-            if std::env::var_os("CI").is_some() {
-                panic!("CI is set but no wgpu adapter is available: {e}");
-            }
-            eprintln!("SKIPPED holes_left_by_buried_pieces_show_light_as_in_the_cpu_render: {e}");
-            return;
-        }
+    let Some(gpu) = headless("holes_left_by_buried_pieces_show_light_as_in_the_cpu_render") else {
+        return;
     };
     let file = radiosity::io::scene_file::parse_scene(
         include_str!("../../../../examples/room.scene"),

@@ -146,22 +146,10 @@ impl HoleCover {
 
 #[cfg(test)]
 mod tests {
-    use glam::dvec3;
-
     use super::*;
     use crate::mesh::refine_contacts;
-    use crate::render::test_support::{scene, surface};
+    use crate::render::test_support::{facing_up, scene, surface};
     use crate::visibility::PolygonBvh;
-
-    /// The square [x0, x1] x [z0, z1] in the plane y, facing +y.
-    fn square(x0: f64, x1: f64, z0: f64, z1: f64, y: f64) -> Vec<DVec3> {
-        vec![
-            dvec3(x0, y, z0),
-            dvec3(x0, y, z1),
-            dvec3(x1, y, z1),
-            dvec3(x1, y, z0),
-        ]
-    }
 
     #[test]
     fn a_floor_under_a_lid_is_covered_where_its_pieces_were_dropped() {
@@ -170,8 +158,8 @@ mod tests {
         // into cells, its corners in the open showing the floor's light whole and those
         // deep under the lid none of it.
         let s = scene(vec![
-            surface("floor", 0.0, square(0.0, 4.0, 0.0, 4.0, 0.0)),
-            surface("lid", 0.0, square(1.0, 3.0, 1.0, 3.0, 0.001)),
+            surface("floor", 0.0, facing_up(0.0, 4.0, 0.0, 4.0, 0.0)),
+            surface("lid", 0.0, facing_up(1.0, 3.0, 1.0, 3.0, 0.001)),
         ]);
         let grid = mesh_scene(&s, 0.25).unwrap();
         let bvh = PolygonBvh::over_surfaces(&s);
@@ -209,7 +197,11 @@ mod tests {
 
     #[test]
     fn a_mesh_without_holes_needs_no_cover() {
-        let s = scene(vec![surface("floor", 0.0, square(0.0, 4.0, 0.0, 4.0, 0.0))]);
+        let s = scene(vec![surface(
+            "floor",
+            0.0,
+            facing_up(0.0, 4.0, 0.0, 4.0, 0.0),
+        )]);
         let mesh = mesh_scene(&s, 0.25).unwrap();
         assert!(HoleCover::new(&s, &mesh).is_empty());
     }

@@ -160,18 +160,8 @@ mod tests {
     use super::*;
     use crate::mesh::mesh_scene;
     use crate::progress::NoProgress;
-    use crate::render::test_support::{scene, surface};
+    use crate::render::test_support::{facing_up, scene, surface};
     use crate::render::{Camera, Renderer, Shading};
-
-    /// The square [x0, x1] x [z0, z1] in the plane y, facing +y.
-    fn facing_up(x0: f64, x1: f64, z0: f64, z1: f64, y: f64) -> Vec<DVec3> {
-        vec![
-            dvec3(x0, y, z0),
-            dvec3(x0, y, z1),
-            dvec3(x1, y, z1),
-            dvec3(x1, y, z0),
-        ]
-    }
 
     #[test]
     fn a_ray_through_a_dropped_piece_sees_the_surface_not_what_lies_behind() {

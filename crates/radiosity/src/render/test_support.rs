@@ -24,6 +24,16 @@ pub(crate) fn surface(name: &str, emission: f64, vertices: Vec<DVec3>) -> Surfac
     }
 }
 
+/// The rectangle [x0, x1] x [z0, z1] in the plane y, facing +y.
+pub(crate) fn facing_up(x0: f64, x1: f64, z0: f64, z1: f64, y: f64) -> Vec<DVec3> {
+    vec![
+        dvec3(x0, y, z0),
+        dvec3(x0, y, z1),
+        dvec3(x1, y, z1),
+        dvec3(x1, y, z0),
+    ]
+}
+
 /// The rectangle [x0, x1] x [y0, y1] in the plane z, facing -z.
 pub(crate) fn facing_minus_z(x0: f64, x1: f64, y0: f64, y1: f64, z: f64) -> Vec<DVec3> {
     vec![
