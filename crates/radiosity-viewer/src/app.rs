@@ -16,7 +16,7 @@ use radiosity::shade::{self, Exposure};
 use radiosity::visibility::PolygonBvh;
 
 use crate::camera::{CameraController, MoveKeys};
-use crate::gpu::{colour_vertices, cover_colours, mesh_bounds, MeshRenderer, Style, Target};
+use crate::gpu::{covered_colours, mesh_bounds, MeshRenderer, Style, Target};
 use crate::model::{Modeller, SurfaceColours};
 use crate::worker::{self, Recolour, StageProgress, Update};
 use crate::ViewerOptions;
@@ -621,8 +621,7 @@ impl ViewerApp {
                 if self.colours_dirty {
                     let mut vertex_b = shade::vertex_radiosity(mesh, &self.element_b);
                     shade::smooth_objects(&self.modeller.scene, mesh, &mut vertex_b);
-                    let mut colours = colour_vertices(mesh, &self.element_b, &vertex_b);
-                    colours.extend(cover_colours(&self.cover, mesh, &self.element_b, &vertex_b));
+                    let colours = covered_colours(mesh, &self.cover, &self.element_b, &vertex_b);
                     gpu.renderer.set_colours(&rs.device, &rs.queue, &colours);
                     self.colours_dirty = false;
                     drew = true;

@@ -195,6 +195,19 @@ pub fn cover_colours(
         .collect()
 }
 
+/// The colours of everything [`MeshRenderer::set_mesh_covered`] uploads: [`colour_vertices`]
+/// followed by [`cover_colours`].
+pub fn covered_colours(
+    mesh: &Mesh,
+    cover: &HoleCover,
+    element_b: &[[f64; 3]],
+    vertex_b: &[[f64; 3]],
+) -> Vec<ColourVertex> {
+    let mut colours = colour_vertices(mesh, element_b, vertex_b);
+    colours.extend(cover_colours(cover, mesh, element_b, vertex_b));
+    colours
+}
+
 /// The colours matching [`geometry_vertices`]: `vertex_b` per mesh vertex (may be empty,
 /// then the element's radiosity is used for smooth shading too) and `element_b` per element.
 pub fn colour_vertices(
@@ -523,8 +536,7 @@ impl MeshRenderer {
     }
 
     /// [`MeshRenderer::set_mesh`] followed by the triangles of `cover` (the mesh's hole
-    /// cover, [`cover_geometry`]); the colours then are [`colour_vertices`] followed by
-    /// [`cover_colours`].
+    /// cover, [`cover_geometry`]); the colours then are [`covered_colours`].
     pub fn set_mesh_covered(
         &mut self,
         device: &wgpu::Device,
@@ -799,8 +811,7 @@ impl Headless {
     ) -> Result<image::RgbaImage, GpuError> {
         let mut renderer = MeshRenderer::new(&self.device);
         renderer.set_mesh_covered(&self.device, mesh, on_top, cover);
-        let mut colours = colour_vertices(mesh, element_b, vertex_b);
-        colours.extend(cover_colours(cover, mesh, element_b, vertex_b));
+        let colours = covered_colours(mesh, cover, element_b, vertex_b);
         renderer.set_colours(&self.device, &self.queue, &colours);
         let target = Target::new(&self.device, camera.width, camera.height);
         let mut encoder = self.device.create_command_encoder(&Default::default());
