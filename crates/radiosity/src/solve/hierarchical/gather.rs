@@ -215,7 +215,7 @@ impl Solver<'_> {
             self.normal[nl.surface as usize],
             self.normal[nq.surface as usize],
         );
-        let mut f = patch_form_factor(nl, ml, nq, mq);
+        let mut f = patch_form_factor(&self.near_pairs, nl, ml, nq, mq);
         if f <= 0.0 {
             return;
         }

@@ -5,6 +5,7 @@
 
 use glam::DVec3;
 
+use super::near_pairs::NearPairMemo;
 use super::solver::Solver;
 use super::tree::Node;
 use crate::form_factor::exact::point_to_polygon;
@@ -47,14 +48,20 @@ fn box_in_front(lo: DVec3, hi: DVec3, point: DVec3, normal: DVec3) -> bool {
 
 /// F from patch p (normal `mp`) to patch q (normal `mq`), unoccluded, by their distance:
 /// where the centres are closer than the sum of the radii, the exact area-averaged F (double
-/// contour integral): the mean over four points misses the peak of F near a shared edge and
+/// contour integral, through the memo of pair shapes): the mean over four points misses the peak of F near a shared edge and
 /// is biased low there (5 % on the Cornell box's walls at epsilon 0.01); up to three times
 /// that, the mean of Lambert's exact point value at four points of p, accurate to
 /// O((R / r)^2); beyond, the point-to-point kernel between four points of each.
-pub(super) fn patch_form_factor(np: &Node, mp: DVec3, nq: &Node, mq: DVec3) -> f64 {
+pub(super) fn patch_form_factor(
+    memo: &NearPairMemo,
+    np: &Node,
+    mp: DVec3,
+    nq: &Node,
+    mq: DVec3,
+) -> f64 {
     let r = np.centre.distance(nq.centre);
     if r < np.radius + nq.radius {
-        crate::form_factor::exact::polygon_to_polygon(np.polygon(), nq.polygon())
+        memo.form_factor(np.polygon(), nq.polygon())
     } else if r > 3.0 * (np.radius + nq.radius) {
         mean_point_pairs(np.polygon(), mp, nq.polygon(), mq, nq.area)
     } else {
@@ -142,7 +149,7 @@ impl Solver<'_> {
                         return Estimate::Refine;
                     }
                 }
-                let f_pq = patch_form_factor(np, mp, nq, mq);
+                let f_pq = patch_form_factor(&self.near_pairs, np, mp, nq, mq);
                 // F_qp for the oracle by reciprocity (A_p F_pq = A_q F_qp).
                 (f_pq, f_pq * (np.area / nq.area).max(1.0))
             }

@@ -145,6 +145,7 @@ mod contact;
 mod export;
 mod gather;
 mod link;
+mod near_pairs;
 mod oracle;
 mod refine;
 mod solver;
@@ -174,6 +175,9 @@ pub const DEFAULT_HIERARCHICAL_TOLERANCE: f64 = 1e-6;
 /// thousandth of the power is plenty, and the sweeps to 1e-6 are made once, at the end (on
 /// the million-element building: 134 sweeps over 6 solves before).
 const ROUND_TOLERANCE: f64 = 1e-3;
+/// The most the memo of near pairs' exact form factors holds (see the `near_pairs` module):
+/// the million-element building's shapes take a few MiB.
+const NEAR_PAIR_MEMO_BYTES: u64 = 256 << 20;
 /// Give up refining after this many rounds (each round is a solve and a refinement pass).
 const MAX_ROUNDS: usize = 64;
 
@@ -330,7 +334,10 @@ pub fn solve_hierarchical(
             .unwrap_or_else(|| crate::form_factor::available_memory_bytes() / 10 * 8),
         peak_memory: 0,
         gathered_at: 0,
+        near_pairs: near_pairs::NearPairMemo::new(0),
     };
+    solver.near_pairs =
+        near_pairs::NearPairMemo::new(NEAR_PAIR_MEMO_BYTES.min(solver.memory_limit / 8));
     progress.message(&format!(
         "hierarchical radiosity: memory grows with the refinement, about {} bytes per node \
          and {} per link; refinement stops with an error past {} MiB",
@@ -477,8 +484,10 @@ pub fn solve_hierarchical(
         p if p == report.leaves => String::from("final gather at every leaf"),
         p => format!("final gather at {p} points (patches of several leaves)"),
     };
+    let (memo_hits, memo_misses) = solver.near_pairs.counts();
     progress.message(&format!(
-        "hierarchical radiosity: {} leaves, {} clusters, {} links ({} initial), {} rounds, {} sweeps, {} rays, {gather}",
+        "hierarchical radiosity: {} leaves, {} clusters, {} links ({} initial), {} rounds, {} sweeps, {} rays, {gather}; \
+         exact near-pair form factors: {memo_misses} pair shapes computed, {memo_hits} pairs of the same shapes reused",
         report.leaves, report.clusters, report.links, report.initial_links, rounds, iterations, report.rays
     ));
     Ok(HierarchicalSolution {

@@ -6,6 +6,7 @@
 use glam::DVec3;
 
 use super::link::Link;
+use super::near_pairs::{self, NearPairMemo};
 use super::tree::{Cluster, ClusterSample, Node, CLUSTER_SAMPLES};
 use super::HierarchicalSettings;
 use crate::luminaire::Luminaire;
@@ -52,6 +53,8 @@ pub(super) struct Solver<'a> {
     pub(super) peak_memory: u64,
     /// Points the final gather gathered at (0 before it or without it).
     pub(super) gathered_at: usize,
+    /// Exact form factors of near patch pairs by shape (see [`NearPairMemo`]).
+    pub(super) near_pairs: NearPairMemo,
 }
 
 /// Bytes each pair of a refinement frontier takes while it is estimated: the pair in the
@@ -87,5 +90,6 @@ impl Solver<'_> {
                 * (std::mem::size_of::<Cluster>()
                     + CLUSTER_SAMPLES * std::mem::size_of::<ClusterSample>())
             + self.link_count * std::mem::size_of::<Link>() * 3 / 2) as u64
+            + self.near_pairs.len() as u64 * near_pairs::ENTRY_BYTES
     }
 }
