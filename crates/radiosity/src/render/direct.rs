@@ -272,21 +272,43 @@ pub struct DirectCorrection<'m> {
     /// How each vertex takes its value from the elements' ([`crate::shade::vertex_rule`],
     /// the rule of `vertex_radiosity`), so that D is interpolated exactly as B is.
     rule: crate::shade::VertexRule,
+    /// Which vertices smooth shading joins across the facets of a curved object
+    /// ([`crate::shade::smooth_objects`]), so that D is joined where B is, and the shading
+    /// normals that follow from the joins.
+    joins: crate::shade::ObjectJoins,
+    /// Per element, whether one of its vertices has a shading normal of its own (a facet
+    /// of a curved object); the others take their plane's normal.
+    curved: Vec<bool>,
     /// Per element, its average direct irradiance, once computed.
     element_direct: Vec<OnceLock<Rgb>>,
-    /// Per vertex, the area-weighted mean of its elements' averages, once computed.
+    /// Per vertex, its elements' averages combined by the vertex rule, once computed.
+    rule_direct: Vec<OnceLock<Rgb>>,
+    /// Per vertex, those values joined across facets as B's are, once computed.
     vertex_direct: Vec<OnceLock<Rgb>>,
 }
 
 impl<'m> DirectCorrection<'m> {
     /// The correction for `mesh`, which was cut from `scene`.
     pub fn new(scene: &Scene, mesh: &'m Mesh) -> DirectCorrection<'m> {
+        let joins = crate::shade::ObjectJoins::new(scene, mesh);
+        let display = mesh.display();
+        let curved = (0..mesh.len())
+            .map(|e| {
+                display
+                    .polygon(e)
+                    .iter()
+                    .any(|&c| joins.is_curved(c as usize))
+            })
+            .collect();
         DirectCorrection {
             light: DirectLight::new(scene),
             mesh,
             reflectance: scene.surfaces.iter().map(|s| s.reflectance).collect(),
             rule: crate::shade::vertex_rule(mesh),
+            joins,
+            curved,
             element_direct: (0..mesh.len()).map(|_| OnceLock::new()).collect(),
+            rule_direct: (0..mesh.vertices.len()).map(|_| OnceLock::new()).collect(),
             vertex_direct: (0..mesh.vertices.len()).map(|_| OnceLock::new()).collect(),
         }
     }
@@ -316,14 +338,61 @@ impl<'m> DirectCorrection<'m> {
     /// The element averages around vertex `v` combined by the rule of
     /// [`crate::shade::vertex_radiosity`] (not raised to zero: D_smooth enters a
     /// difference, and must cancel what the same rule does to the direct part of B).
-    fn vertex(&self, v: usize) -> Rgb {
-        *self.vertex_direct[v].get_or_init(|| {
+    fn vertex_by_rule(&self, v: usize) -> Rgb {
+        *self.rule_direct[v].get_or_init(|| {
             let mut sum = Rgb::default();
             for (e, w) in self.rule.terms(v) {
                 sum += self.element(e) * w;
             }
             sum
         })
+    }
+
+    /// D_smooth at vertex `v`: [`DirectCorrection::vertex_by_rule`], joined across the
+    /// facets of a curved object as [`crate::shade::smooth_objects`] joins B.
+    fn vertex(&self, v: usize) -> Rgb {
+        *self.vertex_direct[v].get_or_init(|| match self.joins.group(v) {
+            None => self.vertex_by_rule(v),
+            Some((members, area)) => {
+                let mut sum = Rgb::default();
+                for (m, w) in members {
+                    sum += self.vertex_by_rule(m) * w;
+                }
+                sum * (1.0 / area)
+            }
+        })
+    }
+
+    /// D(x), the direct irradiance at `x` on element `e` (interpolation `weights`). On a
+    /// flat surface it is received on the element's plane. On a facet of a curved object
+    /// it is received as on the smooth surface the facets approximate: the cosine is taken
+    /// to the shading normal, the vertices' normals ([`crate::shade::ObjectJoins`])
+    /// interpolated with the colours' weights (Phong 1975, "Illumination for computer
+    /// generated pictures", CACM 18), and the shadow rays leave from `x` lifted off the
+    /// facet onto the curved surface those normals describe (Hanika 2021, "Hacking the
+    /// shadow terminator", Ray Tracing Gems II ch. 4: the weighted mean of `x` projected onto
+    /// each vertex's tangent plane, where it lies below it), so that near the terminator
+    /// the neighbouring facets do not shadow light that the shading normal takes in. On a
+    /// convex object a lifted point on or outside the true surface sees all that the
+    /// surface's tangent plane there lets through, and D varies smoothly across facet edges,
+    /// where the facets' own planes would make it jump.
+    fn irradiance_here(&self, e: usize, x: DVec3, weights: &Interpolation, salt: u64) -> Rgb {
+        let el = &self.mesh.elements[e];
+        if !self.curved[e] {
+            return self.light.irradiance(x, el.normal, salt);
+        }
+        let mut normal = DVec3::ZERO;
+        let mut lift = DVec3::ZERO;
+        for (c, w) in weights.pairs() {
+            let (p, n) = (
+                self.mesh.vertices[c as usize],
+                self.joins.normal(c as usize),
+            );
+            normal += n * w;
+            lift -= n * (w * (x - p).dot(n).min(0.0));
+        }
+        self.light
+            .irradiance(x + lift, normal.normalize_or(el.normal), salt)
     }
 
     /// The correction at `x` on element `e`, where smooth shading interpolates the vertices
@@ -339,7 +408,7 @@ impl<'m> DirectCorrection<'m> {
         for (c, w) in weights.pairs() {
             smooth += self.vertex(c as usize) * w;
         }
-        let here = self.light.irradiance(x, el.normal, salt);
+        let here = self.irradiance_here(e, x, weights, salt);
         rho * (here - smooth)
     }
 }
