@@ -16,6 +16,8 @@
 
 use std::collections::HashMap;
 
+use glam::DVec3;
+
 use crate::mesh::Mesh;
 use crate::scene::Scene;
 
@@ -77,102 +79,205 @@ pub fn object_of(name: &str) -> Option<&str> {
 /// and a light set into a ceiling (another colour) are left as they are. The mesh is not
 /// changed (its vertices stay one surface's each, as the solvers need), only the colours
 /// that interpolate across it; where two facets' edges were cut at different points, the
-/// points they share are joined and the others keep their own values.
+/// points they share are joined and the others keep their own values. The joins are
+/// [`ObjectJoins`]; the renderer's direct light takes its shading normals from them.
 ///
 /// # Panics
 /// If `vertex_b` does not have one entry per mesh vertex or the mesh is not `scene`'s.
 pub fn smooth_objects(scene: &Scene, mesh: &Mesh, vertex_b: &mut [[f64; 3]]) {
     assert_eq!(vertex_b.len(), mesh.vertices.len(), "one value per vertex");
-    let surfaces = &scene.surfaces;
-    // Which surfaces can be joined at all: those of an object with another facet.
-    let mut facets: HashMap<&str, usize> = HashMap::new();
-    for s in surfaces {
-        if let Some(o) = object_of(&s.name) {
-            *facets.entry(o).or_default() += 1;
-        }
-    }
-    if !facets.values().any(|&n| n > 1) {
-        return;
-    }
-    let normal: Vec<Option<glam::DVec3>> = surfaces
-        .iter()
-        .map(|s| crate::geometry::polygon_normal(&s.vertices))
-        .collect();
-    let display = mesh.display();
-    let mut ring_area = vec![0.0f64; mesh.vertices.len()];
-    let mut surface_of = vec![u32::MAX; mesh.vertices.len()];
-    for (e, element) in mesh.elements.iter().enumerate() {
-        for &c in display.polygon(e) {
-            ring_area[c as usize] += element.area;
-            surface_of[c as usize] = element.surface;
-        }
-    }
-    let (lo, hi) = scene.bounds();
-    let extent = (hi - lo).max_element();
-    if !(extent.is_finite() && extent > 0.0) {
-        return;
-    }
-    let cell = 1e-9 * extent;
-    let joinable = |s: usize| {
-        object_of(&surfaces[s].name).is_some_and(|o| facets.get(o).is_some_and(|&n| n > 1))
-    };
-    let mut at: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-    for (v, p) in mesh.vertices.iter().enumerate() {
-        let s = surface_of[v];
-        if s != u32::MAX && joinable(s as usize) {
-            let key = (*p / cell).round().to_array().map(|x| x as i64);
-            at.entry(key).or_default().push(v as u32);
-        }
-    }
-    let cos_crease = CREASE_DEGREES.to_radians().cos();
-    let same = |a: usize, b: usize| {
-        let (x, y) = (&surfaces[a], &surfaces[b]);
-        object_of(&x.name) == object_of(&y.name)
-            && x.reflectance == y.reflectance
-            && x.emission == y.emission
-            && match (normal[a], normal[b]) {
-                (Some(m), Some(n)) => m.dot(n) > cos_crease,
-                _ => false,
+    ObjectJoins::new(scene, mesh).apply(vertex_b);
+}
+
+/// Which vertices of a mesh [`smooth_objects`] joins (the facets of one curved object
+/// meeting at a point), with their weights, and the shading normals that follow from the
+/// same joins: a joined vertex's normal is the area-weighted mean of its facets' normals,
+/// as its value is the area-weighted mean of theirs; every other vertex keeps its
+/// surface's (flat) normal.
+#[derive(Clone, Debug)]
+pub struct ObjectJoins {
+    /// Per vertex, its group in `groups`, or `u32::MAX` when it is not joined.
+    group_of: Vec<u32>,
+    /// Each group's vertices (in the order they are summed) and their total weight.
+    groups: Vec<(Vec<u32>, f64)>,
+    /// Per vertex, its weight: the area of the elements around it.
+    ring_area: Vec<f64>,
+    /// Per vertex, the unit shading normal.
+    normal: Vec<DVec3>,
+    /// Per vertex, whether its group joins facets of different normals (so its shading
+    /// normal is not its surface's).
+    curved: Vec<bool>,
+}
+
+impl ObjectJoins {
+    /// The joins of `mesh`, which was cut from `scene` (see [`smooth_objects`]).
+    pub fn new(scene: &Scene, mesh: &Mesh) -> ObjectJoins {
+        let n_vertices = mesh.vertices.len();
+        let display = mesh.display();
+        let mut ring_area = vec![0.0f64; n_vertices];
+        let mut surface_of = vec![u32::MAX; n_vertices];
+        let mut normal = vec![DVec3::ZERO; n_vertices];
+        for (e, element) in mesh.elements.iter().enumerate() {
+            for &c in display.polygon(e) {
+                ring_area[c as usize] += element.area;
+                surface_of[c as usize] = element.surface;
+                normal[c as usize] = element.normal;
             }
-    };
-    for members in at.values().filter(|m| m.len() > 1) {
-        // Union-find over the few vertices at this point.
-        let n = members.len();
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn root(parent: &mut [usize], mut i: usize) -> usize {
-            while parent[i] != i {
-                parent[i] = parent[parent[i]];
-                i = parent[i];
-            }
-            i
         }
-        for i in 0..n {
-            for j in i + 1..n {
-                let (a, b) = (members[i] as usize, members[j] as usize);
-                if same(surface_of[a] as usize, surface_of[b] as usize) {
-                    let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
-                    parent[ri] = rj;
+        let mut joins = ObjectJoins {
+            group_of: vec![u32::MAX; n_vertices],
+            groups: Vec::new(),
+            ring_area,
+            normal,
+            curved: vec![false; n_vertices],
+        };
+        let surfaces = &scene.surfaces;
+        // Which surfaces can be joined at all: those of an object with another facet.
+        let mut facets: HashMap<&str, usize> = HashMap::new();
+        for s in surfaces {
+            if let Some(o) = object_of(&s.name) {
+                *facets.entry(o).or_default() += 1;
+            }
+        }
+        if !facets.values().any(|&n| n > 1) {
+            return joins;
+        }
+        let surface_normal: Vec<Option<DVec3>> = surfaces
+            .iter()
+            .map(|s| crate::geometry::polygon_normal(&s.vertices))
+            .collect();
+        let (lo, hi) = scene.bounds();
+        let extent = (hi - lo).max_element();
+        if !(extent.is_finite() && extent > 0.0) {
+            return joins;
+        }
+        let cell = 1e-9 * extent;
+        let joinable = |s: usize| {
+            object_of(&surfaces[s].name).is_some_and(|o| facets.get(o).is_some_and(|&n| n > 1))
+        };
+        let mut at: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (v, p) in mesh.vertices.iter().enumerate() {
+            let s = surface_of[v];
+            if s != u32::MAX && joinable(s as usize) {
+                let key = (*p / cell).round().to_array().map(|x| x as i64);
+                at.entry(key).or_default().push(v as u32);
+            }
+        }
+        let cos_crease = CREASE_DEGREES.to_radians().cos();
+        let same = |a: usize, b: usize| {
+            let (x, y) = (&surfaces[a], &surfaces[b]);
+            object_of(&x.name) == object_of(&y.name)
+                && x.reflectance == y.reflectance
+                && x.emission == y.emission
+                && match (surface_normal[a], surface_normal[b]) {
+                    (Some(m), Some(n)) => m.dot(n) > cos_crease,
+                    _ => false,
+                }
+        };
+        // Points in a fixed order, so the groups (and the normals' rounding) do not depend
+        // on the hash map's.
+        let mut points: Vec<&Vec<u32>> = at.values().filter(|m| m.len() > 1).collect();
+        points.sort_unstable_by_key(|m| m[0]);
+        for members in points {
+            // Union-find over the few vertices at this point.
+            let n = members.len();
+            let mut parent: Vec<usize> = (0..n).collect();
+            fn root(parent: &mut [usize], mut i: usize) -> usize {
+                while parent[i] != i {
+                    parent[i] = parent[parent[i]];
+                    i = parent[i];
+                }
+                i
+            }
+            for i in 0..n {
+                for j in i + 1..n {
+                    let (a, b) = (members[i] as usize, members[j] as usize);
+                    if same(surface_of[a] as usize, surface_of[b] as usize) {
+                        let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+                        parent[ri] = rj;
+                    }
                 }
             }
-        }
-        let mut sums: HashMap<usize, ([f64; 3], f64, usize)> = HashMap::new();
-        for (i, &v) in members.iter().enumerate() {
-            let r = root(&mut parent, i);
-            let v = v as usize;
-            let entry = sums.entry(r).or_insert(([0.0; 3], 0.0, 0));
-            for (s, b) in entry.0.iter_mut().zip(vertex_b[v]) {
-                *s += ring_area[v] * b;
+            let mut by_root: Vec<(usize, Vec<u32>)> = Vec::new();
+            for (i, &v) in members.iter().enumerate() {
+                let r = root(&mut parent, i);
+                match by_root.iter_mut().find(|(q, _)| *q == r) {
+                    Some((_, group)) => group.push(v),
+                    None => by_root.push((r, vec![v])),
+                }
             }
-            entry.1 += ring_area[v];
-            entry.2 += 1;
-        }
-        for (i, &v) in members.iter().enumerate() {
-            let r = root(&mut parent, i);
-            let (sum, area, count) = sums[&r];
-            if count > 1 && area > 0.0 {
-                vertex_b[v as usize] = sum.map(|x| x / area);
+            for (_, group) in by_root {
+                let area: f64 = group.iter().map(|&v| joins.ring_area[v as usize]).sum();
+                let joined = group.len() > 1 && area > 0.0;
+                if !joined {
+                    continue;
+                }
+                // The shading normal: the facets' normals weighted as the values are.
+                let first = joins.normal[group[0] as usize];
+                let curved = group
+                    .iter()
+                    .any(|&v| joins.normal[v as usize].dot(first) < 1.0 - 1e-12);
+                let mean = group
+                    .iter()
+                    .map(|&v| joins.ring_area[v as usize] * joins.normal[v as usize])
+                    .sum::<DVec3>()
+                    .normalize_or_zero();
+                let index = joins.groups.len() as u32;
+                for &v in &group {
+                    joins.group_of[v as usize] = index;
+                    if curved && mean != DVec3::ZERO {
+                        joins.normal[v as usize] = mean;
+                        joins.curved[v as usize] = true;
+                    }
+                }
+                joins.groups.push((group, area));
             }
         }
+        joins
+    }
+
+    /// The vertices joined with `v` (itself included) and their weights, with the sum of
+    /// the weights; `None` for a vertex that keeps its own value.
+    pub fn group(&self, v: usize) -> Option<(impl Iterator<Item = (usize, f64)> + '_, f64)> {
+        let g = *self.group_of.get(v)?;
+        if g == u32::MAX {
+            return None;
+        }
+        let (members, area) = &self.groups[g as usize];
+        Some((
+            members
+                .iter()
+                .map(|&m| (m as usize, self.ring_area[m as usize])),
+            *area,
+        ))
+    }
+
+    /// Replaces the values of every group of joined vertices by their weighted mean.
+    pub fn apply(&self, values: &mut [[f64; 3]]) {
+        for (members, area) in &self.groups {
+            let mut sum = [0.0f64; 3];
+            for &v in members {
+                let v = v as usize;
+                for (s, b) in sum.iter_mut().zip(values[v]) {
+                    *s += self.ring_area[v] * b;
+                }
+            }
+            for &v in members {
+                values[v as usize] = sum.map(|x| x / area);
+            }
+        }
+    }
+
+    /// The unit shading normal at vertex `v`: the area-weighted mean of the normals of
+    /// the facets joined there, or its surface's normal where none are.
+    pub fn normal(&self, v: usize) -> DVec3 {
+        self.normal[v]
+    }
+
+    /// True when the shading normal at vertex `v` differs from its surface's (it joins
+    /// facets of a curved object).
+    pub fn is_curved(&self, v: usize) -> bool {
+        self.curved[v]
     }
 }
 

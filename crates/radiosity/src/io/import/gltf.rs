@@ -51,7 +51,13 @@
 //! Each node with a mesh is one object: its surfaces are named after the node (or its
 //! mesh, or `node N`). Unit: metres, glTF's unit, times [`super::ImportOptions::scale`].
 //!
-//! Ignored: cameras and lights (`KHR_lights_punctual`), normals, UVs beyond the texture
+//! The first perspective camera in the node tree (depth first, as the meshes are placed)
+//! is the scene's camera (eye, viewing direction and up from its node's transform, the
+//! vertical field of view from `yfov`), so a scene that `radiosity export` wrote renders
+//! from the view it was exported with; orthographic cameras are warned about and passed
+//! over.
+//!
+//! Ignored: lights (`KHR_lights_punctual`), normals, UVs beyond the texture
 //! mean, the emissive texture, metallic-roughness, alpha and
 //! `doubleSided` (every surface is one-sided: it reflects on its front only), morph
 //! targets and skins, animations. Sparse accessors and quantized positions
@@ -115,9 +121,13 @@ pub fn parse(
         exposure_scale: 1.0,
         derived: Vec::new(),
         settings: None,
+        camera: None,
     };
     let (soup, format) = reader.soup(bytes)?;
-    let (scene, mut warnings) = soup.to_scene(options.scale)?;
+    let (mut scene, mut warnings) = soup.to_scene(options.scale)?;
+    scene.camera = reader.camera.map(|(eye, forward, up, fov_y_degrees)| {
+        camera_hint(&scene, eye * options.scale, forward, up, fov_y_degrees)
+    });
     let mut all = std::mem::take(&mut reader.warnings);
     all.append(&mut warnings);
     // Settings given win; then those a radiosity export wrote (its area in the file's
@@ -167,6 +177,9 @@ struct Reader<'a> {
     derived: Vec<SoupMaterial>,
     /// The meshing settings a radiosity export wrote (`asset.extras.radiosity.meshSettings`).
     settings: Option<MeshSettings>,
+    /// The first perspective camera met in the walk, in the file's units: (eye, unit
+    /// viewing direction, unit up, vertical field of view in degrees).
+    camera: Option<(DVec3, DVec3, DVec3, f64)>,
 }
 
 /// The bit that marks a face's material as one of [`Reader::derived`] during the walk.
@@ -262,6 +275,9 @@ impl Reader<'_> {
             let local =
                 DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
             let global = parent * local;
+            if let (None, Some(camera)) = (self.camera, node.camera()) {
+                self.camera = self.camera(&camera, &node, &global);
+            }
             if let Some(mesh) = node.mesh() {
                 let object = soup.objects.len() as u32;
                 soup.objects.push(object_name(&node, &mesh));
@@ -417,6 +433,51 @@ impl Reader<'_> {
             )));
         }
         Ok(())
+    }
+
+    /// The view of a camera node with global transform `global`: glTF's camera looks down
+    /// its node's -z with +y up (glTF 2.0 specification, 3.10 "Cameras"), so the eye is the
+    /// node's origin, the viewing direction its -z axis and the up its +y axis, all placed
+    /// by the transform. `None`, with a warning, for an orthographic camera or one whose
+    /// transform or field of view gives no view (not finite, or a field of view not
+    /// strictly between 0 and 180 degrees); the next perspective camera is then looked at.
+    fn camera(
+        &mut self,
+        camera: &gltf::Camera,
+        node: &gltf::Node,
+        global: &DMat4,
+    ) -> Option<(DVec3, DVec3, DVec3, f64)> {
+        let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+            self.warn(format!(
+                "the orthographic camera of node {} ignored (the renderer's camera is a \
+                 perspective one)",
+                describe_node(node)
+            ));
+            return None;
+        };
+        let eye = global.transform_point3(DVec3::ZERO);
+        let forward = global.transform_vector3(DVec3::NEG_Z).try_normalize();
+        let up = global.transform_vector3(DVec3::Y).try_normalize();
+        let fov_y_degrees = f64::from(p.yfov()).to_degrees();
+        match (forward, up) {
+            (Some(forward), Some(up))
+                if eye.is_finite()
+                    && fov_y_degrees > 0.0
+                    && fov_y_degrees < 180.0
+                    && forward.cross(up).length() > 1e-6 =>
+            {
+                Some((eye, forward, up, fov_y_degrees))
+            }
+            _ => {
+                self.warn(format!(
+                    "the camera of node {} ignored: its transform or field of view ({} \
+                     degrees) gives no view",
+                    describe_node(node),
+                    fov_y_degrees
+                ));
+                None
+            }
+        }
     }
 
     /// The nodes the scene starts from.
@@ -1165,6 +1226,32 @@ impl Reader<'_> {
         }
         soup.vertices.extend(points);
         Ok(n)
+    }
+}
+
+/// The scene camera for a glTF camera at `eye` (scaled as the scene is) looking along the
+/// unit `forward`: it looks at the point that far along as the centre of the scene's
+/// bounds (1 unit along for an empty scene or one centred on the eye; only the direction
+/// matters to the view).
+fn camera_hint(
+    scene: &crate::scene::Scene,
+    eye: DVec3,
+    forward: DVec3,
+    up: DVec3,
+    fov_y_degrees: f64,
+) -> crate::scene::CameraHint {
+    let (lo, hi) = scene.bounds();
+    let distance = (0.5 * (lo + hi) - eye).length();
+    let distance = if distance.is_finite() && distance > 0.0 {
+        distance
+    } else {
+        1.0
+    };
+    crate::scene::CameraHint {
+        eye,
+        look_at: eye + forward * distance,
+        up,
+        fov_y_degrees,
     }
 }
 

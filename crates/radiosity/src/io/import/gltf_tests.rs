@@ -1299,3 +1299,118 @@ fn unlit_export_without_its_colours_reads_as_the_baked_light() {
         }
     }
 }
+
+/// Issue #13: the camera `radiosity export` writes reads back as the scene's camera, so
+/// `render out.glb` shows the view it was exported with, at any `--scale`. glTF holds the
+/// node's translation and rotation and `yfov` in single precision (the `gltf` crate reads
+/// them as f32), so the eye agrees to f32 rounding of its coordinates (6e-8 of them; 1e-6
+/// allowed, of the eye's distance from the origin) and the camera's axes, from an f32
+/// unit quaternion, to a few f32 roundings too (1e-6); the field of view to 1e-6 of it.
+#[test]
+fn exported_camera_reads_back_as_the_scene_camera() {
+    use crate::io::export::gltf::{write_glb, write_gltf, Bake};
+    use crate::render::Camera;
+    let dir = tempfile::tempdir().unwrap();
+    let prepared = Prepared::new(cornell_scene(), coarse_settings(), &NoProgress).unwrap();
+    let vertex_b = vec![[0.1; 3]; prepared.mesh.vertices.len()];
+    // The box's own view (a half turn about y), and an oblique one with a tilted up.
+    let views = [
+        (
+            dvec3(278.0, 273.0, -800.0),
+            dvec3(278.0, 273.0, 0.0),
+            DVec3::Y,
+            39.3,
+        ),
+        (
+            dvec3(100.0, 450.0, -300.0),
+            dvec3(300.0, 200.0, 250.0),
+            dvec3(0.2, 1.0, 0.1),
+            55.0,
+        ),
+    ];
+    for (eye, look_at, up, fov_y_degrees) in views {
+        let camera = Camera {
+            eye,
+            look_at,
+            up,
+            fov_y_degrees,
+            width: 64,
+            height: 48,
+        };
+        let bake = Bake {
+            scene: &prepared.scene,
+            mesh: &prepared.mesh,
+            vertex_b: &vertex_b,
+            exposure_scale: 1.0,
+            exposure: "fixed",
+            camera: &camera,
+            settings: coarse_settings(),
+        };
+        let (glb, gltf) = (dir.path().join("view.glb"), dir.path().join("view.gltf"));
+        write_glb(&glb, &bake).unwrap();
+        write_gltf(&gltf, &bake).unwrap();
+        let (forward, right, up) = camera.basis();
+        for (path, scale) in [(&glb, 1.0), (&gltf, 1.0), (&glb, 0.001)] {
+            let options = ImportOptions {
+                scale,
+                settings: None,
+            };
+            let imported = read_any_scene(path, &options).unwrap();
+            assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
+            let scene = &imported.file.scene;
+            let hint = scene.camera.expect("the exported camera");
+            let got = Camera::for_scene(scene, 64, 48);
+            let what = format!(
+                "{} at scale {scale}, view from {eye} to {look_at}",
+                path.display()
+            );
+            assert!(
+                got.eye.distance(eye * scale) <= 1e-6 * eye.length() * scale,
+                "{what}: eye {}",
+                got.eye
+            );
+            let (f, r, u) = got.basis();
+            for (a, b, axis) in [(f, forward, "forward"), (r, right, "right"), (u, up, "up")] {
+                assert!(a.distance(b) <= 1e-6, "{what}: {axis} {a} against {b}");
+            }
+            assert!(
+                (hint.fov_y_degrees / fov_y_degrees - 1.0).abs() <= 1e-6,
+                "{what}: field of view {}",
+                hint.fov_y_degrees
+            );
+        }
+    }
+}
+
+/// An orthographic glTF camera is passed over with a warning, and the scene keeps no
+/// camera (the renderer then frames the scene itself).
+#[test]
+fn an_orthographic_camera_is_warned_about_and_not_used() {
+    use crate::io::export::gltf::{write_gltf, Bake};
+    let dir = tempfile::tempdir().unwrap();
+    let prepared = Prepared::new(cornell_scene(), coarse_settings(), &NoProgress).unwrap();
+    let vertex_b = vec![[0.1; 3]; prepared.mesh.vertices.len()];
+    let camera = crate::render::Camera::for_scene(&prepared.scene, 64, 48);
+    let bake = Bake {
+        scene: &prepared.scene,
+        mesh: &prepared.mesh,
+        vertex_b: &vertex_b,
+        exposure_scale: 1.0,
+        exposure: "fixed",
+        camera: &camera,
+        settings: coarse_settings(),
+    };
+    let path = dir.path().join("ortho.gltf");
+    write_gltf(&path, &bake).unwrap();
+    let mut doc: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    doc["cameras"][0] = json!({
+        "type": "orthographic",
+        "orthographic": { "xmag": 1.0, "ymag": 1.0, "znear": 0.1, "zfar": 10.0 },
+    });
+    std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+    let imported = read_any_scene(&path, &ImportOptions::default()).unwrap();
+    assert!(imported.file.scene.camera.is_none());
+    assert_eq!(imported.warnings.len(), 1, "{:?}", imported.warnings);
+    let w = imported.warnings[0].to_string();
+    assert!(w.contains("orthographic camera of node"), "{w}");
+}
