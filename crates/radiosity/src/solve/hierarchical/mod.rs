@@ -484,10 +484,10 @@ pub fn solve_hierarchical(
         p if p == report.leaves => String::from("final gather at every leaf"),
         p => format!("final gather at {p} points (patches of several leaves)"),
     };
-    let (memo_hits, memo_misses) = solver.near_pairs.counts();
+    let (shapes_computed, shapes_reused) = solver.near_pairs.counts();
     progress.message(&format!(
         "hierarchical radiosity: {} leaves, {} clusters, {} links ({} initial), {} rounds, {} sweeps, {} rays, {gather}; \
-         exact near-pair form factors: {memo_misses} pair shapes computed, {memo_hits} pairs of the same shapes reused",
+         exact near-pair form factors: {shapes_computed} pair shapes computed, {shapes_reused} pairs of the same shapes reused",
         report.leaves, report.clusters, report.links, report.initial_links, rounds, iterations, report.rays
     ));
     Ok(HierarchicalSolution {
