@@ -6,59 +6,60 @@ use glam::DVec3;
 
 use super::solver::Solver;
 
-/// 16 stratified points of a triangle or a planar convex quadrilateral: one in each cell
-/// of a 4 x 4 grid of the quadrilateral's (u, v) square, or in each of the 16 sub-triangles
-/// of the triangle split four times along each edge, at a uniformly random spot of its
-/// cell drawn from `seed` (jittered sampling, Cook 1986). Cell centres never come nearer
-/// the edge than half a cell, and the edge is where a perpendicular occluder hides most (a
-/// window at the end of its reveals sees least of the room from its rim): judged from
-/// centres, such links were too visible. Jittered points are unbiased.
-fn sample_points(poly: &[DVec3], seed: u64) -> [DVec3; 16] {
-    let mut stratum = 0;
-    let mut next = || {
-        stratum += 1;
-        crate::splitmix::jitter(seed, stratum)
-    };
-    let mut out = [DVec3::ZERO; 16];
+/// The k-th (0..16) of 16 stratified points of a triangle or a planar convex
+/// quadrilateral: one in each cell of a 4 x 4 grid of the quadrilateral's (u, v) square, or
+/// in each of the 16 sub-triangles of the triangle split four times along each edge, at a
+/// uniformly random spot of its cell drawn from `seed` and the cell's number (jittered
+/// sampling, Cook 1986). Cell centres never come nearer the edge than half a cell, and the
+/// edge is where a perpendicular occluder hides most (a window at the end of its reveals
+/// sees least of the room from its rim): judged from centres, such links were too visible.
+/// Jittered points are unbiased. One point at a time, because most links settle after the
+/// first four pairs: drawing all 32 points of a link's two nodes up front was 6 % of the
+/// million-element building's CPU time (`perf`, December 2026).
+fn sample_point(poly: &[DVec3], seed: u64, k: usize) -> DVec3 {
+    let (s, t) = crate::splitmix::jitter(seed, k + 1);
     if poly.len() == 4 {
-        for j in 0..4 {
-            for i in 0..4 {
-                let (s, t) = next();
-                let (u, v) = ((i as f64 + s) / 4.0, (j as f64 + t) / 4.0);
-                out[j * 4 + i] = crate::mesh::bilinear(poly, u, v);
-            }
-        }
+        let (i, j) = (k % 4, k / 4);
+        crate::mesh::bilinear(poly, (i as f64 + s) / 4.0, (j as f64 + t) / 4.0)
     } else {
+        let (x, y, across) = TRIANGLE_CELLS[k];
+        let (u, v) = if s + t > 1.0 {
+            (1.0 - s, 1.0 - t)
+        } else {
+            (s, t)
+        };
         let (a, e1, e2) = (poly[0], poly[1] - poly[0], poly[2] - poly[0]);
-        let mut k = 0;
-        for b in 0..4 {
-            for s in 0..4 - b {
-                let (x, y) = (s as f64, b as f64);
-                // The sub-triangle (x, y), (x + 1, y), (x, y + 1) of the lattice ...
-                let (u, v) = next();
-                let (u, v) = if u + v > 1.0 {
-                    (1.0 - u, 1.0 - v)
-                } else {
-                    (u, v)
-                };
-                out[k] = a + e1 * ((x + u) / 4.0) + e2 * ((y + v) / 4.0);
-                k += 1;
-                if s + b + 1 < 4 {
-                    // ... and the one across its diagonal, (x + 1, y + 1) less the same.
-                    let (u, v) = next();
-                    let (u, v) = if u + v > 1.0 {
-                        (1.0 - u, 1.0 - v)
-                    } else {
-                        (u, v)
-                    };
-                    out[k] = a + e1 * ((x + 1.0 - u) / 4.0) + e2 * ((y + 1.0 - v) / 4.0);
-                    k += 1;
-                }
-            }
+        if across {
+            // The sub-triangle across the diagonal: (x + 1, y + 1) less the same.
+            a + e1 * ((x + 1.0 - u) / 4.0) + e2 * ((y + 1.0 - v) / 4.0)
+        } else {
+            // The sub-triangle (x, y), (x + 1, y), (x, y + 1) of the lattice.
+            a + e1 * ((x + u) / 4.0) + e2 * ((y + v) / 4.0)
         }
     }
-    out
 }
+
+/// The 16 sub-triangles of a triangle split four times along each edge, in the order the
+/// points are numbered: the lattice corner (x, y) of each, and whether it is the one across
+/// the diagonal. Row by row (y), each upright cell followed by the one across from it.
+const TRIANGLE_CELLS: [(f64, f64, bool); 16] = {
+    let mut cells = [(0.0, 0.0, false); 16];
+    let (mut k, mut y) = (0, 0);
+    while y < 4 {
+        let mut x = 0;
+        while x < 4 - y {
+            cells[k] = (x as f64, y as f64, false);
+            k += 1;
+            if x + y + 1 < 4 {
+                cells[k] = (x as f64, y as f64, true);
+                k += 1;
+            }
+            x += 1;
+        }
+        y += 1;
+    }
+    cells
+};
 
 /// A stride that visits 0..n in a spread-out order: the integer nearest 0.618 n that is
 /// coprime with n (1 for n <= 2).
@@ -78,6 +79,48 @@ fn spread_stride(n: usize) -> usize {
         s += 1;
     }
     s
+}
+
+/// The 16 point pairs of a patch <- patch link: 4 x 4 stratified points on each node,
+/// paired by a fixed permutation, each weighed by what it stands for of the exchange.
+struct PatchPairs<'a> {
+    polygons: (&'a [DVec3], &'a [DVec3]),
+    seeds: (u64, u64),
+    normals: (DVec3, DVec3),
+    /// A sixteenth of the larger node's area: the disc that bounds a pair's kernel.
+    disc: f64,
+}
+
+impl PatchPairs<'_> {
+    /// The pairs' order: the first four spread over both nodes (a diagonal of the 4 x 4
+    /// grid).
+    const ORDER: [usize; 16] = [0, 5, 10, 15, 1, 2, 3, 4, 6, 7, 8, 9, 11, 12, 13, 14];
+
+    /// Pairs `range` (in [`Self::ORDER`]) and their weights: the kernel cos cos / (pi d^2),
+    /// bounded as the form factor to a disc of a sixteenth of the larger node (Wallace et
+    /// al. 1989, eq. 7) so that two points that nearly meet do not outweigh the rest.
+    fn draw(
+        &self,
+        range: std::ops::Range<usize>,
+        pairs: &mut [(DVec3, DVec3, DVec3, DVec3); 16],
+        weights: &mut [f64; 16],
+    ) {
+        let (mp, mq) = self.normals;
+        for k in range {
+            let i = Self::ORDER[k];
+            let x = sample_point(self.polygons.0, self.seeds.0, i);
+            let y = sample_point(self.polygons.1, self.seeds.1, (i * 5 + 3) % 16);
+            pairs[k] = (x, mp, y, mq);
+            let d = y - x;
+            let d2 = d.length_squared();
+            let (cx, cy) = (mp.dot(d), -mq.dot(d));
+            weights[k] = if cx > 0.0 && cy > 0.0 {
+                cx * cy / (d2 * (std::f64::consts::PI * d2 + self.disc))
+            } else {
+                0.0
+            };
+        }
+    }
 }
 
 impl Solver<'_> {
@@ -101,6 +144,8 @@ impl Solver<'_> {
         // Cluster links weigh their facing pairs by what each stands for.
         let mut weights = [1.0f64; 16];
         let mut weighted = false;
+        // A patch link's pairs past the first four, drawn only when those do not settle it.
+        let mut deferred = None;
         if !np.is_cluster() && !nq.is_cluster() {
             let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
             for &v in np.polygon().iter().chain(nq.polygon()) {
@@ -118,33 +163,14 @@ impl Solver<'_> {
             // The same points for the link p <- q as for q <- p.
             let seed = crate::splitmix::splitmix64((p.min(q) as u64) << 32 | p.max(q) as u64);
             let (seed_p, seed_q) = if p < q { (seed, !seed) } else { (!seed, seed) };
-            let (a, b) = (
-                sample_points(np.polygon(), seed_p),
-                sample_points(nq.polygon(), seed_q),
-            );
-            let (mp, mq) = (self.normal[sp as usize], self.normal[sq as usize]);
-            // What a point pair stands for of the exchange: the kernel cos cos / (pi d^2),
-            // bounded as the form factor to a disc of a sixteenth of the larger node
-            // (Wallace et al. 1989, eq. 7) so that two points that nearly meet do not
-            // outweigh the rest.
-            let w = np.area.max(nq.area) / 16.0;
-            // The first four pairs spread over both nodes (a diagonal of the 4 x 4 grid).
-            for (k, i) in [0, 5, 10, 15, 1, 2, 3, 4, 6, 7, 8, 9, 11, 12, 13, 14]
-                .into_iter()
-                .enumerate()
-            {
-                let (x, y) = (a[i], b[(i * 5 + 3) % 16]);
-                pairs[k] = (x, mp, y, mq);
-                let d = y - x;
-                let d2 = d.length_squared();
-                let (cx, cy) = (mp.dot(d), -mq.dot(d));
-                weights[k] = if cx > 0.0 && cy > 0.0 {
-                    cx * cy / (d2 * (std::f64::consts::PI * d2 + w))
-                } else {
-                    0.0
-                };
-            }
-            weighted = weights.iter().all(|w| w.is_finite()) && weights.iter().sum::<f64>() > 0.0;
+            let patch_pairs = PatchPairs {
+                polygons: (np.polygon(), nq.polygon()),
+                seeds: (seed_p, seed_q),
+                normals: (self.normal[sp as usize], self.normal[sq as usize]),
+                disc: np.area.max(nq.area) / 16.0,
+            };
+            patch_pairs.draw(0..4, &mut pairs, &mut weights);
+            deferred = Some(patch_pairs);
             count = 16;
         } else {
             // Up to eight pairs that face each other (from all pairs of sample points, in
@@ -197,13 +223,21 @@ impl Solver<'_> {
         let (mut facing, mut visible, mut all_visible) = (0u32, 0u32, 0u32);
         let (mut facing_weight, mut visible_weight) = (0.0, 0.0);
         let mut rays = 0;
-        for (i, &(x, mx, y, my)) in pairs[..count].iter().enumerate() {
+        for i in 0..count {
             // Four facing pairs all open settle it; anything else (some blocked: partial
             // visibility, where the fraction matters, or none visible, which ends the
             // link's refinement) casts all sixteen.
-            if i == 4 && facing == 4 && visible == 4 {
-                break;
+            if i == 4 {
+                if facing == 4 && visible == 4 {
+                    break;
+                }
+                if let Some(patch_pairs) = &deferred {
+                    patch_pairs.draw(4..16, &mut pairs, &mut weights);
+                    weighted =
+                        weights.iter().all(|w| w.is_finite()) && weights.iter().sum::<f64>() > 0.0;
+                }
             }
+            let (x, mx, y, my) = pairs[i];
             let faces = mx.dot(y - x) > 0.0 && my.dot(x - y) > 0.0;
             let open = !blocked(x, y);
             rays += 1;
@@ -225,5 +259,55 @@ impl Solver<'_> {
             all_visible as f64 / rays as f64
         };
         (fraction, rays, facing)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_points_lie_one_in_each_cell_of_the_4_by_4_grid() {
+        let square = [
+            DVec3::ZERO,
+            DVec3::new(4.0, 0.0, 0.0),
+            DVec3::new(4.0, 4.0, 0.0),
+            DVec3::new(0.0, 4.0, 0.0),
+        ];
+        for seed in [1, 2, 0xdead_beef] {
+            for k in 0..16 {
+                let x = sample_point(&square, seed, k);
+                // The square's (u, v) is (x, y) / 4: point k in cell (k % 4, k / 4).
+                assert_eq!(
+                    (x.x.floor() as usize, x.y.floor() as usize),
+                    (k % 4, k / 4),
+                    "seed {seed}, point {k} at {x}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn triangle_points_lie_one_in_each_of_the_16_sub_triangles() {
+        // The right triangle (0,0) (4,0) (0,4): lattice cells are unit squares cut by their
+        // diagonal, the lower-left half upright, the upper-right half across.
+        let tri = [
+            DVec3::ZERO,
+            DVec3::new(4.0, 0.0, 0.0),
+            DVec3::new(0.0, 4.0, 0.0),
+        ];
+        for seed in [1, 7, 0xdead_beef] {
+            let mut cells: Vec<(i64, i64, bool)> = (0..16)
+                .map(|k| {
+                    let p = sample_point(&tri, seed, k);
+                    assert!(p.x >= 0.0 && p.y >= 0.0 && p.x + p.y <= 4.0, "{p}");
+                    let (cx, cy) = (p.x.floor(), p.y.floor());
+                    (cx as i64, cy as i64, (p.x - cx) + (p.y - cy) > 1.0)
+                })
+                .collect();
+            cells.sort();
+            cells.dedup();
+            assert_eq!(cells.len(), 16, "seed {seed}: {cells:?}");
+        }
     }
 }
