@@ -542,12 +542,7 @@ pub struct IlluminanceArgs {
     pub solve: SolveOptions,
     /// Calculation points: a CSV with the header name,x,y,z,nx,ny,nz (scene units; the
     /// normal is the direction the meter faces).
-    #[arg(
-        long,
-        value_name = "P.csv",
-        required_unless_present = "grid",
-        conflicts_with = "grid"
-    )]
+    #[arg(long, value_name = "P.csv", conflicts_with = "grid")]
     pub points: Option<PathBuf>,
     /// A rectangular grid instead: corners x0,y0,z0 and x1,y1,z1 (equal in at least one
     /// axis) and the spacing; points from the first corner every SPACING up to the second.
@@ -563,7 +558,7 @@ pub struct IlluminanceArgs {
     pub output: PathBuf,
     /// Also draw the grid's total illuminance as a PNG (coloured cells with their values and
     /// a scale bar in lx).
-    #[arg(long, value_name = "FILE.png", requires = "grid")]
+    #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
 }
 
