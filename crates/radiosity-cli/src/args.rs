@@ -618,9 +618,16 @@ pub struct BenchArgs {
     /// 0.01 unshot for progressive, 1e-6 changing power for hierarchical).
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
-    /// Image width and height in pixels.
-    #[arg(long, default_value_t = 512, value_name = "PIXELS")]
+    /// Image width and height in pixels (--width or --height sets one side).
+    #[arg(long, default_value_t = 512, value_name = "PIXELS",
+          value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub size: u32,
+    /// Image width in pixels, as for `render` (default: --size).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub width: Option<u32>,
+    /// Image height in pixels, as for `render` (default: --size).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub height: Option<u32>,
     /// Rays per pixel along each axis (as `render --supersample`).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub supersample: u32,

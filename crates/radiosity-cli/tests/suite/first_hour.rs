@@ -1481,3 +1481,31 @@ fn help_texts_give_the_ranges_and_units_the_commands_hold_to() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn bench_takes_width_and_height_as_render_does_and_keeps_size() {
+    // QA of issue #16: bench had only --size, and its zero check was worded unlike the
+    // other commands' --width.
+    let dir = scratch_dir("bench-size");
+    let base = ["bench", "--max-area", "20000", "--repeat", "1"];
+    let run = |extra: &[&str]| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        radiosity(&args, &dir)
+    };
+    let out = run(&["--size", "8", "--width", "12"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("render 12x8 at"), "{}", stderr(&out));
+    let out = run(&["--size", "8"]);
+    assert!(stderr(&out).contains("render 8x8 at"), "{}", stderr(&out));
+    for flag in ["--size", "--width", "--height"] {
+        let out = run(&[flag, "0"]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!("'{flag} <")) && err.contains("0 is not in 1..=10000"),
+            "{err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
