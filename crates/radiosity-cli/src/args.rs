@@ -51,10 +51,11 @@ pub enum ValidateCommand {
 #[derive(Args)]
 pub struct Cie171Args {
     /// Write each case's scene and points file (name,x,y,z,nx,ny,nz) into DIR and stop
-    /// (the repository keeps them under validation/).
+    /// (the repository keeps them under validation/); with --case, those cases' only.
     #[arg(long, value_name = "DIR")]
     pub write: Option<PathBuf>,
-    /// Run only the cases whose id starts with this, e.g. 5.8 or 5.11.
+    /// Run (or, with --write, write) only the cases whose id starts with this, e.g. 5.8 or
+    /// 5.11.
     #[arg(long, value_name = "ID")]
     pub case: Option<String>,
     /// Only the verdict line (no table, no list of sources); the exit status still says

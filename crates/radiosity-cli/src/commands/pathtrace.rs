@@ -38,6 +38,30 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             args.paths,
         )?;
     }
+    if let Some(path) = &args.reference {
+        // The tracing flags do nothing when the view is read back (QA of issue #16:
+        // `--paths` was dropped without a word). Printed even with --quiet.
+        let default = PathTraceSettings::DEFAULT;
+        let given = [
+            ("--paths", args.paths != default.samples_per_pixel),
+            ("--path-seed", args.path_seed != default.seed),
+            ("--max-bounces", args.max_bounces != default.max_bounces),
+            (
+                "--roulette-after",
+                args.roulette_after != default.roulette_after_bounces,
+            ),
+            ("--no-light-sampling", args.no_light_sampling),
+        ];
+        let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+        if !ignored.is_empty() {
+            errln!(
+                "warning: {} ignored with --reference: the path-traced view is read from {} \
+                 as it was traced (its paths a pixel and seed are noted when it is read)",
+                ignored.join(", "),
+                path.display()
+            );
+        }
+    }
     if args.compare {
         setup::check_render_budget(
             &args.camera,

@@ -224,3 +224,54 @@ fn bad_flags_exit_2_with_what_was_expected() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_render_exr_as_reference_is_named_for_what_it_is_and_tracing_flags_are_warned() {
+    // QA of issue #16: a render's EXR given to --reference was first refused for its
+    // size, then its camera, before the real cause; --paths with --reference was ignored
+    // without a word.
+    let dir = scratch_dir("pathtrace-render-exr");
+    let r = radiosity(
+        &[
+            "render",
+            "--width",
+            "6",
+            "--height",
+            "5",
+            "--max-area",
+            "20000",
+            "-o",
+            "r.exr",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(r.status.success(), "{}", stderr(&r));
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--reference",
+            "r.exr",
+            "--paths",
+            "64",
+            "--path-seed",
+            "3",
+            "--fov",
+            "50",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("r.exr is an OpenEXR image but not a saved path-traced view")
+            && !err.contains("holds a")
+            && !err.contains("another camera"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: --paths, --path-seed ignored with --reference"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
