@@ -718,7 +718,7 @@ fn a_negative_number_is_taken_as_the_flags_value() {
         ),
         (
             vec!["render", "--fov", "-45", "-o", "x.png"],
-            "--fov must be between 0 and 180 degrees, got -45",
+            "--fov must be more than 0 and less than 180 degrees, got -45",
         ),
         (
             vec!["render", "--solver", "hierarchical", "--epsilon", "-0.5"],
@@ -1507,5 +1507,50 @@ fn bench_takes_width_and_height_as_render_does_and_keeps_size() {
             "{err}"
         );
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn export_help_wireframe_exposure_and_fov_say_what_is_true() {
+    // QA of issue #16: export's --width/--height said "Image width"; a wireframe render
+    // printed an exposure line though its lines are white whatever the exposure; the
+    // --fov message said "between 0 and 180" with both ends excluded.
+    let dir = scratch_dir("export-help-wireframe");
+    let help = crate::fixtures::stdout(&radiosity(&["export", "--help"], &dir));
+    assert!(
+        help.contains("aspect ratio is WIDTH / HEIGHT") && !help.contains("Image width"),
+        "{help}"
+    );
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--shading",
+            "wireframe",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--exposure",
+            "2",
+            "-o",
+            "w.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("exposure scale"), "{err}");
+    assert!(
+        err.contains("warning: --exposure ignored with --shading wireframe"),
+        "{err}"
+    );
+    let out = radiosity(&["render", "--fov", "180", "-o", "f.png"], &dir);
+    assert!(
+        stderr(&out).contains("more than 0 and less than 180 degrees, got 180"),
+        "{}",
+        stderr(&out)
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
