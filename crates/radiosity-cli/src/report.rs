@@ -981,8 +981,9 @@ pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
     outln!("max               {:.2} %", 100.0 * c.max);
     if let Some(noise) = c.reference_noise {
         outln!(
-            "reference noise   {:.2} % (the path tracer's RMS standard error: the rms a render \
-             equal to the true image would show)",
+            "reference noise   {:.2} % (the path tracer's RMS standard error over its RMS \
+             luminance, as the lines above, where `noise` divides it by the mean luminance: \
+             the rms a render equal to the true image would show)",
             100.0 * noise
         );
         outln!("rms less noise    {:.2} %", 100.0 * c.rms_less_noise());

@@ -295,16 +295,16 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         &error_png,
         &reporter,
     )?;
-    if args.tone.exposure == Exposure::Auto {
-        reporter.note(&format!(
-            "exposure scale {} (auto, the radiosity solution's); the path-traced view's \
-             own auto exposure would be {}",
-            report::significant(scale, 4),
+    // One line for the exposure (QA of issue #16: it was printed twice).
+    let whose = match args.tone.exposure {
+        Exposure::Auto => format!(
+            " (auto, the radiosity solution's; the path-traced view's own would be {})",
             report::significant(view.auto_exposure_scale(), 4)
-        ));
-    }
+        ),
+        Exposure::Fixed(_) => String::new(),
+    };
     reporter.note(&format!(
-        "exposure scale {} for both; error map: white 0, blue darker and red brighter \
+        "exposure scale {} for both{whose}; error map: white 0, blue darker and red brighter \
          than the path tracer, full colour at {} % of its RMS luminance, black left out",
         report::significant(scale, 4),
         100.0 * args.error_scale

@@ -275,3 +275,40 @@ fn a_render_exr_as_reference_is_named_for_what_it_is_and_tracing_flags_are_warne
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn compare_prints_one_exposure_line_and_says_how_its_two_noise_figures_differ() {
+    // QA of issue #16: the exposure was printed twice, and `noise` and `reference noise`
+    // gave two figures with nothing to say that they divide by different luminances.
+    let dir = scratch_dir("pathtrace-compare-lines");
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--compare",
+            "--paths",
+            "4",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--max-area",
+            "20000",
+            "-o",
+            "c.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(err.matches("exposure scale").count(), 1, "{err}");
+    assert!(
+        err.contains("for both (auto, the radiosity solution's; the path-traced view's own"),
+        "{err}"
+    );
+    let text = stdout(&out);
+    assert!(
+        text.contains("where `noise` divides it by the mean luminance"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
