@@ -51,10 +51,11 @@ pub enum ValidateCommand {
 #[derive(Args)]
 pub struct Cie171Args {
     /// Write each case's scene and points file (name,x,y,z,nx,ny,nz) into DIR and stop
-    /// (the repository keeps them under validation/).
+    /// (the repository keeps them under validation/); with --case, those cases' only.
     #[arg(long, value_name = "DIR")]
     pub write: Option<PathBuf>,
-    /// Run only the cases whose id starts with this, e.g. 5.8 or 5.11.
+    /// Run (or, with --write, write) only the cases whose id starts with this, e.g. 5.8 or
+    /// 5.11.
     #[arg(long, value_name = "ID")]
     pub case: Option<String>,
     /// Only the verdict line (no table, no list of sources); the exit status still says
@@ -542,12 +543,7 @@ pub struct IlluminanceArgs {
     pub solve: SolveOptions,
     /// Calculation points: a CSV with the header name,x,y,z,nx,ny,nz (scene units; the
     /// normal is the direction the meter faces).
-    #[arg(
-        long,
-        value_name = "P.csv",
-        required_unless_present = "grid",
-        conflicts_with = "grid"
-    )]
+    #[arg(long, value_name = "P.csv", conflicts_with = "grid")]
     pub points: Option<PathBuf>,
     /// A rectangular grid instead: corners x0,y0,z0 and x1,y1,z1 (equal in at least one
     /// axis) and the spacing; points from the first corner every SPACING up to the second.
@@ -563,7 +559,7 @@ pub struct IlluminanceArgs {
     pub output: PathBuf,
     /// Also draw the grid's total illuminance as a PNG (coloured cells with their values and
     /// a scale bar in lx).
-    #[arg(long, value_name = "FILE.png", requires = "grid")]
+    #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
 }
 
@@ -623,9 +619,16 @@ pub struct BenchArgs {
     /// 0.01 unshot for progressive, 1e-6 changing power for hierarchical).
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
-    /// Image width and height in pixels.
-    #[arg(long, default_value_t = 512, value_name = "PIXELS")]
+    /// Image width and height in pixels (--width or --height sets one side).
+    #[arg(long, default_value_t = 512, value_name = "PIXELS",
+          value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub size: u32,
+    /// Image width in pixels, as for `render` (default: --size).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub width: Option<u32>,
+    /// Image height in pixels, as for `render` (default: --size).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub height: Option<u32>,
     /// Rays per pixel along each axis (as `render --supersample`).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub supersample: u32,

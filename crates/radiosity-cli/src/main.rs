@@ -63,6 +63,14 @@ enum Command {
     /// Export a scene for other tools: the solved mesh with the radiosity baked into vertex
     /// colours as glTF (-o out.glb or out.gltf), or the scene's surfaces as OBJ + MTL
     /// (-o out.obj).
+    // The camera flags are `render`'s, but export draws no image: --width and --height
+    // give the glTF camera's aspect ratio (QA of issue #16: they said "Image width").
+    #[command(
+        mut_arg("width", |a| a.help("glTF: the camera's width, in proportion to --height: \
+            the camera node's aspect ratio is WIDTH / HEIGHT (no image is drawn)")),
+        mut_arg("height", |a| a.help("glTF: the camera's height, in proportion to --width \
+            (see --width)"))
+    )]
     Export(ExportArgs),
     /// Open the walkthrough window and modeller on a solved scene (feature `viewer`).
     View(ViewArgs),

@@ -67,6 +67,28 @@ pub fn progress_line(
     elapsed: Duration,
     counting: Option<Counting>,
 ) -> String {
+    progress_line_of(stage, None, done, total, elapsed, counting)
+}
+
+/// What a stage's known total counts, where that is not plain (QA of issue #16: the path
+/// tracer's progress said "(24 of 64)" of nothing).
+pub fn stage_unit(stage: Stage) -> Option<&'static str> {
+    match stage {
+        Stage::PathTrace | Stage::Render => Some("rows"),
+        Stage::Illuminance => Some("points"),
+        _ => None,
+    }
+}
+
+/// [`progress_line`], its total followed by `unit` when given: "(24 of 64 rows)".
+pub fn progress_line_of(
+    stage: &str,
+    unit: Option<&str>,
+    done: u64,
+    total: u64,
+    elapsed: Duration,
+    counting: Option<Counting>,
+) -> String {
     let secs = elapsed.as_secs_f64();
     if total < 2 {
         return match counting {
@@ -94,8 +116,9 @@ pub fn progress_line(
     } else {
         String::new()
     };
+    let unit = unit.map_or(String::new(), |u| format!(" {u}"));
     format!(
-        "{stage}: {:.1} % ({done} of {total}) after {secs:.0} s{left}",
+        "{stage}: {:.1} % ({done} of {total}{unit}) after {secs:.0} s{left}",
         100.0 * fraction
     )
 }
@@ -238,8 +261,9 @@ impl Reporter {
                         return;
                     }
                     if timeout.timed_out() {
-                        let line = progress_line(
+                        let line = progress_line_of(
                             stage.name(),
+                            stage_unit(stage),
                             d.load(Ordering::Relaxed),
                             total,
                             started.elapsed(),
@@ -283,12 +307,17 @@ impl Progress for Reporter {
             return;
         }
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+        let template = match stage_unit(stage) {
+            Some(unit) => format!(
+                "{{prefix:>13}} [{{bar:40}}] {{percent:>3}}% ({{pos}} of {{len}} {unit}) \
+                 {{elapsed_precise}} eta {{eta}}"
+            ),
+            None => "{prefix:>13} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}".into(),
+        };
         bar.set_style(
-            ProgressStyle::with_template(
-                "{prefix:>13} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+            ProgressStyle::with_template(&template)
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
         );
         bar.set_prefix(stage.name());
         *self.bar.lock().unwrap() = Some(bar);
@@ -335,6 +364,18 @@ mod tests {
         assert_eq!(
             progress_line("solve", 17, 0, Duration::from_secs(10), None),
             "solve: 17 steps after 10 s"
+        );
+        // The path tracer's total is rows of the image (QA of issue #16).
+        assert_eq!(
+            progress_line_of(
+                Stage::PathTrace.name(),
+                stage_unit(Stage::PathTrace),
+                16,
+                64,
+                Duration::from_secs(10),
+                None
+            ),
+            "path trace: 25.0 % (16 of 64 rows) after 10 s, about 30 s left"
         );
     }
 

@@ -844,7 +844,13 @@ pub const BENCH_OTHER: &str = "contact refinement, the memory and work checks, t
                                and the renderer's own BVH built before the render";
 
 /// Prints the note (stderr, unless `quiet`) and the header of the `bench` table.
-pub fn bench_header(repeat: usize, size: u32, supersample: u32, solver: SolverKind, quiet: bool) {
+pub fn bench_header(
+    repeat: usize,
+    (width, height): (u32, u32),
+    supersample: u32,
+    solver: SolverKind,
+    quiet: bool,
+) {
     let solver_name = match solver {
         SolverKind::Auto => {
             "auto (dense Gauss-Seidel up to 20,000 elements when the matrix fits in half the \
@@ -857,9 +863,9 @@ pub fn bench_header(repeat: usize, size: u32, supersample: u32, solver: SolverKi
     };
     if !quiet {
         errln!(
-            "median of {} runs; times in ms; render {1}x{1} at {2}x{2} supersampling; solver {solver_name}; \
+            "median of {} runs; times in ms; render {1}x{2} at {3}x{3} supersampling; solver {solver_name}; \
              other: end to end less the stages listed ({BENCH_OTHER})",
-            repeat, size, supersample
+            repeat, width, height, supersample
         );
     }
     outln!(
@@ -975,8 +981,9 @@ pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
     outln!("max               {:.2} %", 100.0 * c.max);
     if let Some(noise) = c.reference_noise {
         outln!(
-            "reference noise   {:.2} % (the path tracer's RMS standard error: the rms a render \
-             equal to the true image would show)",
+            "reference noise   {:.2} % (the path tracer's RMS standard error over its RMS \
+             luminance, as the lines above, where `noise` divides it by the mean luminance: \
+             the rms a render equal to the true image would show)",
             100.0 * noise
         );
         outln!("rms less noise    {:.2} %", 100.0 * c.rms_less_noise());

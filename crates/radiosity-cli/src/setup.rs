@@ -818,7 +818,7 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     }
     if let Some(fov) = args.fov {
         if !(fov > 0.0 && fov < 180.0) {
-            bail!("--fov must be between 0 and 180 degrees, got {fov}");
+            bail!("--fov must be more than 0 and less than 180 degrees, got {fov}");
         }
         camera.fov_y_degrees = fov;
     }

@@ -114,12 +114,48 @@ pub enum ViewerError {
     /// No usable graphics adapter.
     #[error(transparent)]
     Gpu(#[from] gpu::GpuError),
+    /// DISPLAY is set but no X server answers there.
+    #[error(
+        "the display could not be opened: no X server answers at DISPLAY={display}. Start \
+         the X server, correct DISPLAY, or run headless under Xvfb: `apt-get install xvfb` \
+         then `xvfb-run -s \"-screen 0 1280x800x24\" radiosity view ...` (`radiosity \
+         render` makes images without any window)"
+    )]
+    DisplayUnreachable {
+        /// The value of DISPLAY (empty when unset).
+        display: String,
+    },
     /// The window system or renderer failed.
     #[error("the window could not be opened: {0}. Tried winit (X11) with wgpu; without a GPU install a Vulkan software driver (`apt-get install mesa-vulkan-drivers`) or run with WGPU_BACKEND=gl")]
     Window(String),
     /// The solve or the screenshot failed while the window was open.
     #[error("{0}")]
     Failed(String),
+}
+
+/// What eframe's failure to open the window means: no X server at DISPLAY is said in
+/// those words (QA of issue #16: it was answered with GPU advice and a path into the
+/// cargo registry); otherwise winit's source location ("os error at FILE:LINE: ") is left
+/// out of the message.
+fn window_error(e: eframe::Error) -> ViewerError {
+    let text = e.to_string();
+    if text.contains("open connection to X server") {
+        return ViewerError::DisplayUnreachable {
+            display: std::env::var("DISPLAY").unwrap_or_default(),
+        };
+    }
+    ViewerError::Window(strip_source_location(&text))
+}
+
+/// "os error at /path/file.rs:12: message" -> "os error: message".
+fn strip_source_location(text: &str) -> String {
+    if let Some(rest) = text.find("os error at ").map(|i| &text[i + 12..]) {
+        if let Some(colon) = rest.find(": ") {
+            let start = text.len() - rest.len() - 12;
+            return format!("{}os error: {}", &text[..start], &rest[colon + 2..]);
+        }
+    }
+    text.to_string()
 }
 
 /// Opens the window and runs until it is closed; returns notes to print (where the
@@ -151,10 +187,43 @@ pub fn run(options: ViewerOptions) -> Result<Vec<String>, ViewerError> {
         native,
         Box::new(move |cc| Ok(Box::new(app::ViewerApp::new(cc, options, for_app)))),
     )
-    .map_err(|e| ViewerError::Window(e.to_string()))?;
+    .map_err(window_error)?;
     let outcome = std::mem::take(&mut *outcome.lock().unwrap());
     match outcome.error {
         Some(e) => Err(ViewerError::Failed(e)),
         None => Ok(outcome.notes),
+    }
+}
+
+#[cfg(test)]
+mod window_error_tests {
+    use super::*;
+
+    #[test]
+    fn winit_source_locations_are_left_out() {
+        assert_eq!(
+            strip_source_location(
+                "winit EventLoopError: os error at /root/.cargo/registry/src/x/winit-0.30.13/\
+                 src/platform_impl/linux/mod.rs:788: something failed"
+            ),
+            "winit EventLoopError: os error: something failed"
+        );
+        assert_eq!(strip_source_location("no location"), "no location");
+    }
+
+    #[test]
+    fn no_x_server_names_display_and_xvfb() {
+        let text = ViewerError::DisplayUnreachable {
+            display: ":99".into(),
+        }
+        .to_string();
+        assert!(
+            text.contains("DISPLAY=:99") && text.contains("xvfb-run"),
+            "{text}"
+        );
+        assert!(
+            !text.contains("Vulkan") && !text.contains("registry"),
+            "{text}"
+        );
     }
 }

@@ -19,9 +19,6 @@ pub fn run(args: BenchArgs) -> Result<()> {
     if args.repeat == 0 {
         bail!("--repeat must be at least 1");
     }
-    if args.size == 0 || args.size > 10_000 {
-        bail!("--size must be between 1 and 10000");
-    }
     if args.supersample == 0 || args.supersample > 16 {
         bail!("--supersample must be between 1 and 16");
     }
@@ -51,7 +48,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     }
     report::bench_header(
         args.repeat,
-        args.size,
+        image_size(&args),
         args.supersample,
         args.solver.0,
         args.quiet,
@@ -162,7 +159,8 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         (None, SolutionReport::Hierarchical(r)) => r.rays,
         (None, _) => 0,
     };
-    let camera = Camera::for_scene(&prepared.scene, args.size, args.size);
+    let (width, height) = image_size(args);
+    let camera = Camera::for_scene(&prepared.scene, width, height);
     let scale = Exposure::Auto.scale(&prepared.scene, &solution.mesh, solution.element_rgb());
     let image = shade_and_render(
         &prepared,
@@ -204,4 +202,13 @@ fn median(mut values: Vec<f64>) -> f64 {
     } else {
         0.5 * (values[n / 2 - 1] + values[n / 2])
     }
+}
+
+/// The rendered image's width and height: `--width` and `--height`, each `--size` when
+/// not given (checked by clap: 1 to 10,000 pixels, worded as for `render --width`).
+fn image_size(args: &BenchArgs) -> (u32, u32) {
+    (
+        args.width.unwrap_or(args.size),
+        args.height.unwrap_or(args.size),
+    )
 }

@@ -151,6 +151,8 @@ fn export_obj(
         ("--look-at", c.look_at.is_some()),
         ("--up", c.up.is_some()),
         ("--fov", c.fov.is_some()),
+        ("--width", c.width != 512),
+        ("--height", c.height != 512),
     ];
     let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
     if !ignored.is_empty() {

@@ -14,6 +14,16 @@ const MAX_GRID_POINTS: usize = 1_000_000;
 
 pub fn run(args: IlluminanceArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
+    // Checked here rather than by clap, whose messages named only --points when neither
+    // was given and asked for --grid and --normal beside --points for --png (QA of issue
+    // #16).
+    if args.png.is_some() && args.grid.is_none() {
+        bail!(
+            "--png draws the cells of a --grid; --points P.csv gives no grid, so drop --png \
+             (the CSV holds every point's lux) or use --grid X0,Y0,Z0:X1,Y1,Z1:SPACING \
+             --normal NX,NY,NZ instead of --points"
+        );
+    }
     let inputs = [
         ("scene file", args.scene.scene.as_deref()),
         ("points file", args.points.as_deref()),
@@ -48,7 +58,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
             };
             (points, Some(dims))
         }
-        (None, None) => bail!("give --points P.csv or --grid x0,y0,z0:x1,y1,z1:SPACING"),
+        (None, None) => bail!(
+            "give the points to compute: --points P.csv, or a grid with --grid \
+             X0,Y0,Z0:X1,Y1,Z1:SPACING --normal NX,NY,NZ"
+        ),
     };
     // The points are in the scene file's units, so --scale applies to them as to the scene
     // (a room in millimetres with --scale 0.001, points in millimetres: lux as in metres);
@@ -135,9 +148,12 @@ fn grid_refusal(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> String {
     match smallest_spacing(a, b, spacing, MAX_GRID_POINTS) {
         Some(wider) => format!(
             "{head} makes {count:.0} points, more than the {MAX_GRID_POINTS} one run \
-             computes; a spacing of {wider} or more fits"
+             computes, --no-work-limit or not; a spacing of {wider} or more fits (or split \
+             the grid into several runs)"
         ),
-        None => format!("{head} makes {count:.0} points, more than one run computes"),
+        None => format!(
+            "{head} makes {count:.0} points, more than one run computes, --no-work-limit or not"
+        ),
     }
 }
 

@@ -38,6 +38,30 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             args.paths,
         )?;
     }
+    if let Some(path) = &args.reference {
+        // The tracing flags do nothing when the view is read back (QA of issue #16:
+        // `--paths` was dropped without a word). Printed even with --quiet.
+        let default = PathTraceSettings::DEFAULT;
+        let given = [
+            ("--paths", args.paths != default.samples_per_pixel),
+            ("--path-seed", args.path_seed != default.seed),
+            ("--max-bounces", args.max_bounces != default.max_bounces),
+            (
+                "--roulette-after",
+                args.roulette_after != default.roulette_after_bounces,
+            ),
+            ("--no-light-sampling", args.no_light_sampling),
+        ];
+        let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+        if !ignored.is_empty() {
+            errln!(
+                "warning: {} ignored with --reference: the path-traced view is read from {} \
+                 as it was traced (its paths a pixel and seed are noted when it is read)",
+                ignored.join(", "),
+                path.display()
+            );
+        }
+    }
     if args.compare {
         setup::check_render_budget(
             &args.camera,
@@ -271,16 +295,16 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         &error_png,
         &reporter,
     )?;
-    if args.tone.exposure == Exposure::Auto {
-        reporter.note(&format!(
-            "exposure scale {} (auto, the radiosity solution's); the path-traced view's \
-             own auto exposure would be {}",
-            report::significant(scale, 4),
+    // One line for the exposure (QA of issue #16: it was printed twice).
+    let whose = match args.tone.exposure {
+        Exposure::Auto => format!(
+            " (auto, the radiosity solution's; the path-traced view's own would be {})",
             report::significant(view.auto_exposure_scale(), 4)
-        ));
-    }
+        ),
+        Exposure::Fixed(_) => String::new(),
+    };
     reporter.note(&format!(
-        "exposure scale {} for both; error map: white 0, blue darker and red brighter \
+        "exposure scale {} for both{whose}; error map: white 0, blue darker and red brighter \
          than the path tracer, full colour at {} % of its RMS luminance, black left out",
         report::significant(scale, 4),
         100.0 * args.error_scale

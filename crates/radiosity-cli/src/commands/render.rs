@@ -96,6 +96,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
         // Printed even with --quiet: the run does not do what the flags say.
         errln!("warning: --snapshot-every ignored: no --snapshots DIR to write snapshots to");
     }
+    let wireframe = settings.shading == render::Shading::Wireframe;
+    if wireframe && args.tone.exposure != radiosity::shade::Exposure::Auto {
+        // Printed even with --quiet (QA of issue #16): the lines are drawn white whatever
+        // the exposure.
+        errln!("warning: --exposure ignored with --shading wireframe: its lines are drawn white");
+    }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     if args.snapshots.is_some() && !matches!(solver, radiosity::solve::Solver::Progressive(_)) {
         bail!(
@@ -218,13 +224,17 @@ pub fn run(args: RenderArgs) -> Result<()> {
         render::write_png(&image, &output)
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
-    reporter.note(&exposure_note(
-        &prepared,
-        &solution.mesh,
-        solution.element_rgb(),
-        exposure,
-        scale,
-    ));
+    // A wireframe's lines are not scaled by the exposure (QA of issue #16: its note was
+    // printed for them).
+    if !wireframe {
+        reporter.note(&exposure_note(
+            &prepared,
+            &solution.mesh,
+            solution.element_rgb(),
+            exposure,
+            scale,
+        ));
+    }
     reporter.note(&format!(
         "wrote {} ({} x {})",
         output.display(),

@@ -11,12 +11,6 @@ use crate::args::Cie171Args;
 
 /// Runs (or, with `--write`, writes) the CIE 171 cases.
 pub fn cie171(args: Cie171Args) -> Result<()> {
-    if let Some(dir) = &args.write {
-        let written = cie171::write_files(dir)
-            .with_context(|| format!("cannot write the validation files into {}", dir.display()))?;
-        println!("wrote {} files into {}", written.len(), dir.display());
-        return Ok(());
-    }
     let cases: Vec<Case> = cie171::cases()
         .into_iter()
         .filter(|c| {
@@ -31,6 +25,14 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
              5.8 (one per reflectance), 5.9 and 5.11",
             args.case.unwrap_or_default()
         );
+    }
+    // --write with --case writes only those cases' files (QA of issue #16: --case was
+    // ignored and every case written).
+    if let Some(dir) = &args.write {
+        let written = cie171::write_case_files(dir, &cases)
+            .with_context(|| format!("cannot write the validation files into {}", dir.display()))?;
+        println!("wrote {} files into {}", written.len(), dir.display());
+        return Ok(());
     }
     let dir = tempfile_dir()?;
     let quiet = args.quiet;

@@ -19,6 +19,21 @@ pub fn run(args: ViewArgs) -> Result<()> {
     // where XDG_RUNTIME_DIR is missing (root under Xvfb).
     crate::runtime_dir::ensure_runtime_dir();
     if args.bench {
+        // Refused before anything runs (QA of issue #16: 0 elements ran the frame timing
+        // and then failed with "MAX_PATCH_AREA ... got inf"; 0 frames printed an inf row).
+        if args.bench_elements.contains(&0) {
+            bail!(
+                "--bench-elements must be element counts of at least 1, got {}",
+                args.bench_elements
+                    .iter()
+                    .map(|n| n.to_string())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            );
+        }
+        if args.bench_frames == 0 {
+            bail!("--bench-frames must be at least 1 (the frames timed per scene)");
+        }
         // Progress on stderr, the tables once on stdout.
         let table = radiosity_viewer::bench::run_all(
             &args.bench_elements,

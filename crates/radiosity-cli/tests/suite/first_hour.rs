@@ -718,7 +718,7 @@ fn a_negative_number_is_taken_as_the_flags_value() {
         ),
         (
             vec!["render", "--fov", "-45", "-o", "x.png"],
-            "--fov must be between 0 and 180 degrees, got -45",
+            "--fov must be more than 0 and less than 180 degrees, got -45",
         ),
         (
             vec!["render", "--solver", "hierarchical", "--epsilon", "-0.5"],
@@ -1478,6 +1478,79 @@ fn help_texts_give_the_ranges_and_units_the_commands_hold_to() {
     assert!(
         help.contains("236,916 points in about 110 s of CPU"),
         "{help}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bench_takes_width_and_height_as_render_does_and_keeps_size() {
+    // QA of issue #16: bench had only --size, and its zero check was worded unlike the
+    // other commands' --width.
+    let dir = scratch_dir("bench-size");
+    let base = ["bench", "--max-area", "20000", "--repeat", "1"];
+    let run = |extra: &[&str]| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        radiosity(&args, &dir)
+    };
+    let out = run(&["--size", "8", "--width", "12"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("render 12x8 at"), "{}", stderr(&out));
+    let out = run(&["--size", "8"]);
+    assert!(stderr(&out).contains("render 8x8 at"), "{}", stderr(&out));
+    for flag in ["--size", "--width", "--height"] {
+        let out = run(&[flag, "0"]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains(&format!("'{flag} <")) && err.contains("0 is not in 1..=10000"),
+            "{err}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn export_help_wireframe_exposure_and_fov_say_what_is_true() {
+    // QA of issue #16: export's --width/--height said "Image width"; a wireframe render
+    // printed an exposure line though its lines are white whatever the exposure; the
+    // --fov message said "between 0 and 180" with both ends excluded.
+    let dir = scratch_dir("export-help-wireframe");
+    let help = crate::fixtures::stdout(&radiosity(&["export", "--help"], &dir));
+    assert!(
+        help.contains("aspect ratio is WIDTH / HEIGHT") && !help.contains("Image width"),
+        "{help}"
+    );
+    let out = radiosity(
+        &[
+            "render",
+            "--max-area",
+            "20000",
+            "--shading",
+            "wireframe",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--exposure",
+            "2",
+            "-o",
+            "w.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("exposure scale"), "{err}");
+    assert!(
+        err.contains("warning: --exposure ignored with --shading wireframe"),
+        "{err}"
+    );
+    let out = radiosity(&["render", "--fov", "180", "-o", "f.png"], &dir);
+    assert!(
+        stderr(&out).contains("more than 0 and less than 180 degrees, got 180"),
+        "{}",
+        stderr(&out)
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -378,3 +378,38 @@ fn illuminance_refuses_a_grid_too_large_and_work_of_hours_saying_what_fits() {
     assert!(!dir.join("g.csv").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn illuminance_usage_errors_name_both_ways_to_give_points() {
+    // QA of issue #16: neither --points nor --grid named only --points; --png with
+    // --points asked for --grid and --normal beside --points.
+    let dir = scratch_dir("illuminance-usage");
+    let out = radiosity(&["illuminance", "-o", "o.csv"], &dir);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--points P.csv") && err.contains("--grid") && err.contains("--normal"),
+        "{err}"
+    );
+    std::fs::write(dir.join("p.csv"), "name,x,y,z,nx,ny,nz\na,1,1,1,0,0,1\n").unwrap();
+    let out = radiosity(
+        &[
+            "illuminance",
+            "--points",
+            "p.csv",
+            "--png",
+            "g.png",
+            "-o",
+            "o.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--png draws the cells of a --grid") && !err.contains("required"),
+        "{err}"
+    );
+    assert!(!dir.join("o.csv").exists() && !dir.join("g.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -224,3 +224,91 @@ fn bad_flags_exit_2_with_what_was_expected() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_render_exr_as_reference_is_named_for_what_it_is_and_tracing_flags_are_warned() {
+    // QA of issue #16: a render's EXR given to --reference was first refused for its
+    // size, then its camera, before the real cause; --paths with --reference was ignored
+    // without a word.
+    let dir = scratch_dir("pathtrace-render-exr");
+    let r = radiosity(
+        &[
+            "render",
+            "--width",
+            "6",
+            "--height",
+            "5",
+            "--max-area",
+            "20000",
+            "-o",
+            "r.exr",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(r.status.success(), "{}", stderr(&r));
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--reference",
+            "r.exr",
+            "--paths",
+            "64",
+            "--path-seed",
+            "3",
+            "--fov",
+            "50",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("r.exr is an OpenEXR image but not a saved path-traced view")
+            && !err.contains("holds a")
+            && !err.contains("another camera"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: --paths, --path-seed ignored with --reference"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_prints_one_exposure_line_and_says_how_its_two_noise_figures_differ() {
+    // QA of issue #16: the exposure was printed twice, and `noise` and `reference noise`
+    // gave two figures with nothing to say that they divide by different luminances.
+    let dir = scratch_dir("pathtrace-compare-lines");
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--compare",
+            "--paths",
+            "4",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--max-area",
+            "20000",
+            "-o",
+            "c.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(err.matches("exposure scale").count(), 1, "{err}");
+    assert!(
+        err.contains("for both (auto, the radiosity solution's; the path-traced view's own"),
+        "{err}"
+    );
+    let text = stdout(&out);
+    assert!(
+        text.contains("where `noise` divides it by the mean luminance"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

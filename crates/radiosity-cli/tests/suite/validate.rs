@@ -63,3 +63,30 @@ fn validate_cie171_says_where_each_reference_comes_from() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn validate_cie171_write_with_case_writes_only_that_case() {
+    // QA of issue #16: --case was ignored by --write, which wrote every case.
+    let dir = scratch_dir("validate-write-case");
+    let out = radiosity(
+        &["validate", "cie171", "--write", "cases", "--case", "5.11"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("wrote 2 files"), "{}", stdout(&out));
+    let mut names: Vec<String> = std::fs::read_dir(dir.join("cases"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 2, "{names:?}");
+    assert!(names[0].ends_with(".points.csv") && names[1].ends_with(".scene"));
+    let out = radiosity(
+        &["validate", "cie171", "--write", "more", "--case", "9.9"],
+        &dir,
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("\"9.9\""), "{}", stderr(&out));
+    assert!(!dir.join("more").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

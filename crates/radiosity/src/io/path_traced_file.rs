@@ -331,6 +331,22 @@ pub fn read_path_traced(
         _ => Err(missing(format!("text attribute {name}"))),
     };
 
+    // That it is a saved path-traced view at all, first: an OpenEXR image of another kind
+    // (a `render -o out.exr`, which carries the same camera attributes) is told so rather
+    // than that its size or camera differs (QA of issue #16).
+    let markers = [SAMPLES, MAX_BOUNCES, ROULETTE, NEXT_EVENT, SEED, SCENE];
+    for name in markers
+        .into_iter()
+        .chain(camera_attributes(camera).map(|(name, _)| name))
+    {
+        attribute(name)?;
+    }
+    for name in BANDS.into_iter().chain(SE_BANDS).chain([SE_Y, EMITTER]) {
+        if !layer.channel_data.list.iter().any(|c| c.name == *name) {
+            return Err(missing(format!("channel {name}")));
+        }
+    }
+
     // What the file is of, checked before its pixels are read.
     let (w, h) = (layer.size.width(), layer.size.height());
     let expected = (camera.width as usize, camera.height as usize);
@@ -565,7 +581,29 @@ mod tests {
             matches!(err, PathTracedFileError::NotPathTraced { .. }),
             "{err}"
         );
-        assert!(err.to_string().contains("radiosity.eye.x"), "{err}");
+        assert!(err.to_string().contains(SAMPLES), "{err}");
+        std::fs::remove_file(&path).unwrap();
+    }
+
+    #[test]
+    fn a_render_exr_is_not_a_saved_view_whatever_its_size_or_camera() {
+        // `render -o out.exr` carries the camera attributes but is another format: that is
+        // said first, not that its size or camera differs (QA of issue #16).
+        let (scene, camera, _, _) = traced();
+        let path = scratch("render.exr");
+        let other = Camera {
+            width: 4,
+            height: 3,
+            fov_y_degrees: camera.fov_y_degrees + 5.0,
+            ..camera
+        };
+        crate::io::exr::write_radiance(&path, 4, 3, &[[1.0; 3]; 12], &other, "test", "metres")
+            .unwrap();
+        let err = read_path_traced(&path, &camera, &scene).unwrap_err();
+        assert!(
+            matches!(err, PathTracedFileError::NotPathTraced { .. }),
+            "{err}"
+        );
         std::fs::remove_file(&path).unwrap();
     }
 

@@ -855,9 +855,18 @@ pub struct ComputeError(pub String);
 /// Writes every case's scene and points file into `dir` (`<stem>.scene`,
 /// `<stem>.points.csv`), returning the paths written.
 pub fn write_files(dir: &std::path::Path) -> std::io::Result<Vec<std::path::PathBuf>> {
+    write_case_files(dir, &cases())
+}
+
+/// Writes the scene and points file of each of `cases` into `dir`, as [`write_files`]
+/// does for all of them, returning the paths written.
+pub fn write_case_files(
+    dir: &std::path::Path,
+    cases: &[Case],
+) -> std::io::Result<Vec<std::path::PathBuf>> {
     std::fs::create_dir_all(dir)?;
     let mut written = Vec::new();
-    for case in cases() {
+    for case in cases {
         for (name, text) in [
             (format!("{}.scene", case.stem), case.scene.clone()),
             (format!("{}.points.csv", case.stem), case.points_csv()),
