@@ -70,7 +70,7 @@ pub fn solve_scene(
     if solver.needs_matrix() {
         match form_factors {
             FormFactors::File(path) => {
-                reporter.note(&format!("form factors read from {}", path.display()))
+                reporter.note(&format!("reading form factors from {}", path.display()))
             }
             _ => reporter.note(&format!(
                 "form factors by {}; occlusion: {}",
