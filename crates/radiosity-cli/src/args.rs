@@ -413,7 +413,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub false_colour: bool,
     /// With --false-colour: the illuminance at the top of the scale, in lux (default: the
-    /// largest on any element); brighter surfaces take the top colour.
+    /// largest on any element, rounded up to 4-8 round steps: 150.3 gives 160); brighter
+    /// surfaces take the top colour.
     #[arg(long, value_name = "LUX", requires = "false_colour")]
     pub lux_max: Option<f64>,
 }

@@ -336,10 +336,10 @@ fn max_area_origin(args: &SceneArgs) -> String {
 /// The note on the scene every command prints: surfaces, elements and mesh settings.
 pub fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
     reporter.note(&format!(
-        "{}: {} surfaces, {} elements (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
+        "{}: {}, {} (MAX_PATCH_AREA {}, INTEGRAL_STEPS {})",
         stem,
-        prepared.scene.surfaces.len(),
-        prepared.mesh.len(),
+        crate::report::count(prepared.scene.surfaces.len() as u64, "surface"),
+        crate::report::count(prepared.mesh.len() as u64, "element"),
         prepared.settings.max_patch_area,
         prepared.settings.integral_steps
     ));
@@ -669,6 +669,17 @@ pub fn ray_settings(rays: &RayArgs, shading_arg: ShadingArg) -> RenderSettings {
              --supersample above 2 (given {n}) and smooth or flat shading"
         );
     }
+    if rays.direct_light != DirectLightArg::Gather && shading_arg != ShadingArg::Smooth {
+        // QA of issue #16: --direct-light mesh with --shading flat ran without a word.
+        errln!(
+            "warning: --direct-light ignored: it chooses smooth shading's direct light, and \
+             --shading {} draws each element's own radiosity",
+            match shading_arg {
+                ShadingArg::Flat => "flat",
+                _ => "wireframe",
+            }
+        );
+    }
     RenderSettings {
         shading: shading(shading_arg),
         supersample: rays.supersample,
@@ -878,11 +889,28 @@ pub fn adapt(
     solver: &Solver,
 ) -> Result<Option<AdaptSettings>> {
     let rounds = options.adapt_rounds.unwrap_or(DEFAULT_ADAPT_ROUNDS);
+    // The tuning flags given (a value other than the default: clap does not say whether
+    // the default was typed).
+    let mut tuning = Vec::new();
+    if options.adapt_contrast != radiosity::mesh::DEFAULT_CONTRAST {
+        tuning.push("--adapt-contrast");
+    }
+    if options.adapt_max_elements.is_some() {
+        tuning.push("--adapt-max-elements");
+    }
+    // Printed even with --quiet: the run does not do what the flags say.
     if !solver.needs_matrix() && options.adapt_rounds.is_some_and(|r| r > 0) {
-        // Printed even with --quiet: the run does not do what the flags say.
         errln!(
-            "warning: --adapt-rounds ignored: adaptive subdivision refines the dense solvers' \
-             mesh (choose --solver gauss-seidel or lu)"
+            "warning: --adapt-rounds{} ignored: adaptive subdivision refines the dense \
+             solvers' mesh (choose --solver gauss-seidel or lu)",
+            tuning.iter().map(|f| format!(", {f}")).collect::<String>()
+        );
+    } else if rounds == 0 && !tuning.is_empty() {
+        // QA of issue #16: --adapt-contrast alone ran without a word.
+        errln!(
+            "warning: {} ignored: adaptive subdivision is off (it takes --adapt-rounds N, N \
+             above 0)",
+            tuning.join(" and ")
         );
     }
     if !solver.needs_matrix() || rounds == 0 {

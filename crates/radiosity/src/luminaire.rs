@@ -23,7 +23,7 @@
 //!
 //! # Angles and the azimuth convention
 //!
-//! theta is the angle from the axis (`AIM`, default 0 0 -1: straight down), the photometric
+//! theta is the angle from the axis (`AIM`, default 0 0 -1: -z, straight down in a z-up scene), the photometric
 //! axis of type C photometry (theta = 0 is nadir for a downlight). The azimuth phi (the C
 //! plane) is measured round the axis from a reference direction `u` towards `v = aim x u`,
 //! counter-clockwise seen from behind the light looking along the axis... for the default
@@ -41,7 +41,8 @@ use glam::DVec3;
 use crate::light::Rgb;
 use crate::photometry::ies::IesPhotometry;
 
-/// The default `AIM`: straight down.
+/// The default `AIM`: -z (straight down in a z-up scene; horizontal in a y-up one such as
+/// the Cornell box, whose downlights need `AIM 0 -1 0`).
 pub const DEFAULT_AIM: DVec3 = DVec3::new(0.0, 0.0, -1.0);
 
 /// The shape of a luminaire's intensity distribution.

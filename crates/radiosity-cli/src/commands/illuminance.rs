@@ -102,9 +102,9 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     });
     write(&args, &points, &lux)?;
     reporter.note(&format!(
-        "wrote {} ({} points; {}; the scene's unit: {})",
+        "wrote {} ({}; {}; the scene's unit: {})",
         args.output.display(),
-        points.len(),
+        crate::report::count(points.len() as u64, "point"),
         crate::setup::LUX_NOTE,
         crate::setup::scene_unit()
     ));

@@ -70,7 +70,7 @@ pub fn solve_scene(
     if solver.needs_matrix() {
         match form_factors {
             FormFactors::File(path) => {
-                reporter.note(&format!("form factors read from {}", path.display()))
+                reporter.note(&format!("reading form factors from {}", path.display()))
             }
             _ => reporter.note(&format!(
                 "form factors by {}; occlusion: {}",
@@ -209,6 +209,17 @@ pub fn exposure_note(
         return format!("exposure scale {scale}");
     }
     let brightest = lit_radiosity_top_mean(&prepared.scene, mesh, element_b, 0.0).unwrap_or(0.0);
+    let white = lit_radiosity_top_mean(&prepared.scene, mesh, element_b, AUTO_EXPOSURE_TOP_AREA);
+    if !white.is_some_and(|w| w > 0.0 && (1.0 / w).is_finite()) {
+        // Exposure::scale's fallback (QA of issue #16: "auto 1.0000 is the mean" for a scene
+        // with no light, where 1 is no mean at all).
+        return format!(
+            "exposure scale {} (auto: nothing is lit, the brightest {} % of the non-emitting \
+             area has radiosity 0, so there is nothing to expose for; scale 1 is the fallback)",
+            crate::report::significant(scale, 4),
+            100.0 * AUTO_EXPOSURE_TOP_AREA,
+        );
+    }
     format!(
         "exposure scale {} (auto: {:.4}, the mean radiosity of the brightest {} % of \
          the non-emitting area, is white; the brightest non-emitting element is {:.4}, \

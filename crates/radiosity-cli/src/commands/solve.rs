@@ -64,10 +64,10 @@ pub fn run(args: SolveArgs) -> Result<()> {
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
     reporter.note(&format!(
-        "wrote {} ({} elements; radiosity in the scene's emission units, W/m^2 or lm/m^2 \
+        "wrote {} ({}; radiosity in the scene's emission units, W/m^2 or lm/m^2 \
          as the scene gives E; area and centroids in {})",
         output.display(),
-        solution.mesh.len(),
+        crate::report::count(solution.mesh.len() as u64, "element"),
         crate::setup::scene_unit()
     ));
     if let Some(report) = &args.report {
@@ -82,9 +82,9 @@ pub fn run(args: SolveArgs) -> Result<()> {
         })
         .with_context(|| format!("cannot write {}", report.display()))?;
         reporter.note(&format!(
-            "wrote {} ({} surfaces; radiosity in the scene's emission units; lengths in {})",
+            "wrote {} ({}; radiosity in the scene's emission units; lengths in {})",
             report.display(),
-            prepared.scene.surfaces.len(),
+            crate::report::count(prepared.scene.surfaces.len() as u64, "surface"),
             crate::setup::scene_unit()
         ));
     }

@@ -103,9 +103,10 @@ fn solve_writes_csv_with_exact_header_and_one_row_per_element() {
         .and_then(|n| n.parse().ok())
         .expect("check prints the element count");
     assert_eq!(lines.count(), elements);
-    // And the length unit (a .scene file states none).
+    // And the length unit (a .scene file states none: metres, as the README says).
     assert!(
-        text.lines().any(|l| l == "unit              scene units"),
+        text.lines().any(|l| l
+            == "unit              metres (a .scene file states no unit; metres assumed)"),
         "{text}"
     );
 

@@ -1354,14 +1354,8 @@ fn check_gives_plain_numbers_with_units_and_lists_that_add_up() {
         let figures = line.split("relative error").next().unwrap();
         assert!(!figures.contains("e0") && !figures.contains("e1"), "{line}");
     }
-    assert!(
-        text.contains("square scene units (of the grid's elements)"),
-        "{text}"
-    );
-    assert!(
-        text.contains(": gap 0.005 scene units, covering 3.08 square scene units"),
-        "{text}"
-    );
+    assert!(text.contains(" m^2 (of the grid's elements)"), "{text}");
+    assert!(text.contains(": gap 0.005 m, covering 3.08 m^2"), "{text}");
     // The lists: the largest five of how many, all of them together, and that total less
     // the part counted twice is the energy line's escaped share (to the 0.01 % printed).
     let escaped_line = text.lines().find(|l| l.starts_with("energy (R)")).unwrap();

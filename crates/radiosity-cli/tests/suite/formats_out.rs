@@ -31,6 +31,10 @@ SCENEEND
 pub const FURNACE_B: [f64; 3] = [2.0, 1.0, 1.0];
 
 /// The camera flags of a view from inside the furnace.
+/// The length unit of a `.scene` file as the runs report it: the format states none, and the
+/// README says its lengths are metres.
+const SCENE_UNIT: &str = "metres (a .scene file states no unit; metres assumed)";
+
 const INSIDE: [&str; 10] = [
     "--width",
     "12",
@@ -87,10 +91,10 @@ fn render_and_pathtrace_write_linear_radiance_exr() {
         assert_furnace_radiance(&dir.join("furnace.exr"), (12, 10), 1e-3);
     }
     // The units are attributes (issue #13): the radiance's, and the scene's length unit
-    // as the reader gives it (a .scene file states none).
+    // as the reader gives it (a .scene file states none: metres assumed).
     let attributes = radiosity::io::exr::text_attributes(&dir.join("furnace.exr")).unwrap();
     assert_eq!(attributes["radiosity.unit"], radiosity::io::exr::UNIT);
-    assert_eq!(attributes["radiosity.lengthUnit"], "scene units");
+    assert_eq!(attributes["radiosity.lengthUnit"], SCENE_UNIT);
     // The path tracer: unbiased but noisy per pixel (the roulette weights of blue's long
     // paths, rho 0.75, spread a pixel's paths by tens of per cent), so the image mean over
     // 120 pixels x 256 paths is what is tested (the image is the same for the fixed seed;
@@ -105,7 +109,7 @@ fn render_and_pathtrace_write_linear_radiance_exr() {
     assert_eq!((w, h), (12, 10));
     let attributes = radiosity::io::exr::text_attributes(&dir.join("pt.exr")).unwrap();
     assert_eq!(attributes["radiosity.unit"], radiosity::io::exr::UNIT);
-    assert_eq!(attributes["radiosity.lengthUnit"], "scene units");
+    assert_eq!(attributes["radiosity.lengthUnit"], SCENE_UNIT);
     for k in 0..3 {
         let mean = pixels.iter().map(|p| p[k] as f64).sum::<f64>() / pixels.len() as f64;
         let expect = FURNACE_B[k] / PI;
@@ -201,9 +205,12 @@ fn solve_report_has_one_row_per_surface_at_the_closed_form() {
             lines[0].starts_with("# radiosity in the scene's emission units"),
             "{text}"
         );
-        // The length unit, as the reader gives it (a .scene file states none).
+        // The length unit, as the reader gives it (a .scene file states none), and the
+        // area in its square (QA of issue #16: "scene units ... being scene units").
         assert!(
-            lines[0].contains("the scene's unit of length being scene units;"),
+            lines[0].contains(&format!(
+                "area in the square of the scene's unit of length, {SCENE_UNIT};"
+            )),
             "{text}"
         );
         assert_eq!(
@@ -418,11 +425,8 @@ fn exported_glb_checks_as_the_scene_it_came_from() {
     };
     let want = lines(&room);
     assert_eq!(want.len(), 4, "{want:?}");
-    // The same figures; the unit differs: a .scene file's is "scene units", glTF's metres.
-    let got: Vec<String> = lines("room.glb")
-        .iter()
-        .map(|l| l.replace(" m^2 ", " square scene units "))
-        .collect();
+    // The same figures in the same unit: a .scene file's lengths are metres, as glTF's.
+    let got: Vec<String> = lines("room.glb");
     assert_eq!(got, want);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -148,7 +148,8 @@ pub enum FormFactorFileError {
     #[error(
         "form-factor file {path} was computed for a different mesh: it holds {elements} \
          elements, made with method `{method}` (fingerprint {found:016x}, this mesh is \
-         {expected:016x}; the file records no MAX_PATCH_AREA)"
+         {expected:016x}; the file records only the element count and method, not the scene or \
+         the MAX_PATCH_AREA it was made for)"
     )]
     Stale {
         /// The file.

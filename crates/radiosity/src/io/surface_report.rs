@@ -34,7 +34,7 @@ pub const HEADER: &str =
 pub fn unit_comment(length_unit: &str) -> String {
     format!(
         "# radiosity in the scene's emission units (W/m^2 or lm/m^2, as the scene gives E); \
-         area in scene units^2, the scene's unit of length being {length_unit}; mean over \
+         area in the square of the scene's unit of length, {length_unit}; mean over \
          each surface's elements weighted by area; luminance with Rec. 709 weights"
     )
 }

@@ -179,13 +179,22 @@ impl Plan {
     }
 }
 
+/// `x` rounded up to a whole number, but a whole number exceeded only by rounding (by
+/// 1e-12 of it) rounded down to it: the area ratio of a 5 x 3 wall and a MAX_PATCH_AREA of
+/// 0.25 is 60, and scaled by 0.001 (`--scale`: 0.005 x 0.003 against 0.25 x 0.001^2) it
+/// can come out as 60.00000000000001, which must not make a 61st element (QA of issue #16:
+/// the unit changed the mesh). The cells are checked against the area with the same slack.
+fn ceil_relative(x: f64) -> f64 {
+    (x * (1.0 - 1e-12)).ceil()
+}
+
 /// Plans the cut of one polygon so that no element exceeds `max_area`, or returns the
 /// (estimated) element count when that would exceed [`MAX_ELEMENTS`] on its own, before any
 /// integer could overflow or any loop run long.
 fn plan(vertices: &[DVec3], max_area: f64) -> Result<Plan, f64> {
     let area = geometry::polygon_area(vertices);
     // Area alone needs this many elements; the cut below stays within a small factor of it.
-    let target = (area / max_area).ceil().max(1.0);
+    let target = ceil_relative(area / max_area).max(1.0);
     if target > MAX_ELEMENTS as f64 {
         return Err(target);
     }
@@ -202,7 +211,10 @@ fn plan(vertices: &[DVec3], max_area: f64) -> Result<Plan, f64> {
             // a zero or infinite area) would make NaN, which casts to 0, and a grid of
             // 0 x 4,294,967,295. Surfaces are validated before planning; this keeps the
             // planner safe on its own.
-            let nu_f = (target * lu / lv).sqrt().round().clamp(1.0, target);
+            // Ties (3.5) and near-ties by rounding go up alike, whatever the unit.
+            let nu_f = ((target * lu / lv).sqrt() * (1.0 + 1e-12))
+                .round()
+                .clamp(1.0, target);
             if !(nu_f.is_finite() && area.is_finite() && area > 0.0) {
                 return Err(f64::INFINITY);
             }
@@ -212,7 +224,7 @@ fn plan(vertices: &[DVec3], max_area: f64) -> Result<Plan, f64> {
             }
             let (mut nu, mut nv) = (nu_f as u32, nv_f as u32);
             while max_quad_cell_area(vertices, nu, nv) > max_area * (1.0 + 1e-12) {
-                if lu / nu as f64 >= lv / nv as f64 {
+                if lu / nu as f64 >= lv / nv as f64 * (1.0 - 1e-12) {
                     nu += 1;
                 } else {
                     nv += 1;
@@ -228,7 +240,7 @@ fn plan(vertices: &[DVec3], max_area: f64) -> Result<Plan, f64> {
             let fan_areas =
                 fan_triangles(vertices).map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length());
             let largest = fan_areas.fold(0.0, f64::max);
-            let m = (largest / max_area).sqrt().ceil().max(1.0);
+            let m = ceil_relative((largest / max_area).sqrt()).max(1.0);
             if fans as f64 * m * m > MAX_ELEMENTS as f64 {
                 return Err(fans as f64 * m * m);
             }
@@ -727,6 +739,18 @@ mod tests {
                 assert!(geometry::is_convex(&pos), "element {e} not convex");
                 assert!((geometry::polygon_normal(&pos).unwrap() - el.normal).length() < 1e-9);
             }
+        }
+    }
+
+    /// The unit does not change the grid (QA of issue #16): a 5 x 3 wall under 0.25 is 60
+    /// cells of 0.25 (15 / 0.25), in metres, millimetres or kilometres, where the ratio of
+    /// the scaled areas can exceed 60 by rounding.
+    #[test]
+    fn the_grid_does_not_depend_on_the_unit() {
+        for scale in [1.0, 0.001, 1000.0, 0.1, 3.0] {
+            let wall: Vec<DVec3> = rect(5.0, 3.0).into_iter().map(|v| v * scale).collect();
+            let mesh = mesh_scene(&scene_of(vec![wall]), 0.25 * scale * scale).unwrap();
+            assert_eq!(mesh.len(), 60, "scale {scale}");
         }
     }
 

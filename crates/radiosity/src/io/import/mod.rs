@@ -397,6 +397,11 @@ pub fn scaled_unit(unit: &str, scale: f64) -> String {
     }
 }
 
+/// The length unit of a `.scene` file: the format states none, and lengths are taken as
+/// metres (what point luminaires' I / d^2 and `FLUX` over an area need for lux), as an OBJ's
+/// are (QA of issue #16: it was "scene units" beside a README that said metres).
+pub const SCENE_FILE_UNIT: &str = "metres (a .scene file states no unit; metres assumed)";
+
 /// A `.scene` file, scaled: every coordinate (the camera and the point luminaires too)
 /// times `scale`, `MAX_PATCH_AREA` times its square, so that the scene meshes into the same
 /// elements, and a `FLUX` block's exitance over its scaled area, so that it emits the same
@@ -453,7 +458,7 @@ fn read_scene_scaled(path: &Path, scale: f64) -> Result<Imported, ImportError> {
     Ok(Imported {
         file,
         warnings: Vec::new(),
-        unit: scaled_unit("scene units", scale),
+        unit: scaled_unit(SCENE_FILE_UNIT, scale),
         format: Format::Scene,
     })
 }

@@ -341,14 +341,20 @@ fn dispatch_by_extension() {
 fn scene_file_scaled_meshes_the_same() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/cornell_box.scene");
     let plain = read_any_scene(&path, &ImportOptions::default()).unwrap();
-    assert_eq!(plain.unit, "scene units");
+    assert_eq!(
+        plain.unit,
+        "metres (a .scene file states no unit; metres assumed)"
+    );
     assert_eq!(plain.file, read_scene(&path).unwrap());
     let o = ImportOptions {
         scale: 0.5,
         settings: None,
     };
     let half = read_any_scene(&path, &o).unwrap();
-    assert_eq!(half.unit, "scene units x 0.5");
+    assert_eq!(
+        half.unit,
+        "metres (a .scene file states no unit; metres assumed) x 0.5"
+    );
     // Halving is exact in binary: every coordinate exactly half, the area a quarter.
     assert_eq!(
         half.file.settings.max_patch_area,

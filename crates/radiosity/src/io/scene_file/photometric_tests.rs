@@ -213,11 +213,18 @@ fn light_block_errors_name_the_line_and_what_was_expected() {
     let e = lines(
         "LIGHTBEGIN\n#L\nPOSITION 0 0 1\nAIM 0 0 0\nINTENSITY 5\nDISTRIBUTION COSINE\nLIGHTEND",
     );
+    // Once (QA of issue #16: the zero aim was reported by the reader and again by the
+    // light's own check).
+    assert_eq!(e.len(), 1, "{e:?}");
     assert_eq!(e[0].0, 21, "{e:?}");
     assert!(e[0].2.contains("AIM must be a direction"), "{e:?}");
     let e = lines("LIGHTBEGIN\n#L\nPOSITION 0 0 1\nINTENSITY -5\nDISTRIBUTION COSINE\nLIGHTEND");
     assert!(e[0].2.contains("INTENSITY must not be negative"), "{e:?}");
     let e = lines("LIGHTBEGIN\n#L\nPOSITION 0 0 1\nWATTS 5\nLIGHTEND");
+    // The unknown line, and then (the rest of the block still read) the missing
+    // DISTRIBUTION, at the block's first line.
+    assert_eq!(e.len(), 2, "{e:?}");
+    assert!(e[1].2.contains("has no DISTRIBUTION"), "{e:?}");
     assert_eq!((e[0].0, e[0].1), (21, 1), "{e:?}");
     assert!(
         e[0].2

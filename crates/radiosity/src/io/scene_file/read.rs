@@ -369,14 +369,47 @@ impl<'a> Parser<'a> {
     }
 
     /// Like [`Self::expect`], with `wanted` describing the expectation in the message.
+    ///
+    /// A line with an unknown keyword is reported and does not end the block, so that one
+    /// run shows every mistake in it: when the expected line follows it (and any other
+    /// unknown lines) it was an extra line and is passed over; otherwise it is taken as the
+    /// expected line misspelt, and its values are still read and checked.
     fn expect_either(&mut self, keyword: Keyword, wanted: &str) -> Step<Line<'a>> {
+        if self.skip_unknown_before(wanted, |k| k == keyword) {
+            return self.expect_either(keyword, wanted);
+        }
         match self.current() {
             Some(line) if line.keyword() == keyword => {
                 self.pos += 1;
                 Ok(line)
             }
+            Some(line) if line.keyword() == Keyword::Unknown => {
+                // Reported once, as a misspelling of the expected line.
+                self.unexpected(wanted);
+                self.pos += 1;
+                Ok(line)
+            }
             _ => Err(self.unexpected(wanted)),
         }
+    }
+
+    /// When the current line and any after it have unknown keywords and the next known
+    /// line is one that `accept` takes: reports each unknown line (once, as not `wanted`)
+    /// and moves past them, returning true. Otherwise takes nothing and returns false.
+    fn skip_unknown_before(&mut self, wanted: &str, accept: impl Fn(Keyword) -> bool) -> bool {
+        let mut next = self.pos;
+        while self.lines.get(next).map(Line::keyword) == Some(Keyword::Unknown) {
+            next += 1;
+        }
+        let found = self.lines.get(next).map(Line::keyword);
+        if next == self.pos || !found.is_some_and(accept) {
+            return false;
+        }
+        while self.pos < next {
+            self.unexpected(wanted);
+            self.pos += 1;
+        }
+        true
     }
 
     /// Reports the current line (or the end of the file) where `wanted` should be.
@@ -806,6 +839,9 @@ impl<'a> Parser<'a> {
         let mut emission = [0.0; 3];
         let mut photometry = SurfacePhotometry::default();
         let mut flux = None;
+        self.skip_unknown_before("Er (or LUMINANCE L, or FLUX P)", |k| {
+            matches!(k, Keyword::Er | Keyword::Luminance | Keyword::Flux)
+        });
         match self.current_keyword() {
             Some(k @ (Keyword::Luminance | Keyword::Flux)) => {
                 let (v, token, line) = self.value_or_recorded(k)?;
@@ -850,6 +886,9 @@ impl<'a> Parser<'a> {
             }
         }
         let mut reflectance = [0.0; 3];
+        self.skip_unknown_before("Rr (or OPENING)", |k| {
+            matches!(k, Keyword::Rr | Keyword::Opening)
+        });
         if self.current_keyword() == Some(Keyword::Opening) {
             let line = self.expect(Keyword::Opening)?;
             self.line_end(&line, 1);
@@ -941,7 +980,7 @@ impl<'a> Parser<'a> {
         for k in 0..count {
             let keyword = Keyword::Vertex(k);
             let found = self.current_keyword();
-            if k > 0 && !matches!(found, Some(Keyword::Vertex(_))) {
+            if k > 0 && !matches!(found, Some(Keyword::Vertex(_) | Keyword::Unknown)) {
                 let wanted = format!(
                     "{} (VERTICES says {count} vertices, but only {k} are given)",
                     keyword.spelling()
@@ -988,6 +1027,7 @@ impl<'a> Parser<'a> {
         let mut distribution = None;
         let mut colour = None;
         let mut seen: Vec<(Keyword, usize)> = Vec::new();
+        let errors_before = self.errors.len();
         loop {
             let Some(line) = self.current() else {
                 return Err(self.unexpected("LIGHTEND"));
@@ -1030,7 +1070,7 @@ impl<'a> Parser<'a> {
                             head,
                             &l,
                             "AIM must be a direction (not 0 0 0): the axis of the light, \
-                             for example 0 0 -1 for straight down",
+                             for example 0 0 -1 for straight down in a z-up scene, 0 -1 0 in a y-up one",
                         );
                     }
                     aim = Some(v);
@@ -1067,9 +1107,12 @@ impl<'a> Parser<'a> {
                     colour = Some(Rgb(read.map(|t| t.map_or(0.0, |t| t.0))));
                 }
                 _ => {
-                    return Err(self.unexpected(
+                    // Reported, and the rest of the block still read: the light is
+                    // dropped at its end.
+                    self.unexpected(
                         "POSITION, AIM, INTENSITY, FLUX, DISTRIBUTION, COLOUR or LIGHTEND",
-                    ))
+                    );
+                    self.pos += 1;
                 }
             }
         }
@@ -1099,6 +1142,11 @@ impl<'a> Parser<'a> {
             distribution,
             colour: colour.unwrap_or(Rgb::splat(1.0)),
         };
+        if self.errors.len() > errors_before {
+            // A light with a bad line is dropped; its own check would report the same line
+            // again (AIM 0 0 0 as a zero aim).
+            return Err(Reported);
+        }
         if let Err(e) = light.check() {
             return Err(self.error(line, column, format!("the light \"{}\": {e}", light.name)));
         }
@@ -1312,6 +1360,9 @@ impl<'a> Parser<'a> {
             height = h;
         }
         let mut resolution = shape::DEFAULT_RESOLUTION;
+        self.skip_unknown_before("RESOLUTION or the block's end", |k| {
+            k == Keyword::Resolution
+        });
         if self.current_keyword() == Some(Keyword::Resolution) {
             let (v, token, line) = self.value(Keyword::Resolution)?;
             match Self::whole(v) {
@@ -1360,6 +1411,9 @@ impl<'a> Parser<'a> {
 
     /// `ORIGIN` + `SIZE`, or `VERTICES 4` + `VERTEX0..3` + `HEIGHT`.
     fn box_shape(&mut self) -> Step<BoxShape> {
+        self.skip_unknown_before("ORIGIN or VERTICES", |k| {
+            matches!(k, Keyword::Vertices | Keyword::Origin)
+        });
         if self.current_keyword() == Some(Keyword::Vertices) {
             return self.prism_shape();
         }

@@ -182,6 +182,41 @@ fn unknown_keyword() {
     );
 }
 
+/// An unknown line does not hide the block's other mistakes (QA of issue #16: an extra
+/// line before `Er` hid a bad `VERTEX` in the same patch), and each is reported once.
+#[test]
+fn an_unknown_line_does_not_hide_the_rest_of_its_block() {
+    // An extra line (the expected Er follows it), then a bad VERTEX1: two errors.
+    let text = with_lines(&[(6, "VERTICES 4\nTEXTURE wood"), (14, "VERTEX1 1 zero 0")]);
+    let e = errors(&text);
+    assert_eq!(e.len(), 2, "{e:#?}");
+    assert_eq!((e[0].0, e[0].1), (7, 1), "{e:#?}");
+    assert!(e[0].2.contains("unknown keyword \"TEXTURE\""), "{e:#?}");
+    assert!(e[0].2.contains("expected Er"), "{e:#?}");
+    // VERTEX1 is on line 15 now; "zero" starts at column 11.
+    assert_eq!((e[1].0, e[1].1), (15, 11), "{e:#?}");
+    assert!(e[1].2.contains("the y coordinate"), "{e:#?}");
+    // A misspelt line in place of an expected one (Rg), then a bad reflectance (Rb):
+    // the misspelling once, the reflectance once.
+    let e = errors(&with_lines(&[(11, "Rgg 0.5"), (12, "Rb 1.5")]));
+    assert_eq!(e.len(), 2, "{e:#?}");
+    assert_eq!(
+        (
+            e[0].0,
+            e[0].2.contains("unknown keyword \"Rgg\"; expected Rg")
+        ),
+        (11, true)
+    );
+    assert_eq!((e[1].0, e[1].2.contains("reflectance must be")), (12, true));
+    // Two unknown lines before a box's ORIGIN, and a bad SIZE: three errors.
+    let boxed = "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 1\nSCENEBEGIN\nBOXBEGIN\n#B\nFACING OUT\n\
+                 Er 0\nEg 0\nEb 0\nRr 0.5\nRg 0.5\nRb 0.5\nSHAPE box\nWOOD 1\n\
+                 ORIGIN 0 0 0\nSIZE 1 -1 1\nBOXEND\nSCENEEND\n";
+    let e = errors(boxed);
+    let lines: Vec<usize> = e.iter().map(|e| e.0).collect();
+    assert_eq!(lines, [13, 14, 16], "{e:#?}");
+}
+
 #[test]
 fn missing_header_lines_give_one_error_each() {
     one_error(
