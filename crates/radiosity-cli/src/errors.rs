@@ -22,10 +22,15 @@ pub fn describe(err: &anyhow::Error) -> String {
     if let Some(hint) = err.chain().find_map(hint) {
         text.push_str(&hint);
     }
+    // Messages in the compiler's form ("file:line: error: what") carry their own prefix:
+    // scene and import errors always, and any other library error that names a place in a
+    // file (a points CSV, an IES file).
     if err.downcast_ref::<scene::SceneError>().is_some()
         || err
             .downcast_ref::<radiosity::io::import::ImportError>()
             .is_some()
+        || text.starts_with("error: ")
+        || text.contains(": error: ")
     {
         text
     } else {

@@ -134,6 +134,8 @@ pub struct Reporter {
     ticker: Mutex<Option<Ticker>>,
     bar: Mutex<Option<ProgressBar>>,
     timings: Mutex<Vec<(Stage, Duration)>>,
+    /// What a timed stage worked on, by its index in `timings` ([`Reporter::name_last`]).
+    subjects: Mutex<Vec<(usize, String)>>,
     quiet: bool,
     /// What the solve stage counts (see [`Reporter::solving_with`]).
     solve_counting: Mutex<Option<Counting>>,
@@ -149,6 +151,7 @@ impl Reporter {
             ticker: Mutex::new(None),
             bar: Mutex::new(None),
             timings: Mutex::new(Vec::new()),
+            subjects: Mutex::new(Vec::new()),
             quiet,
             solve_counting: Mutex::new(None),
         }
@@ -171,16 +174,35 @@ impl Reporter {
         *self.solve_counting.lock().unwrap() = Counting::solve(solver);
     }
 
-    /// Stage timings with distinct labels: a stage that ran more than once (the solves of
-    /// adaptive subdivision, the files a command writes) is numbered, "solve #2".
+    /// Names what the stage timed last worked on, for its timing label: "write
+    /// out-error.png" (QA of issue #16: "write #1, write #2, write #3" did not say which
+    /// file took the time).
+    pub fn name_last(&self, subject: &str) {
+        let count = self.timings.lock().unwrap().len();
+        if let Some(last) = count.checked_sub(1) {
+            self.subjects
+                .lock()
+                .unwrap()
+                .push((last, subject.to_string()));
+        }
+    }
+
+    /// Stage timings with distinct labels: a stage named by [`Reporter::name_last`] is
+    /// labelled with what it worked on, "write out.png"; another that ran more than once
+    /// (the solves of adaptive subdivision) is numbered, "solve #2".
     pub fn labelled_timings(&self) -> Vec<(String, Duration)> {
         let timings = self.timings();
+        let subjects = self.subjects.lock().unwrap().clone();
         let mut seen: Vec<(Stage, usize)> = Vec::new();
         timings
             .iter()
-            .map(|&(stage, d)| {
+            .enumerate()
+            .map(|(i, &(stage, d))| {
                 let runs = timings.iter().filter(|t| t.0 == stage).count();
-                let label = if runs > 1 {
+                let subject = subjects.iter().rev().find(|s| s.0 == i);
+                let label = if let Some((_, subject)) = subject {
+                    format!("{} {subject}", stage.name())
+                } else if runs > 1 {
                     let k = match seen.iter_mut().find(|s| s.0 == stage) {
                         Some(s) => {
                             s.1 += 1;
@@ -343,6 +365,20 @@ impl Progress for Reporter {
     fn message(&self, text: &str) {
         self.note(text);
     }
+}
+
+/// Runs `work` as `stage` of `reporter`, its timing labelled with the file it reads or
+/// writes ([`Reporter::name_last`]): "write out.png", "parse room.scene".
+pub fn run_file_stage<T>(
+    reporter: &Reporter,
+    stage: Stage,
+    path: &std::path::Path,
+    work: impl FnOnce() -> T,
+) -> T {
+    let out = radiosity::progress::run_stage(reporter, stage, 0, work);
+    let name = path.file_name().unwrap_or(path.as_os_str());
+    reporter.name_last(&name.to_string_lossy());
+    out
 }
 
 #[cfg(test)]

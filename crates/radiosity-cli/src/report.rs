@@ -437,7 +437,17 @@ pub fn check(
     outln!("scene             {stem}");
     outln!("unit              {}", crate::setup::scene_unit());
     outln!("surfaces          {}", scene.surfaces.len());
-    outln!("elements          {}", solution.mesh.len());
+    if solution.mesh.len() == prepared.mesh.len() {
+        outln!("elements          {}", solution.mesh.len());
+    } else {
+        // QA of issue #16: the count changed between lines with no word why.
+        outln!(
+            "elements          {} (hierarchical radiosity's leaves: its patches subdivided \
+             where the light varies; the uniform mesh at MAX_PATCH_AREA has {})",
+            solution.mesh.len(),
+            prepared.mesh.len()
+        );
+    }
     let (_, area_unit) = length_and_area_units();
     // The elements' area: less than the surfaces' where contact refinement dropped buried
     // pieces or a surface lying on another covers part of it (QA of issue #16: `generate`

@@ -2,6 +2,7 @@
 //! flags of [`crate::args`] (the scene prepared for a method, the solver, the render
 //! settings and the camera), with the checks that need more than one flag or the scene.
 
+use crate::progress_bar::run_file_stage;
 use std::path::Path;
 
 use anyhow::{bail, Result};
@@ -428,7 +429,9 @@ pub fn load_scene(
                 scale,
                 settings: None,
             };
-            let imported = run_stage(reporter, Stage::Parse, 0, || read_any_scene(path, &options))?;
+            let imported = run_file_stage(reporter, Stage::Parse, path, || {
+                read_any_scene(path, &options)
+            })?;
             for w in &imported.warnings {
                 errln!("{w}");
             }
@@ -713,6 +716,13 @@ pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
     let Some(out) = output else {
         return Ok(ImageFormat::Png);
     };
+    if out.is_dir() {
+        bail!(
+            "-o {}: this is a folder; give the image a file name in it, ending .png \
+             (tone-mapped) or .exr (linear radiance)",
+            out.display()
+        );
+    }
     let ext = out
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());

@@ -1,6 +1,7 @@
 //! `radiosity export`: the solved scene as glTF with the radiosity in vertex colours, or
 //! the scene's surfaces as OBJ + MTL.
 
+use crate::progress_bar::run_file_stage;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
@@ -98,7 +99,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
         camera: &camera,
         settings: prepared.settings,
     };
-    run_stage(&reporter, Stage::Write, 0, || match format {
+    run_file_stage(&reporter, Stage::Write, output, || match format {
         Format::Glb => gltf::write_glb(output, &bake),
         Format::Gltf | Format::Obj => gltf::write_gltf(output, &bake),
     })
@@ -170,7 +171,7 @@ fn export_obj(
         integral_steps: args.scene.steps.unwrap_or(file.settings.integral_steps),
     };
     let output = &args.output;
-    run_stage(reporter, Stage::Write, 0, || {
+    run_file_stage(reporter, Stage::Write, output, || {
         obj::write_obj(output, &file.scene, Some(settings))
     })
     .with_context(|| format!("cannot write {}", output.display()))?;

@@ -41,6 +41,12 @@ pub fn run(args: FormFactorArgs) -> Result<()> {
     let (f, stats) = prepared.form_factors(&reporter)?;
     report::form_factor_stats(&prepared, &prepared.mesh, &stats, &reporter);
     prepared.save_form_factors(&output, &f, &reporter)?;
+    reporter.name_last(
+        &output
+            .file_name()
+            .unwrap_or(output.as_os_str())
+            .to_string_lossy(),
+    );
     reporter.note(&format!(
         "wrote {} ({} x {} form factors, method {})",
         output.display(),

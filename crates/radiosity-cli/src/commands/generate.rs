@@ -81,6 +81,15 @@ pub fn building(args: BuildingArgs) -> Result<()> {
     let built = scene::building(&params);
     scene::write_scene_file(&built.scene, built.settings, &args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
+    if args.light == 0.0 {
+        // Every other command refuses a scene with no light only by its dark picture; say
+        // so now (QA of issue #16: `--light 0` wrote a building without a word).
+        errln!(
+            "warning: --light 0: the ceiling panels emit nothing and the building has no \
+             other light, so it renders black; give their exitance in lm/m^2 (default {})",
+            scene::BuildingParams::default().light
+        );
+    }
     if args.quiet {
         return Ok(());
     }

@@ -3,6 +3,7 @@
 //! difference and an error map; `--save-reference` / `--reference` keep an expensive view
 //! in an OpenEXR file.
 
+use crate::progress_bar::run_file_stage;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -186,7 +187,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     // The path-traced view: traced, or read back.
     let (view, settings) = match &args.reference {
         Some(path) => {
-            let saved = run_stage(&reporter, Stage::Parse, 0, || {
+            let saved = run_file_stage(&reporter, Stage::Parse, path, || {
                 read_path_traced(path, &camera, scene)
             })?;
             reporter.note(&format!(
@@ -215,7 +216,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         }
     };
     if let Some(path) = &args.save_reference {
-        run_stage(&reporter, Stage::Write, 0, || {
+        run_file_stage(&reporter, Stage::Write, path, || {
             write_path_traced(path, &view, &camera, &settings, scene)
         })?;
         reporter.note(&format!("wrote the reference to {}", path.display()));
@@ -332,7 +333,7 @@ fn write_linear(
     path: &Path,
     reporter: &Reporter,
 ) -> Result<()> {
-    run_stage(reporter, Stage::Write, 0, || {
+    run_file_stage(reporter, Stage::Write, path, || {
         radiosity::io::exr::write_radiance(
             path,
             film.width(),
@@ -370,8 +371,10 @@ fn check_exr(path: &Path) -> Result<()> {
 }
 
 fn write_image(image: &image::RgbImage, path: &Path, reporter: &Reporter) -> Result<()> {
-    run_stage(reporter, Stage::Write, 0, || render::write_png(image, path))
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    run_file_stage(reporter, Stage::Write, path, || {
+        render::write_png(image, path)
+    })
+    .with_context(|| format!("cannot write {}", path.display()))?;
     reporter.note(&format!(
         "wrote {} ({} x {})",
         path.display(),

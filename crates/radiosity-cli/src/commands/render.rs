@@ -1,10 +1,11 @@
 //! `radiosity render`: solve a scene and render it to a PNG image (with snapshots of a progressive solve).
 
+use crate::progress_bar::run_file_stage;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use radiosity::progress::{run_stage, Stage};
+use radiosity::progress::Stage;
 use radiosity::render::{self};
 use radiosity::solve::Step;
 
@@ -187,7 +188,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             &reporter,
         )?
         .expect("a wireframe .exr is refused above");
-        run_stage(&reporter, Stage::Write, 0, || {
+        run_file_stage(&reporter, Stage::Write, &output, || {
             radiosity::io::exr::write_radiance(
                 &output,
                 camera.width as usize,
@@ -220,7 +221,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         scale,
         &reporter,
     )?;
-    run_stage(&reporter, Stage::Write, 0, || {
+    run_file_stage(&reporter, Stage::Write, &output, || {
         render::write_png(&image, &output)
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
@@ -307,7 +308,7 @@ fn false_colour(
         max,
         ticks,
     );
-    run_stage(reporter, Stage::Write, 0, || {
+    run_file_stage(reporter, Stage::Write, output, || {
         render::write_png(&image, output)
     })
     .with_context(|| format!("cannot write {}", output.display()))?;

@@ -1,9 +1,10 @@
 //! `radiosity solve`: solve a scene and write the radiosity of every element as CSV or JSON.
 
+use crate::progress_bar::run_file_stage;
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use radiosity::progress::{run_stage, Stage};
+use radiosity::progress::Stage;
 
 use super::solve_as_asked;
 use crate::args::SolveArgs;
@@ -54,7 +55,7 @@ pub fn run(args: SolveArgs) -> Result<()> {
     let output = outputs(&args)?;
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     let solution = solve_as_asked(&prepared, solver, &args.solve, &reporter)?;
-    run_stage(&reporter, Stage::Write, 0, || {
+    run_file_stage(&reporter, Stage::Write, &output, || {
         radiosity::solution::write_solution(
             &output,
             &prepared.scene,
@@ -71,7 +72,7 @@ pub fn run(args: SolveArgs) -> Result<()> {
         crate::setup::scene_unit()
     ));
     if let Some(report) = &args.report {
-        run_stage(&reporter, Stage::Write, 0, || {
+        run_file_stage(&reporter, Stage::Write, report, || {
             radiosity::io::surface_report::write_surface_report(
                 report,
                 &prepared.scene,

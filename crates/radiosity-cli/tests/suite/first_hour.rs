@@ -1548,3 +1548,140 @@ fn export_help_wireframe_exposure_and_fov_say_what_is_true() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn errors_say_error_once_and_name_a_folder_as_a_folder() {
+    // QA of issue #16: "error: P.csv:1: error: expected the header ...", an IES file's
+    // "error:" inside the scene's, `extension ""` for a folder given as the scene, and
+    // `render -o DIR` answered with the list of image formats.
+    let dir = scratch_dir("error-once");
+    std::fs::write(dir.join("p.csv"), "x,y,z\n1,2,3\n").unwrap();
+    std::fs::create_dir(dir.join("folder")).unwrap();
+    std::fs::write(
+        dir.join("lamp.scene"),
+        lamp_over_floor([0.0, 0.0, 0.0]).replace(
+            "SCENEEND",
+            "LIGHTBEGIN\n#Spot\nPOSITION 0.5 0.5 0.5\nDISTRIBUTION IES bad.ies\nLIGHTEND\nSCENEEND",
+        ),
+    )
+    .unwrap();
+    std::fs::write(dir.join("bad.ies"), "IESNA:LM-63-2002\nno tilt line\n").unwrap();
+    for (args, needle) in [
+        (
+            vec!["illuminance", "--points", "p.csv", "-o", "l.csv"],
+            "p.csv:1: error: expected the header",
+        ),
+        (
+            vec!["check", "folder"],
+            "folder: error: this is a folder, not a scene file",
+        ),
+        (
+            vec!["render", "-o", "folder"],
+            "-o folder: this is a folder; give the image a file name in it",
+        ),
+        (vec!["check", "lamp.scene"], "bad.ies:"),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        let first = err.lines().find(|l| l.contains("error")).unwrap();
+        assert_eq!(first.matches("error:").count(), 1, "{args:?}: {first}");
+        assert!(!err.contains("extension \"\""), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn timings_name_the_files_read_and_written() {
+    // QA of issue #16: "write #1 ..., write #2 ..., write #3" did not say which file.
+    let dir = scratch_dir("timing-names");
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--paths",
+            "2",
+            "--compare",
+            "--max-area",
+            "20000",
+            "-o",
+            "v.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let timings = err.lines().find(|l| l.starts_with("timings:")).unwrap();
+    for name in ["write v.png", "write v-radiosity.png", "write v-error.png"] {
+        assert!(timings.contains(name), "{name}: {timings}");
+    }
+    assert!(!timings.contains('#'), "{timings}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_building_without_light_is_said_to_render_black() {
+    let dir = scratch_dir("dark-building");
+    let args = [
+        "generate",
+        "building",
+        "-o",
+        "b.scene",
+        "--light",
+        "0",
+        "--floors",
+        "1",
+        "--rooms-x",
+        "1",
+        "--rooms-z",
+        "1",
+    ];
+    let out = radiosity(&args, &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning: --light 0"), "{err}");
+    assert!(err.contains("renders black"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn hierarchical_leaves_are_explained_beside_the_element_count() {
+    // QA of issue #16: `render` said 2484 elements, then 5694 leaves, and `check` 5694
+    // elements, with no word why the count changed.
+    let dir = scratch_dir("leaves");
+    let out = radiosity(
+        &["check", "--solver", "hierarchical", "--max-area", "20000"],
+        &dir,
+    );
+    let (err, text) = (stderr(&out), crate::fixtures::stdout(&out));
+    assert!(out.status.success(), "{err}");
+    let line = text.lines().find(|l| l.starts_with("elements")).unwrap();
+    assert!(
+        line.contains("hierarchical radiosity's leaves")
+            && line.contains("the uniform mesh at MAX_PATCH_AREA has"),
+        "{line}"
+    );
+    let args = [
+        "render",
+        "--solver",
+        "hierarchical",
+        "--max-area",
+        "20000",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "-o",
+        "h.png",
+    ];
+    let err = stderr(&radiosity(&args, &dir));
+    assert!(
+        err.contains("leaves (the elements of its solution"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -517,7 +517,10 @@ mod tests {
         let main = 100.0 * on_axis_form_factor();
         let weak_polygon = facing_minus_z(3.0, 5.0, -1.0, 1.0, 1.0);
         let weak_f = point_to_polygon(DVec3::ZERO, DVec3::Z, &weak_polygon);
-        assert!(weak_f < WEAK_SHARE * main, "the test's weak light is not weak");
+        assert!(
+            weak_f < WEAK_SHARE * main,
+            "the test's weak light is not weak"
+        );
         let weak = surface("weak", 1.0, weak_polygon);
         // A blocker at height 0.5 over x in [1, 10] hides the whole weak light (its rays
         // cross z = 0.5 at x in [1.5, 2.5]) and none of the main one (|x| <= 0.5): the
@@ -530,7 +533,10 @@ mod tests {
         ]));
         for salt in 0..8 {
             let d = hidden.irradiance(DVec3::ZERO, DVec3::Z, salt)[0];
-            assert!((d - main).abs() < 1e-9 * main, "salt {salt}: {d} against {main}");
+            assert!(
+                (d - main).abs() < 1e-9 * main,
+                "salt {salt}: {d} against {main}"
+            );
         }
         // Over x in [2, 10] it hides the half x > 4 of the weak light: the coarse rays
         // disagree, the fine pass runs as for any emitter, and the weak light's part is

@@ -211,10 +211,17 @@ pub enum ImportError {
         /// The system's reason.
         message: String,
     },
+    /// The path names a folder.
+    #[error("{file}: error: this is a folder, not a scene file: expected {EXTENSIONS}")]
+    Folder {
+        /// The folder.
+        file: String,
+    },
     /// The extension is none of [`EXTENSIONS`].
     #[error(
-        "{file}: error: cannot tell the scene format from the extension \"{extension}\": \
-         expected {EXTENSIONS}"
+        "{file}: error: cannot tell the scene format from {}: expected {EXTENSIONS}",
+        if extension.is_empty() { "a name with no extension".to_string() }
+        else { format!("the extension \"{extension}\"") }
     )]
     UnknownFormat {
         /// The file.
@@ -371,6 +378,9 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
         });
     }
     let file = path.display().to_string();
+    if path.is_dir() {
+        return Err(ImportError::Folder { file });
+    }
     let Some(format) = Format::of_path(path) else {
         return Err(ImportError::UnknownFormat {
             file,

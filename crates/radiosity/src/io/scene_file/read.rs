@@ -1204,9 +1204,12 @@ impl<'a> Parser<'a> {
             }),
             Err(e) => {
                 let column = line.tokens.get(2).map_or(word.column, |t| t.column);
+                // The IES error reads "file:line: error: what"; inside this message,
+                // which has its own "error:", the inner one is dropped.
+                let inner = e.to_string().replacen(": error: ", ": ", 1);
                 let msg = format!(
                     "the light's IES file \"{written}\" (relative to the scene file's folder) \
-                     cannot be used: {e}"
+                     cannot be used: {inner}"
                 );
                 Err(self.error(line.number, column, msg))
             }

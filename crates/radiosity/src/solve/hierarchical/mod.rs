@@ -486,7 +486,7 @@ pub fn solve_hierarchical(
     };
     let (shapes_computed, shapes_reused) = solver.near_pairs.counts();
     progress.message(&format!(
-        "hierarchical radiosity: {} leaves, {} clusters, {} links ({} initial), {} rounds, {} sweeps, {} rays, {gather}; \
+        "hierarchical radiosity: {} leaves (the elements of its solution: patches of at most MAX_PATCH_AREA, subdivided where the light varies), {} clusters, {} links ({} initial), {} rounds, {} sweeps, {} rays, {gather}; \
          exact near-pair form factors: {shapes_computed} pair shapes computed, {shapes_reused} pairs of the same shapes reused",
         report.leaves, report.clusters, report.links, report.initial_links, rounds, iterations, report.rays
     ));
