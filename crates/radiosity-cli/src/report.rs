@@ -289,9 +289,10 @@ fn lying_on(prepared: &Prepared) {
     let scale = prepared.occluders.scale();
     let same_plane = pairs.iter().filter(|o| o.same_plane(scale)).count();
     outln!(
-        "lying on          {} surface(s) lie on others ({} in the same plane), their covered \
-         parts left out of the mesh:",
-        pairs.len(),
+        "lying on          {} {} on others ({} in the same plane), their covered parts left \
+         out of the mesh:",
+        count(pairs.len() as u64, "surface"),
+        if pairs.len() == 1 { "lies" } else { "lie" },
         same_plane
     );
     const SHOWN: usize = 10;
@@ -398,27 +399,19 @@ pub fn significant(x: f64, digits: usize) -> String {
 }
 
 /// The unit of lengths and of areas of the scene read, short, for figures: `mm` and `mm^2`
-/// for the built-in box, `m` for a file read in metres unscaled, else the words of the
-/// `unit` line (`scene units`, `square scene units`).
+/// for the built-in box, `m` for metres (a file read in metres, or scaled to them), else the
+/// words of the `unit` line (`inches`, `square inches`).
 pub fn length_and_area_units() -> (String, String) {
     let unit = crate::setup::scene_unit();
-    if unit.contains(" x ") {
-        return (
-            "units (see unit)".to_string(),
-            "square units (see unit)".to_string(),
-        );
-    }
     if unit.starts_with("millimetres") {
         ("mm".to_string(), "mm^2".to_string())
     } else if unit.starts_with("metres") {
         ("m".to_string(), "m^2".to_string())
-    } else if unit == "scene units" {
-        ("scene units".to_string(), "square scene units".to_string())
     } else {
-        (
-            "units (see unit)".to_string(),
-            "square units (see unit)".to_string(),
-        )
+        // The unit's words before any note in brackets: "inches", "drawing units".
+        let words = unit.split(" (").next().unwrap_or(&unit).trim().to_string();
+        let area = format!("square {words}");
+        (words, area)
     }
 }
 

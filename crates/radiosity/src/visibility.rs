@@ -378,6 +378,32 @@ impl PolygonBvh {
         })
     }
 
+    /// Whether a polygon whose back faces along `dir` (normal . dir > 0) contains the point
+    /// `p`, to `tolerance` ([`PolygonBvh::polygon_at`]'s test). Where two faces lie back to
+    /// back in one plane (a box's base on the floor) a ray meets both at the same distance
+    /// and which [`PolygonBvh::closest_hit`] reports is rounding; this finds the back one.
+    pub fn back_face_at(&self, p: DVec3, dir: DVec3, tolerance: f64) -> bool {
+        let mut candidates = Vec::new();
+        self.overlapping(
+            p - DVec3::splat(tolerance),
+            p + DVec3::splat(tolerance),
+            &mut candidates,
+        );
+        candidates.into_iter().any(|k| {
+            let poly = &self.polygons[k as usize];
+            poly.normal.dot(dir) > 0.0
+                && self
+                    .intersect(
+                        k as usize,
+                        p + tolerance * poly.normal,
+                        -poly.normal,
+                        0.0,
+                        2.0 * tolerance,
+                    )
+                    .is_some()
+        })
+    }
+
     /// The first polygon hit by the ray from `origin` along unit `dir`, with `t_min <= t <= t_max`.
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
         if self.polygons.is_empty() {

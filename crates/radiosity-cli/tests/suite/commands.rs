@@ -745,7 +745,7 @@ fn check_lists_surfaces_lying_on_others() {
         let out = radiosity(&["check", path.to_str().unwrap()], &dir);
         assert!(out.status.success(), "{}", stderr(&out));
         let text = stdout(&out);
-        let note = format!("1 surface(s) lie on others ({same_plane} in the same plane)");
+        let note = format!("1 surface lies on others ({same_plane} in the same plane)");
         assert!(text.contains(&note), "lift {lift}:\n{text}");
         assert!(
             text.contains("surface 1 \"Rug\" on surface 0 \"Floor\""),

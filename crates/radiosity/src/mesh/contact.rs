@@ -57,6 +57,14 @@ pub const PROBE_SLACK: usize = 2;
 /// Sample points per element (and per piece) along each axis: 4 x 4.
 const PROBE_GRID: u32 = 4;
 
+/// How far the probe points sit from the centres of their cells, in cells (irrational
+/// multiples of the golden ratio's: 0.0618 and 0.0382). Centres fall on round coordinates
+/// (a leg's outline at z = 0.85 on an element from 0.8 to 1.2): a point exactly on an
+/// outline is buried or not by rounding, so the mesh changed with `--scale` (QA of issue
+/// #16: examples/room.scene meshed to 899 elements, 945 at `--scale 0.999`; with the
+/// back-to-back faces below, 906 at every scale tried but 7.7).
+const PROBE_OFFSET: [f64; 2] = [0.061_803_398_874_989_48, 0.038_196_601_125_010_52];
+
 /// What [`refine_contacts`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactReport {
@@ -222,13 +230,22 @@ impl<'a> Probe<'a> {
         if covered {
             return true;
         }
+        // Another surface with a corner in front of the plane, or one pressed face to face
+        // against it (the base of a table top on a leg's top: in the same plane, facing the
+        // other way; missed before where rounding put its corners exactly in the plane, so
+        // the mesh changed with `--scale`, QA of issue #16).
         let origin = corners[0];
         candidates.into_iter().any(|k| {
             let s = self.occluders.id_of(k);
+            let corners = self.polygons[s as usize];
             s != surface
-                && self.polygons[s as usize]
+                && (corners
                     .iter()
                     .any(|&v| (v - origin).dot(normal) > self.lift)
+                    || (self.normals[s as usize].dot(normal) < -1.0 + 1e-9
+                        && corners
+                            .iter()
+                            .all(|&v| (v - origin).dot(normal).abs() <= self.lift)))
         })
     }
 
@@ -248,8 +265,17 @@ impl<'a> Probe<'a> {
                 let phi = (i - 1) as f64 * std::f64::consts::TAU / (PROBE_DIRECTIONS - 1) as f64;
                 (cos * n + sin * (phi.cos() * t1 + phi.sin() * t2)).normalize()
             };
+            // A front face hit where a back face lies in the same plane (a box standing on
+            // the floor: the ray from inside it meets its base and the floor together)
+            // counts as the back face: which of the two comes first is rounding, and it
+            // changed the mesh with `--scale` (QA of issue #16).
             let back = match self.occluders.closest_hit(origin, dir, 0.0, f64::INFINITY) {
-                Some(hit) => self.normals[hit.id as usize].dot(dir) > 0.0,
+                Some(hit) => {
+                    self.normals[hit.id as usize].dot(dir) > 0.0
+                        || self
+                            .occluders
+                            .back_face_at(origin + hit.t * dir, dir, self.lift)
+                }
                 None => false,
             };
             if !back {
@@ -267,13 +293,19 @@ impl<'a> Probe<'a> {
         if corners.len() == 4 {
             for j in 0..k {
                 for i in 0..k {
-                    let (u, v) = ((i as f64 + 0.5) / k as f64, (j as f64 + 0.5) / k as f64);
+                    let (u, v) = (
+                        (i as f64 + 0.5 + PROBE_OFFSET[0]) / k as f64,
+                        (j as f64 + 0.5 + PROBE_OFFSET[1]) / k as f64,
+                    );
                     points.push(bilinear(corners, u, v));
                 }
             }
         } else {
+            let [a, b] = PROBE_OFFSET;
             for_each_subtriangle([corners[0], corners[1], corners[2]], k, |t| {
-                points.push((t[0] + t[1] + t[2]) / 3.0)
+                points.push(
+                    (1.0 / 3.0 + a) * t[0] + (1.0 / 3.0 + b) * t[1] + (1.0 / 3.0 - a - b) * t[2],
+                )
             });
         }
         let (mut buried, mut open) = (false, false);

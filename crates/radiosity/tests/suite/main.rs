@@ -10,3 +10,4 @@ mod form_factors;
 mod hierarchical;
 mod methods_on_examples;
 mod progressive;
+mod scale_invariance;

@@ -486,7 +486,10 @@ fn glb_and_external_buffer_read_as_the_embedded_gltf() {
         },
     )
     .unwrap();
-    assert_eq!(scaled.unit, "metres (glTF's unit) x 0.001");
+    assert_eq!(
+        scaled.unit,
+        "metres, taken as (the file's numbers x 0.001; unscaled, metres (glTF's unit))"
+    );
     let (lo, hi) = scaled.file.scene.bounds();
     assert!((hi.x - lo.x - 0.556).abs() < 1e-6, "{lo} {hi}");
 

@@ -155,9 +155,9 @@ pub struct Imported {
     /// What was repaired or left out (degenerate faces dropped, a missing material file),
     /// for the caller to show.
     pub warnings: Vec<ImportWarning>,
-    /// What one scene unit is, in words: "scene units" for the paper's format (which
-    /// states none), "metres (OBJ states no unit; metres assumed)", with " x SCALE" when
-    /// [`ImportOptions::scale`] is not 1.
+    /// What one scene unit is, in words: "metres (a .scene file states no unit; metres
+    /// assumed)", "metres (OBJ states no unit; metres assumed)", ...; with
+    /// [`ImportOptions::scale`] not 1, metres made of the file's numbers ([`scaled_unit`]).
     pub unit: String,
     /// The format the file was read as.
     pub format: Format,
@@ -398,12 +398,15 @@ pub fn read_any_scene(path: &Path, options: &ImportOptions) -> Result<Imported, 
     }
 }
 
-/// `unit` with " x SCALE" when `scale` is not 1.
+/// `unit`, or when `scale` is not 1, metres with what they were made of: a scale is given
+/// to bring a model's numbers to metres (0.001 for millimetres), and lux and areas in m^2
+/// take the scaled numbers as metres (QA of issue #16: "metres x 0.001" beside "square
+/// units (see unit)" left the unit of every figure to be worked out).
 pub fn scaled_unit(unit: &str, scale: f64) -> String {
     if scale == 1.0 {
         unit.to_string()
     } else {
-        format!("{unit} x {scale}")
+        format!("metres, taken as (the file's numbers x {scale}; unscaled, {unit})")
     }
 }
 
