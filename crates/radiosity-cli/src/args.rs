@@ -551,7 +551,9 @@ pub struct IlluminanceArgs {
     #[arg(long, value_name = "X0,Y0,Z0:X1,Y1,Z1:SPACING", allow_hyphen_values = true,
           value_parser = parse_grid, requires = "normal")]
     pub grid: Option<(DVec3, DVec3, f64)>,
-    /// The normal of every grid point (0,0,1 for a horizontal work plane in a z-up scene).
+    /// The normal of every grid point, required with --grid: 0,0,1 for a horizontal work
+    /// plane in a z-up scene, 0,1,0 in a y-up one such as the Cornell box (scenes come both
+    /// ways up, so no default would be right for all).
     #[arg(long, value_name = "NX,NY,NZ", allow_hyphen_values = true, value_parser = parse_vec3,
           requires = "grid")]
     pub normal: Option<DVec3>,

@@ -525,10 +525,12 @@ fn solver(
     // The numbers alone were checked before the scene was read (check_solve_flags).
     let choice = match options.solver.0 {
         SolverKind::Auto if options.form_factors.is_some() => {
-            reporter.note(
-                "solver auto: Gauss-Seidel on the dense matrix, the form factors read from \
-                 --form-factors",
-            );
+            let file = options.form_factors.as_deref().unwrap_or(Path::new(""));
+            reporter.note(&format!(
+                "solver auto: Gauss-Seidel on the dense matrix of the form factors in {} \
+                 (--form-factors)",
+                file.display()
+            ));
             SolverKind::GaussSeidel
         }
         SolverKind::Auto => {

@@ -48,7 +48,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     let (points, dims) = match (&args.points, args.grid) {
         (Some(path), _) => (illuminance::read_points(path)?, None),
         (None, Some((a, b, spacing))) => {
-            let normal = args.normal.unwrap_or(glam::DVec3::Z);
+            let Some(normal) = args.normal else {
+                // clap requires --normal with --grid (the help says why there is no default).
+                bail!("--grid needs --normal NX,NY,NZ, the way the meters face");
+            };
             if normal.length_squared() == 0.0 {
                 bail!("--normal 0,0,0 is no direction; give the way the meters face, e.g. 0,0,1");
             }

@@ -103,6 +103,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
         // the exposure.
         errln!("warning: --exposure ignored with --shading wireframe: its lines are drawn white");
     }
+    if wireframe && args.tone.gamma != 2.2 {
+        errln!("warning: --gamma ignored with --shading wireframe: its lines are drawn white");
+    }
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     if args.snapshots.is_some() && !matches!(solver, radiosity::solve::Solver::Progressive(_)) {
         bail!(

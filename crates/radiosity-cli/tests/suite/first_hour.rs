@@ -1098,7 +1098,7 @@ fn form_factors_flag_is_checked_before_the_scene_is_meshed() {
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(
-        err.contains("solver auto: Gauss-Seidel on the dense matrix, the form factors read from --form-factors"),
+        err.contains("solver auto: Gauss-Seidel on the dense matrix of the form factors in c.ff"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
@@ -1528,6 +1528,8 @@ fn export_help_wireframe_exposure_and_fov_say_what_is_true() {
             "8",
             "--exposure",
             "2",
+            "--gamma",
+            "1.8",
             "-o",
             "w.png",
         ],
@@ -1538,6 +1540,10 @@ fn export_help_wireframe_exposure_and_fov_say_what_is_true() {
     assert!(!err.contains("exposure scale"), "{err}");
     assert!(
         err.contains("warning: --exposure ignored with --shading wireframe"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: --gamma ignored with --shading wireframe"),
         "{err}"
     );
     let out = radiosity(&["render", "--fov", "180", "-o", "f.png"], &dir);
