@@ -135,12 +135,13 @@ fn zero_rows_text(scene: &Scene, mesh: &Mesh, stats: &FormFactorStats) -> Option
         return None;
     }
     Some(format!(
-        "row sums: {} element(s) see no other element (row sum 0; the first is {}): faces \
+        "row sums: {} {} no other element (row sum 0; the first is {}): faces \
          pressed against another surface, such as the base of furniture standing on the floor \
          or a side against a wall, or elements whose sample points lie under such furniture; \
          no light reaches them, so they keep only their own emission, and they are hidden \
          (or partly hidden) by what touches them",
-        rows.zero,
+        count(rows.zero as u64, "element"),
+        if rows.zero == 1 { "sees" } else { "see" },
         element_name(scene, mesh, rows.min_row),
     ))
 }
@@ -168,12 +169,13 @@ fn over_rows_text(
         }
     };
     Some(format!(
-        "{} element(s) have form-factor rows summing above {ROW_SUM_OVER} (the largest {:.4}, \
+        "{} {} form-factor rows summing above {ROW_SUM_OVER} (the largest {:.4}, \
          {}): they pass on more light than reaches them, so the solution holds light that \
          was never emitted (`check` lists it as \"counted twice\"). It comes from pairs much \
          closer than their elements are large (a wall a few cm behind furniture, surfaces \
          meeting at an edge), whose visibility the {method} points cannot resolve; {cure}",
-        rows.over,
+        count(rows.over as u64, "element"),
+        if rows.over == 1 { "has" } else { "have" },
         rows.max,
         element_name(scene, mesh, rows.max_row),
     ))

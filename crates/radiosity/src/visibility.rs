@@ -279,13 +279,22 @@ impl PolygonBvh {
         let bvh = &self.bvh;
         let mut state = bvh.new_traversal(Vec3A::ZERO);
         let mut node;
+        // The traversal gives every polygon of a leaf whose node box meets the query; each
+        // is kept only when its own box (in f64) does. Without this the answer depended on
+        // how the hierarchy grouped its leaves, which rounding changes with the scene's
+        // scale (QA of issue #16: the ceiling over a light panel was contact-refined at
+        // `--scale 1` and not at 7.7).
+        let (lo, hi) = (lo - DVec3::splat(pad), hi + DVec3::splat(pad));
         obvhs::traverse!(
             bvh,
             node,
             state,
             node.intersect_aabb(&query, state.oct_inv4),
             {
-                out.push(state.primitive_id);
+                let poly = &self.polygons[state.primitive_id as usize];
+                if poly.lo.cmple(hi).all() && poly.hi.cmpge(lo).all() {
+                    out.push(state.primitive_id);
+                }
             }
         );
     }
@@ -552,6 +561,51 @@ mod tests {
         let mut found = Vec::new();
         bvh.overlapping(dvec3(-1.0, -1.0, -1.0), dvec3(1.0, 1.0, 1.0), &mut found);
         assert_eq!(found.len(), 300);
+    }
+
+    #[test]
+    fn a_box_query_returns_exactly_the_polygons_whose_boxes_meet_it() {
+        // 400 small squares on a 20 x 20 lattice of pitch 1 (0.4 wide); queries of every
+        // size: the answer is the brute-force list, not every polygon of a leaf that the
+        // hierarchy happened to group with one that meets the query (QA of issue #16).
+        let mut polygons = Vec::new();
+        for j in 0..20 {
+            for i in 0..20 {
+                let (x, z) = (i as f64, j as f64);
+                polygons.push(vec![
+                    dvec3(x, 0.0, z),
+                    dvec3(x, 0.0, z + 0.4),
+                    dvec3(x + 0.4, 0.0, z + 0.4),
+                    dvec3(x + 0.4, 0.0, z),
+                ]);
+            }
+        }
+        let ids: Vec<u32> = (0..polygons.len() as u32).collect();
+        let bvh = PolygonBvh::new(&polygons, &ids);
+        let pad = 1e-6 * bvh.scale();
+        for (k, size) in [0.05, 0.3, 0.7, 2.5].into_iter().enumerate() {
+            for q in 0..25 {
+                let lo = dvec3(
+                    0.37 * q as f64 + 0.11 * k as f64,
+                    -0.1,
+                    0.53 * q as f64 + 0.07,
+                );
+                let hi = lo + dvec3(size, 0.2, size);
+                let mut found = Vec::new();
+                bvh.overlapping(lo, hi, &mut found);
+                let mut found: Vec<u32> = found.into_iter().map(|f| bvh.id_of(f)).collect();
+                found.sort_unstable();
+                let expected: Vec<u32> = (0..polygons.len())
+                    .filter(|&p| {
+                        let (plo, phi) = (polygons[p][0], polygons[p][2]);
+                        plo.cmple(hi + DVec3::splat(pad)).all()
+                            && phi.cmpge(lo - DVec3::splat(pad)).all()
+                    })
+                    .map(|p| p as u32)
+                    .collect();
+                assert_eq!(found, expected, "query {lo} .. {hi}");
+            }
+        }
     }
 
     #[test]

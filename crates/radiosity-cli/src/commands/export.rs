@@ -64,10 +64,10 @@ pub fn run(args: ExportArgs) -> Result<()> {
         if !scene.lights.is_empty() {
             let names: Vec<&str> = scene.lights.iter().map(|l| l.name.as_str()).collect();
             errln!(
-                "warning: {} point luminaire(s) left out of {} ({}): glTF and OBJ exports do \
+                "warning: {} left out of {} ({}): glTF and OBJ exports do \
                  not carry LIGHTBEGIN blocks yet, so the file read back has only the emitting \
                  surfaces",
-                names.len(),
+                crate::report::count(names.len() as u64, "point luminaire"),
                 output.display(),
                 names.join(", ")
             );

@@ -660,7 +660,7 @@ fn export_names_the_point_luminaires_it_cannot_write() {
         let err = stderr(&out);
         assert!(out.status.success(), "{err}");
         assert!(
-            err.contains("warning: 2 point luminaire(s) left out of")
+            err.contains("warning: 2 point luminaires left out of")
                 && err.contains("(Down1, Down2)"),
             "{out_name}: {err}"
         );

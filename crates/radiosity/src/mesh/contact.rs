@@ -54,6 +54,14 @@ pub const PROBE_DIRECTIONS: usize = 7;
 /// of two hits at the same distance comes first is rounding.
 pub const PROBE_SLACK: usize = 2;
 
+/// How near another surface must come to an element, in the element's size (the square
+/// root of its area), for it to be probed: 0.15. A light panel 5 cm below the ceiling
+/// buries the ceiling above it (the rays from there meet the panel's back); at a twentieth,
+/// the ceiling's 0.5 m elements in examples/room.scene missed both panels, and its pixel
+/// RMS from the path tracer was 4.61 % against 3.72 % (Cornell box and building_small
+/// unchanged or better: BENCHMARKS.md, "Contact refinement at any scale").
+pub const COVER_REACH: f64 = 0.15;
+
 /// Sample points per element (and per piece) along each axis: 4 x 4.
 const PROBE_GRID: u32 = 4;
 
@@ -61,8 +69,7 @@ const PROBE_GRID: u32 = 4;
 /// multiples of the golden ratio's: 0.0618 and 0.0382). Centres fall on round coordinates
 /// (a leg's outline at z = 0.85 on an element from 0.8 to 1.2): a point exactly on an
 /// outline is buried or not by rounding, so the mesh changed with `--scale` (QA of issue
-/// #16: examples/room.scene meshed to 899 elements, 945 at `--scale 0.999`; with the
-/// back-to-back faces below, 906 at every scale tried but 7.7).
+/// #16: examples/room.scene meshed to 899 elements, 945 at `--scale 0.999`).
 const PROBE_OFFSET: [f64; 2] = [0.061_803_398_874_989_48, 0.038_196_601_125_010_52];
 
 /// What [`refine_contacts`] did.
@@ -198,14 +205,15 @@ impl<'a> Probe<'a> {
             .any(|&t| crate::scene::overlap::covers(self.polygons[t as usize], n, p))
     }
 
-    /// True when another surface reaches within a twentieth of the element's size of it and
-    /// has some part in front of its plane: only then can part of it be buried. (A surface
-    /// wholly behind the plane, or lying in it, cannot cover it; a cover standing further
-    /// off, such as the top of a bottomless box whose sides are far from this element, is
-    /// missed: the scenes' boxes have all six faces.)
+    /// True when another surface reaches within [`COVER_REACH`] of the element's size of
+    /// it and has some part in front of its plane, or is pressed against it face to face:
+    /// only then can part of it be buried. (A surface wholly behind the plane, or lying in
+    /// it, cannot cover it; a cover standing further off, such as the top of a bottomless
+    /// box whose sides are far from this element, is missed: the scenes' boxes have all six
+    /// faces.)
     pub(crate) fn has_cover_nearby(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> bool {
         let size = geometry::polygon_area(corners).sqrt();
-        let reach = 0.05 * size + self.lift;
+        let reach = COVER_REACH * size + self.lift;
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         for &c in corners {
             lo = lo.min(c);
