@@ -208,7 +208,7 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert!(lines[0].starts_with('#'), "{}", lines[0]);
         assert!(
-            lines[0].contains("unit of length being metres (glTF's unit);"),
+            lines[0].contains("unit of length, metres (glTF's unit);"),
             "{}",
             lines[0]
         );

@@ -353,7 +353,8 @@ fn scene_file_scaled_meshes_the_same() {
     let half = read_any_scene(&path, &o).unwrap();
     assert_eq!(
         half.unit,
-        "metres (a .scene file states no unit; metres assumed) x 0.5"
+        "metres, taken as (the file's numbers x 0.5; unscaled, metres (a .scene file \
+         states no unit; metres assumed))"
     );
     // Halving is exact in binary: every coordinate exactly half, the area a quarter.
     assert_eq!(
