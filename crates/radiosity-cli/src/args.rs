@@ -102,7 +102,8 @@ pub struct BuildingArgs {
     /// emit 0.6 of it, bluish.
     #[arg(long, default_value_t = 20.0, value_name = "E")]
     pub light: f64,
-    /// No summary line (rooms, surfaces, size and element count; errors are still printed).
+    /// No summary line (rooms, surfaces, size and element count; errors and warnings are
+    /// still printed).
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -128,12 +129,13 @@ pub struct SceneArgs {
     pub steps: Option<u32>,
     #[command(flatten)]
     pub method: MethodArgs,
-    /// No progress bars, timings or notes (errors are still printed).
+    /// No progress bars, timings or notes (errors and warnings are still printed).
     #[arg(short, long)]
     pub quiet: bool,
-    /// Run even work estimated at hours or more (INTEGRAL_STEPS x element pairs, Monte
-    /// Carlo samples, hemicube resolution, image size x --supersample, --paths), which is
-    /// refused otherwise. Memory limits still hold.
+    /// Run even work estimated at hours or more, which is refused otherwise: element pairs
+    /// x INTEGRAL_STEPS^4 point pairs, Monte Carlo samples, hemicube resolution, and where
+    /// the command draws an image, its pixels x --supersample^2 or --paths. Memory limits
+    /// still hold.
     #[arg(long)]
     pub no_work_limit: bool,
 }

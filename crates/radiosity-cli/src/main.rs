@@ -109,7 +109,7 @@ fn command() -> clap::Command {
             check.mut_arg("quiet", |quiet| {
                 quiet.help(
                     "No progress bars or lines (the report, with its stage times, is still \
-                     printed; errors too)",
+                     printed; errors and warnings too)",
                 )
             })
         })

@@ -136,6 +136,8 @@ pub struct Reporter {
     timings: Mutex<Vec<(Stage, Duration)>>,
     /// What a timed stage worked on, by its index in `timings` ([`Reporter::name_last`]).
     subjects: Mutex<Vec<(usize, String)>>,
+    /// What the stages finishing now work for ([`Reporter::stages_for`]).
+    purpose: Mutex<Option<String>>,
     quiet: bool,
     /// What the solve stage counts (see [`Reporter::solving_with`]).
     solve_counting: Mutex<Option<Counting>>,
@@ -152,6 +154,7 @@ impl Reporter {
             bar: Mutex::new(None),
             timings: Mutex::new(Vec::new()),
             subjects: Mutex::new(Vec::new()),
+            purpose: Mutex::new(None),
             quiet,
             solve_counting: Mutex::new(None),
         }
@@ -185,6 +188,13 @@ impl Reporter {
                 .unwrap()
                 .push((last, subject.to_string()));
         }
+    }
+
+    /// Labels the stages that finish from now on with what they work for, "(dense
+    /// reference)", until called with `None` (QA of issue #16: `compare` printed "solve #1,
+    /// solve #2" for the solver tested and its reference).
+    pub fn stages_for(&self, purpose: Option<&str>) {
+        *self.purpose.lock().unwrap() = purpose.map(|p| format!("({p})"));
     }
 
     /// Stage timings with distinct labels: a stage named by [`Reporter::name_last`] is
@@ -359,7 +369,14 @@ impl Progress for Reporter {
         if let Some(bar) = self.bar.lock().unwrap().take() {
             bar.finish_and_clear();
         }
-        self.timings.lock().unwrap().push((stage, elapsed));
+        let mut timings = self.timings.lock().unwrap();
+        timings.push((stage, elapsed));
+        if let Some(purpose) = self.purpose.lock().unwrap().clone() {
+            self.subjects
+                .lock()
+                .unwrap()
+                .push((timings.len() - 1, purpose));
+        }
     }
 
     fn message(&self, text: &str) {

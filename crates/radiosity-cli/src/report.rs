@@ -483,7 +483,10 @@ pub fn check(
     }
     lying_on(prepared);
     lights(prepared);
-    outln!("MAX_PATCH_AREA    {}", prepared.settings.max_patch_area);
+    outln!(
+        "MAX_PATCH_AREA    {}",
+        significant(prepared.settings.max_patch_area, 6)
+    );
     outln!("INTEGRAL_STEPS    {}", prepared.settings.integral_steps);
     outln!("method            {}", prepared.method());
     outln!("occlusion         {}", prepared.method().occlusion());
@@ -739,7 +742,9 @@ fn where_escaped(
             lost.join(", ")
         },
         all(lost.len(), out_count, out_total),
-        if in_count > 0 {
+        // Only where the line below is printed (QA of issue #16: "less 0.00 % counted
+        // twice below" with nothing below).
+        if !twice.is_empty() {
             format!(
                 ", less {:.2} % counted twice below: {:.2} % escaped",
                 100.0 * in_total,
@@ -905,7 +910,10 @@ pub fn bench_header(
     if !quiet {
         errln!(
             "median of {0}; times in ms; render {1}x{2} at {3}x{3} supersampling; solver {solver_name}; \
-             other: end to end less the stages listed ({BENCH_OTHER})",
+             other: end to end less the stages listed ({BENCH_OTHER}); rays/s: visibility rays \
+             over the form-factor stage, or over the solve stage where the solver computes its \
+             form factors within the solve, - where none is cast (the hemicube's depth \
+             buffer)",
             count(repeat as u64, "run"), width, height, supersample
         );
     }
@@ -923,6 +931,9 @@ pub struct BenchRow {
     pub stages: Vec<f64>,
     /// The form-factor stage (also in `stages`), for the ray rate.
     pub form_factors: f64,
+    /// The solve stage (also in `stages`): the ray rate's time where the solver computes
+    /// its form factors within it.
+    pub solve: f64,
     /// End to end less the stages.
     pub other: f64,
     pub total: f64,
@@ -937,7 +948,7 @@ pub fn bench_row(scene: &str, max_area: Option<f64>, row: &BenchRow) {
     let area = max_area.map_or("scene's".to_string(), |a| a.to_string());
     let stages: Vec<String> = row.stages.iter().map(|s| ms(*s)).collect();
     outln!(
-        "| {scene} | {area} | {} | {} | {} | {} | {} | {} | {} | {:.2} M |",
+        "| {scene} | {area} | {} | {} | {} | {} | {} | {} | {} | {} |",
         row.elements,
         row.steps,
         stages.join(" | "),
@@ -945,8 +956,23 @@ pub fn bench_row(scene: &str, max_area: Option<f64>, row: &BenchRow) {
         ms(row.total),
         ms(row.no_render),
         row.rays,
-        row.rays as f64 / row.form_factors.max(1e-9) / 1e6,
+        rays_per_second(row),
     );
+}
+
+/// The rays/s column: rays over the stage that cast them (QA of issue #16: hierarchical
+/// radiosity's rays over its 0 ms form-factor stage gave "5145996000.00 M").
+fn rays_per_second(row: &BenchRow) -> String {
+    let time = if row.form_factors > 0.0 {
+        row.form_factors
+    } else {
+        row.solve
+    };
+    if row.rays == 0 || time <= 0.0 {
+        "-".to_string()
+    } else {
+        format!("{:.2} M", row.rays as f64 / time / 1e6)
+    }
 }
 
 /// Milliseconds with three significant digits or so.

@@ -287,9 +287,12 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
     if options.max_shots == 0 {
         bail!("--max-shots must be at least 1");
     }
-    if !(options.adapt_contrast > 0.0 && options.adapt_contrast.is_finite()) {
+    // A step is a fraction of the brighter element's luminance, so 1 or more never splits
+    // (QA of issue #16: `--adapt-contrast 2` ran and reported "no visible steps").
+    if !(options.adapt_contrast > 0.0 && options.adapt_contrast < 1.0) {
         bail!(
-            "--adapt-contrast must be a positive number, got {}",
+            "--adapt-contrast {}: give the step that splits, as a fraction of the brighter \
+             element's luminance, a number above 0 and below 1",
             options.adapt_contrast
         );
     }
@@ -341,7 +344,9 @@ pub fn note_scene(prepared: &Prepared, stem: &str, reporter: &Reporter) {
         stem,
         crate::report::count(prepared.scene.surfaces.len() as u64, "surface"),
         crate::report::count(prepared.mesh.len() as u64, "element"),
-        prepared.settings.max_patch_area,
+        // Six digits: an imported scene's total area / 1000 printed with seventeen was
+        // noise (QA of issue #16).
+        crate::report::significant(prepared.settings.max_patch_area, 6),
         prepared.settings.integral_steps
     ));
 }
@@ -442,6 +447,9 @@ pub fn load_scene(
                 imported.unit
             ));
             note_unit(&imported.unit);
+            if let Some(n) = millimetres_perhaps(&imported.file.scene, &imported.unit, scale) {
+                errln!("{}: note: {n}", path.display());
+            }
             if let Some(w) = far_from_origin(&imported.file.scene) {
                 errln!("{}: warning: {w}", path.display());
             }
@@ -491,6 +499,27 @@ const FAR_FROM_ORIGIN: f64 = 1e7;
 
 /// A warning when `scene` lies more than [`FAR_FROM_ORIGIN`] times its size from the
 /// origin (a model in millimetres at map coordinates): its light would be silently wrong.
+/// Above this size in metres (the largest side of the scene's box) a scene read as metres
+/// is more likely a model in millimetres: the Cornell box in millimetres is 559 across.
+const LARGER_THAN_A_BUILDING_M: f64 = 300.0;
+
+/// A note when a scene read as metres, unscaled, is larger than a building (QA of issue
+/// #16: examples/cornell_box.scene, in millimetres, was reported as 1874940 m^2 without a
+/// word).
+fn millimetres_perhaps(scene: &radiosity::scene::Scene, unit: &str, scale: f64) -> Option<String> {
+    if scene.surfaces.is_empty() || scale != 1.0 || !unit.starts_with("metres") {
+        return None;
+    }
+    let (lo, hi) = scene.bounds();
+    let side = (hi - lo).max_element();
+    (side > LARGER_THAN_A_BUILDING_M).then(|| {
+        format!(
+            "the scene is {side:.0} m across, read as metres; if its numbers are millimetres, \
+             --scale 0.001 reads them as metres (the lux and areas in m^2 assume metres)"
+        )
+    })
+}
+
 fn far_from_origin(scene: &radiosity::scene::Scene) -> Option<String> {
     if scene.surfaces.is_empty() {
         return None;

@@ -78,6 +78,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             steps: first.steps,
             stages: (0..BENCH_STAGES.len()).map(stage).collect(),
             form_factors: stage(3),
+            solve: stage(4),
             other,
             total,
             no_render,

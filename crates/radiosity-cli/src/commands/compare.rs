@@ -21,6 +21,8 @@ pub fn run(args: CompareArgs) -> Result<()> {
         prepare_solve_with_reference(&args.scene, &args.solve, &reporter)?;
     let reset = reset_peak_memory();
     let start = std::time::Instant::now();
+    let tested = format!("{}, tested", solver.kind().name());
+    reporter.stages_for(Some(&tested));
     let (solution, _) = solve_scene(
         &prepared,
         solver,
@@ -34,6 +36,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
         &mut |_| ControlFlow::Continue(()),
         &reporter,
     )?;
+    reporter.stages_for(None);
     let seconds = start.elapsed().as_secs_f64();
     let peak = Peak {
         bytes: peak_memory_bytes(),
@@ -49,6 +52,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
             )),
             Ok(()) => {
                 reporter.solving_with(&dense);
+                reporter.stages_for(Some("dense reference"));
                 let start = std::time::Instant::now();
                 let exact = pipeline::solve(
                     &prepared,
@@ -56,6 +60,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
                     &mut keep_going,
                     &reporter,
                 )?;
+                reporter.stages_for(None);
                 let seconds = start.elapsed().as_secs_f64();
                 let emission = prepared.light.emission();
                 let difference = radiosity::compare::compare(

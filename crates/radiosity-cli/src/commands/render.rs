@@ -54,6 +54,16 @@ pub fn check(args: &RenderArgs) -> Result<Checked> {
             output.display()
         );
     }
+    if format == ImageFormat::Exr {
+        // Printed even with --quiet, as every flag the run ignores (QA of issue #16: only a
+        // suffix of the "wrote" line said so).
+        if args.tone.exposure != radiosity::shade::Exposure::Auto {
+            errln!("warning: --exposure ignored: an .exr holds linear radiance, not exposed");
+        }
+        if args.tone.gamma != 2.2 {
+            errln!("warning: --gamma ignored: an .exr holds linear radiance, without gamma");
+        }
+    }
     if args.false_colour {
         if format == ImageFormat::Exr {
             bail!(

@@ -1176,7 +1176,11 @@ fn flag_numbers_are_refused_before_the_scene_is_read() {
         ),
         (
             vec!["render", "absent.scene", "--adapt-contrast", "0"],
-            "--adapt-contrast must be a positive number",
+            "--adapt-contrast 0: give the step that splits",
+        ),
+        (
+            vec!["render", "absent.scene", "--adapt-contrast", "2"],
+            "a number above 0 and below 1",
         ),
         (
             vec!["check", "absent.scene", "--min-area", "inf"],
@@ -1689,5 +1693,86 @@ fn hierarchical_leaves_are_explained_beside_the_element_count() {
         err.contains("leaves (the elements of its solution"),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn second_pass_findings_are_said() {
+    // QA of issue #16, second pass: a scene in millimetres read as metres, an .exr with
+    // --exposure and --gamma, compare's two solves, and bench's rays/s with no
+    // form-factor stage.
+    let dir = scratch_dir("second-pass");
+    let err = stderr(&radiosity(
+        &[
+            "check",
+            &crate::fixtures::example("cornell_box.scene"),
+            "--max-area",
+            "20000",
+        ],
+        &dir,
+    ));
+    assert!(
+        err.contains("note: the scene is 559 m across, read as metres")
+            && err.contains("--scale 0.001"),
+        "{err}"
+    );
+    let args = [
+        "render",
+        "--max-area",
+        "20000",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--exposure",
+        "2",
+        "--gamma",
+        "1.8",
+        "-o",
+        "e.exr",
+    ];
+    let out = radiosity(&args, &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: --exposure ignored: an .exr"),
+        "{err}"
+    );
+    assert!(err.contains("warning: --gamma ignored: an .exr"), "{err}");
+    let args = ["compare", "--max-area", "20000", "--solver", "progressive"];
+    let err = stderr(&radiosity(&args, &dir));
+    let timings = err.lines().find(|l| l.starts_with("timings:")).unwrap();
+    assert!(
+        timings.contains("solve (progressive, tested)")
+            && timings.contains("solve (dense reference)")
+            && !timings.contains('#'),
+        "{timings}"
+    );
+    let args = [
+        "bench",
+        "--max-area",
+        "20000",
+        "--solver",
+        "hierarchical",
+        "--repeat",
+        "1",
+        "--width",
+        "8",
+        "--height",
+        "8",
+    ];
+    let out = radiosity(&args, &dir);
+    let row = crate::fixtures::stdout(&out);
+    let row = row.lines().last().unwrap();
+    let rate: f64 = row
+        .trim_end_matches(" M |")
+        .rsplit("| ")
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap_or_else(|e| panic!("{e}: {row}"));
+    // Hierarchical radiosity casts its rays in the solve stage: tens of M rays/s on this
+    // machine, not the billions a 0 ms form-factor stage gave.
+    assert!(rate > 0.01 && rate < 1000.0, "{row}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

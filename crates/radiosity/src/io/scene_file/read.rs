@@ -51,7 +51,8 @@ fn location(file: &str, line: usize, column: usize) -> String {
 
 /// Every problem found in a scene file, in file order (at least one).
 ///
-/// Displays as one [`ParseError`] per line followed by a line with the count.
+/// Displays as one [`ParseError`] per line, followed by a line with the count where there
+/// are several.
 #[derive(Clone, Debug, PartialEq, Eq, Error)]
 #[error("{}", render(errors))]
 pub struct SceneError {
@@ -59,15 +60,14 @@ pub struct SceneError {
     pub errors: Vec<ParseError>,
 }
 
-/// The errors one per line, then `N error(s)`.
+/// The errors one per line, then `N errors` where there are several (QA of issue #16: a
+/// missing file's one line was followed by a stray "1 error").
 fn render(errors: &[ParseError]) -> String {
-    let mut text = String::new();
-    for e in errors {
-        text.push_str(&e.to_string());
-        text.push('\n');
+    let lines: Vec<String> = errors.iter().map(|e| e.to_string()).collect();
+    let mut text = lines.join("\n");
+    if errors.len() > 1 {
+        text.push_str(&format!("\n{} errors", errors.len()));
     }
-    let plural = if errors.len() == 1 { "" } else { "s" };
-    text.push_str(&format!("{} error{plural}", errors.len()));
     text
 }
 

@@ -511,8 +511,7 @@ fn error_display() {
     let err = parse_scene(&with_line(11, "Rg abc"), "room.scene").unwrap_err();
     assert_eq!(
         err.to_string(),
-        "room.scene:11:4: error: expected a number after \"Rg\", found \"abc\"\n\
-         1 error"
+        "room.scene:11:4: error: expected a number after \"Rg\", found \"abc\""
     );
     let err = parse_scene(&with_lines(&[(10, "Rr 3"), (11, "Rg 3")]), "room.scene").unwrap_err();
     let text = err.to_string();
