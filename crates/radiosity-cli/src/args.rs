@@ -367,8 +367,9 @@ pub struct CameraArgs {
 /// would count edge aliasing as error.)
 #[derive(Args)]
 pub struct RayArgs {
-    /// Rays per pixel along each axis, at most: 2 or more antialiases edges. An even N above
-    /// 2 is adaptive (see --adaptive-contrast); 1 casts one ray through each pixel centre.
+    /// Rays per pixel along each axis, at most (1 to 16): 2 or more antialiases edges. An
+    /// even N above 2 is adaptive (see --adaptive-contrast); 1 casts one ray through each
+    /// pixel centre.
     #[arg(long, default_value_t = 8, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
     pub supersample: u32,
     /// Adaptive antialiasing (an even --supersample N above 2, smooth or flat shading): each

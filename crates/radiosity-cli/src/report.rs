@@ -134,6 +134,14 @@ fn zero_rows_text(scene: &Scene, mesh: &Mesh, stats: &FormFactorStats) -> Option
     if rows.zero == 0 {
         return None;
     }
+    if scene.surfaces.len() == 1 {
+        // QA of issue #16: a lone triangle got the furniture explanation.
+        return Some(format!(
+            "row sums: {} no other element: the scene is one flat surface, and a plane \
+             does not see itself",
+            count(rows.zero as u64, "element") + if rows.zero == 1 { " sees" } else { " see" },
+        ));
+    }
     Some(format!(
         "row sums: {} {} no other element (row sum 0; the first is {}): faces \
          pressed against another surface, such as the base of furniture standing on the floor \

@@ -698,10 +698,19 @@ pub fn ray_settings(rays: &RayArgs, shading_arg: ShadingArg) -> RenderSettings {
     let adaptive = n > 2 && n % 2 == 0 && shading_arg != ShadingArg::Wireframe;
     if !adaptive && rays.adaptive_contrast != RayArgs::ADAPTIVE_CONTRAST {
         // Printed even with --quiet: the run does not do what the flags say.
-        errln!(
-            "warning: --adaptive-contrast ignored: adaptive antialiasing takes an even \
-             --supersample above 2 (given {n}) and smooth or flat shading"
-        );
+        // The reason that holds (QA of issue #16: a wireframe's warning pointed at
+        // --supersample 8, which is even).
+        if shading_arg == ShadingArg::Wireframe {
+            errln!(
+                "warning: --adaptive-contrast ignored: a wireframe is drawn without adaptive \
+                 antialiasing (it takes smooth or flat shading)"
+            );
+        } else {
+            errln!(
+                "warning: --adaptive-contrast ignored: adaptive antialiasing takes an even \
+                 --supersample above 2 (given {n})"
+            );
+        }
     }
     if rays.direct_light != DirectLightArg::Gather && shading_arg != ShadingArg::Smooth {
         // QA of issue #16: --direct-light mesh with --shading flat ran without a word.
@@ -850,6 +859,30 @@ fn image_size(args: &CameraArgs) -> Result<()> {
             args.width,
             args.height
         );
+    }
+    Ok(())
+}
+
+/// Refuses, before the scene is read, the camera flags that are wrong whatever the scene:
+/// the image size, `--fov` outside (0, 180), a zero or infinite `--up`, `--eye` equal to
+/// `--look-at` (QA of issue #16: these came after the scene was read and meshed, where
+/// `--gamma` and `--exposure` came before). [`camera`] checks them again with the scene.
+pub fn check_camera_flags(args: &CameraArgs) -> Result<()> {
+    image_size(args)?;
+    if let Some(fov) = args.fov {
+        if !(fov > 0.0 && fov < 180.0) {
+            bail!("--fov must be more than 0 and less than 180 degrees, got {fov}");
+        }
+    }
+    if let Some(up) = args.up {
+        if !(up.length().is_finite() && up.length() > 0.0) {
+            bail!("--up must be a direction of finite, non-zero length, got {up}");
+        }
+    }
+    if let (Some(eye), Some(at)) = (args.eye, args.look_at) {
+        if eye == at {
+            bail!("--eye and --look-at must differ");
+        }
     }
     Ok(())
 }

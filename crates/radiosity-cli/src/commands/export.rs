@@ -76,6 +76,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
     if format == Format::Obj {
         return export_obj(&args, &reporter, warn_lights);
     }
+    crate::setup::check_camera_flags(&args.camera)?;
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     warn_lights(&prepared.scene);
     let camera = camera(&args.camera, &prepared.scene)?;

@@ -79,6 +79,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         check_exr(path)?;
     }
 
+    setup::check_camera_flags(&args.camera)?;
     // The scene: meshed and with its solver for --compare, as it is for the path tracer.
     let prepared = if args.compare {
         Some(prepare_solve(&args.scene, &args.solve, &reporter)?)

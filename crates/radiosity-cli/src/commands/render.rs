@@ -89,6 +89,7 @@ pub fn check(args: &RenderArgs) -> Result<Checked> {
     }
     check_scene_flags(&args.scene)?;
     check_solve_flags(&args.solve)?;
+    crate::setup::check_camera_flags(&args.camera)?;
     Ok(Checked {
         output,
         settings,

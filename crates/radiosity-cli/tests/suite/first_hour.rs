@@ -1776,3 +1776,44 @@ fn second_pass_findings_are_said() {
     assert!(rate > 0.01 && rate < 1000.0, "{row}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn camera_flags_are_refused_before_the_scene_is_read() {
+    // QA of issue #16: --fov 180 and --up 0,0,0 came after the scene was read and meshed.
+    let dir = scratch_dir("camera-early");
+    for (args, needle) in [
+        (
+            vec!["render", "absent.scene", "--fov", "180"],
+            "--fov must be more than 0",
+        ),
+        (
+            vec!["pathtrace", "absent.scene", "--up", "0,0,0"],
+            "--up must be a direction",
+        ),
+        (
+            vec!["export", "absent.scene", "-o", "a.glb", "--fov", "0"],
+            "--fov must be",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(
+            !err.contains("absent.scene"),
+            "{args:?} read the scene first: {err}"
+        );
+    }
+    // A lone surface's zero rows get their own reason, not the furniture's.
+    std::fs::write(
+        dir.join("tri.scene"),
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 2\nSCENEBEGIN\nPATCHBEGIN\n#T\nVERTICES 3\nEr 1\n\
+         Eg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 0 1 0\n\
+         PATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    let text = crate::fixtures::stdout(&radiosity(&["check", "tri.scene"], &dir));
+    assert!(text.contains("the scene is one flat surface"), "{text}");
+    assert!(!text.contains("furniture"), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

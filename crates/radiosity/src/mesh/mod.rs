@@ -128,9 +128,10 @@ pub enum MeshError {
     /// The subdivision would make more elements than the limit.
     #[error(
         "meshing with MAX_PATCH_AREA = {} would make {} elements, more than the \
-         limit of {limit}; raise MAX_PATCH_AREA to at least {suggested:.3e}",
+         limit of {limit}; raise MAX_PATCH_AREA to at least {}",
         compact(*max_area),
-        if *count == u64::MAX { "more than 1.8e19".to_string() } else { count.to_string() }
+        if *count == u64::MAX { "more than 1.8e19".to_string() } else { count.to_string() },
+        four_digits_up(*suggested)
     )]
     TooManyElements {
         /// The requested maximum element area.
@@ -146,6 +147,23 @@ pub enum MeshError {
 
 /// `x` as Rust writes it where that is short (1e-4 to 1e15 in magnitude, or 0), else with
 /// an exponent: a MAX_PATCH_AREA of 1e-300 is not three hundred zeros.
+/// `x` rounded up to four significant digits, plainly written where it is an everyday
+/// number: a value to type back (QA of issue #16: "at least 2.522e-1").
+fn four_digits_up(x: f64) -> String {
+    if !(x.is_finite() && x > 0.0) {
+        return compact(x);
+    }
+    let step = 10f64.powf(x.log10().floor() - 3.0);
+    let up = (x / step).ceil() * step;
+    // Printed from the digits, so no float noise (0.25220000000000004) shows.
+    let decimals = (3.0 - x.log10().floor()).max(0.0) as usize;
+    if (1e-4..1e15).contains(&up) {
+        format!("{up:.decimals$}")
+    } else {
+        format!("{up:.3e}")
+    }
+}
+
 fn compact(x: f64) -> String {
     if x == 0.0 || (1e-4..1e15).contains(&x.abs()) {
         format!("{x}")
