@@ -104,6 +104,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         illuminance::illuminance_with_progress(&prepared, &solution, &scaled, &reporter)
     });
     write(&args, &points, &lux)?;
+    if let Some(w) = dark_points(&points, &lux) {
+        // Printed even with --quiet: figures that are surely not what was meant.
+        errln!("warning: {w}");
+    }
     reporter.note(&format!(
         "wrote {} ({}; {}; the scene's unit: {})",
         args.output.display(),
@@ -128,6 +132,30 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     }
     reporter.print_timings();
     Ok(())
+}
+
+/// A warning when some points get no light at all (QA of issue #16: points inside the
+/// cupboard, under the floor and outside the room gave 0 lx without a word, and spoiled a
+/// grid's minimum and uniformity).
+fn dark_points(points: &[CalcPoint], lux: &[illuminance::Lux]) -> Option<String> {
+    let dark: Vec<&CalcPoint> = points
+        .iter()
+        .zip(lux)
+        .filter(|(_, l)| l.total == 0.0)
+        .map(|(p, _)| p)
+        .collect();
+    let first = dark.first()?;
+    Some(format!(
+        "{} of {} get no light at all, 0 lx (the first: \"{}\" at {},{},{}): inside \
+         furniture, under the floor or outside the scene? A meter there sees only the backs \
+         of faces, or nothing; a grid's minimum and uniformity count them",
+        crate::report::count(dark.len() as u64, "point"),
+        points.len(),
+        first.name,
+        first.position.x,
+        first.position.y,
+        first.position.z
+    ))
 }
 
 /// Why a `--grid` is refused, with what would fit: corners that differ in all three axes,

@@ -1817,3 +1817,34 @@ fn camera_flags_are_refused_before_the_scene_is_read() {
     assert!(!text.contains("furniture"), "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn points_that_get_no_light_are_warned_of() {
+    // QA of issue #16: points under the floor or outside the room gave 0 lx without a word.
+    let dir = scratch_dir("dark-points");
+    std::fs::write(
+        dir.join("p.csv"),
+        "name,x,y,z,nx,ny,nz\nlit,2.5,1,2,0,1,0\nbelow,2.5,-1,2,0,1,0\nout,20,1,2,0,1,0\n",
+    )
+    .unwrap();
+    let room = crate::fixtures::example("room.scene");
+    let args = [
+        "illuminance",
+        &room,
+        "--points",
+        "p.csv",
+        "-o",
+        "l.csv",
+        "-q",
+        "--max-area",
+        "1",
+    ];
+    let out = radiosity(&args, &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: 2 points of 3 get no light at all, 0 lx (the first: \"below\""),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
