@@ -577,9 +577,9 @@ pub fn check(
         }
         SolutionReport::Progressive(report) => {
             outln!(
-                "progressive       {}; unshot power {:.2e} of emitted; ambient {:.3e} / {:.3e} / {:.3e}",
+                "progressive       {}; unshot power {:.3} % of emitted; ambient {:.3e} / {:.3e} / {:.3e}",
                 count(report.shots as u64, "shot"),
-                report.unshot_fraction,
+                100.0 * report.unshot_fraction,
                 report.ambient[0],
                 report.ambient[1],
                 report.ambient[2]

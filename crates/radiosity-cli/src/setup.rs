@@ -90,7 +90,7 @@ fn prepare_solve_as(
     ) {
         // Printed even with --quiet: the run does not do what the flags say.
         errln!(
-            "warning: --method {method} is ignored: hierarchical radiosity computes each \
+            "warning: --method {method} ignored: hierarchical radiosity computes each \
              link's form factor by its own estimate (point-to-polygon with visibility rays), \
              not by a form-factor method; use --solver gauss-seidel or lu for --method {method}"
         );
@@ -608,9 +608,7 @@ fn solver(
         SolverKind::Lu => {
             if options.tolerance.is_some() {
                 // Printed even with --quiet: the run does not do what the flags say.
-                errln!(
-                    "warning: --tolerance is ignored: the LU solver solves directly, to rounding"
-                );
+                errln!("warning: --tolerance ignored: the LU solver solves directly, to rounding");
             }
             Solver::LU
         }

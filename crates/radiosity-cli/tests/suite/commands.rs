@@ -578,7 +578,11 @@ fn compare_prints_a_row_against_the_chosen_dense_reference() {
     assert_eq!(cells[7], "contour k=2", "{row}");
     // --method is the reference's here: no warning that hierarchical radiosity ignores it
     // (warnings print even with --quiet).
-    assert!(!stderr(&out).contains("is ignored"), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("--method contour ignored"),
+        "{}",
+        stderr(&out)
+    );
     let rms: f64 = cells[10].parse().unwrap_or_else(|_| panic!("RMS in {row}"));
     // The coarse box (about 130 elements) at epsilon 0.01: a few per cent; a broken
     // projection or reference gives tens of per cent.

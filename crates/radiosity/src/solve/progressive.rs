@@ -300,8 +300,8 @@ pub fn solve_progressive(
         elapsed: start.elapsed(),
     };
     progress.message(&format!(
-        "progressive refinement ({method}): {n} elements, {shots} shots, unshot power {:.2e} of emitted, {} visibility rays, {:.3} s{}",
-        report.unshot_fraction,
+        "progressive refinement ({method}): {n} elements, {shots} shots, unshot power {:.3} % of emitted, {} visibility rays, {:.3} s{}",
+        100.0 * report.unshot_fraction,
         report.rays,
         report.elapsed.as_secs_f64(),
         if stopped { " (stopped early)" } else { "" }
