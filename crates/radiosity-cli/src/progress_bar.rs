@@ -198,36 +198,42 @@ impl Reporter {
     }
 
     /// Stage timings with distinct labels: a stage named by [`Reporter::name_last`] is
-    /// labelled with what it worked on, "write out.png"; another that ran more than once
-    /// (the solves of adaptive subdivision) is numbered, "solve #2".
+    /// labelled with what it worked on, "write out.png"; a label that still occurs more
+    /// than once (the solves of adaptive subdivision) is numbered, "solve #2", "solve
+    /// (gauss-seidel, tested) #2".
     pub fn labelled_timings(&self) -> Vec<(String, Duration)> {
         let timings = self.timings();
         let subjects = self.subjects.lock().unwrap().clone();
-        let mut seen: Vec<(Stage, usize)> = Vec::new();
-        timings
+        let labels: Vec<String> = timings
             .iter()
             .enumerate()
-            .map(|(i, &(stage, d))| {
-                let runs = timings.iter().filter(|t| t.0 == stage).count();
-                let subject = subjects.iter().rev().find(|s| s.0 == i);
-                let label = if let Some((_, subject)) = subject {
-                    format!("{} {subject}", stage.name())
-                } else if runs > 1 {
-                    let k = match seen.iter_mut().find(|s| s.0 == stage) {
-                        Some(s) => {
-                            s.1 += 1;
-                            s.1
-                        }
-                        None => {
-                            seen.push((stage, 1));
-                            1
-                        }
-                    };
-                    format!("{} #{k}", stage.name())
-                } else {
-                    stage.name().to_string()
+            .map(
+                |(i, &(stage, _))| match subjects.iter().rev().find(|s| s.0 == i) {
+                    Some((_, subject)) => format!("{} {subject}", stage.name()),
+                    None => stage.name().to_string(),
+                },
+            )
+            .collect();
+        let mut seen: Vec<(&str, usize)> = Vec::new();
+        labels
+            .iter()
+            .zip(&timings)
+            .map(|(label, &(_, d))| {
+                let runs = labels.iter().filter(|l| *l == label).count();
+                if runs == 1 {
+                    return (label.clone(), d);
+                }
+                let k = match seen.iter_mut().find(|s| s.0 == label) {
+                    Some(s) => {
+                        s.1 += 1;
+                        s.1
+                    }
+                    None => {
+                        seen.push((label, 1));
+                        1
+                    }
                 };
-                (label, d)
+                (format!("{label} #{k}"), d)
             })
             .collect()
     }

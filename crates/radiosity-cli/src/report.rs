@@ -577,7 +577,7 @@ pub fn check(
         }
         SolutionReport::Progressive(report) => {
             outln!(
-                "progressive       {}; unshot power {:.3} % of emitted; ambient {:.3e} / {:.3e} / {:.3e}",
+                "progressive       {}; unshot power {:.3} % of emitted (the band with the most left); ambient {:.3e} / {:.3e} / {:.3e}",
                 count(report.shots as u64, "shot"),
                 100.0 * report.unshot_fraction,
                 report.ambient[0],
@@ -597,19 +597,40 @@ pub fn check(
             String::new()
         }
     };
-    outln!(
-        "energy ({})        emitted {} = absorbed {}{} + escaped {}{} (relative error {:.1e})",
-        BAND_NAMES[k],
-        significant(b.emitted[k], 7),
-        significant(b.absorbed[k], 7),
-        share(b.absorbed[k]),
-        significant(b.escaped[k], 7),
-        share(b.escaped[k]),
-        b.relative_error()
-    );
-    if band.is_some() {
+    if let SolutionReport::Progressive(_) = solution.report {
+        // A progressive solve holds the power it has not shot yet: the third term, by
+        // difference, in the same band (QA of issue #16: a capped run's "relative error
+        // 5.4e-1" was the unshot power, explained lines further down).
+        let unshot = b.emitted[k] - b.absorbed[k] - b.escaped[k];
         outln!(
-            "                  (escaped: {}; {} is the band emitting most)",
+            "energy ({})        emitted {} = absorbed {}{} + escaped {}{} + not yet shot {}{} \
+             (progressive refinement: the power still to shoot, by difference)",
+            BAND_NAMES[k],
+            significant(b.emitted[k], 7),
+            significant(b.absorbed[k], 7),
+            share(b.absorbed[k]),
+            significant(b.escaped[k], 7),
+            share(b.escaped[k]),
+            significant(unshot, 7),
+            share(unshot),
+        );
+    } else {
+        outln!(
+            "energy ({})        emitted {} = absorbed {}{} + escaped {}{} (relative error {:.1e})",
+            BAND_NAMES[k],
+            significant(b.emitted[k], 7),
+            significant(b.absorbed[k], 7),
+            share(b.absorbed[k]),
+            significant(b.escaped[k], 7),
+            share(b.escaped[k]),
+            b.relative_error()
+        );
+    }
+    if band.is_some() {
+        let (_, area_unit) = length_and_area_units();
+        outln!(
+            "                  (powers: exitance E times {area_unit}, so W or lm where E is in \
+             W/m^2 or lm/m^2 and lengths in metres; escaped: {}; {} is the band emitting most)",
             escaped_meaning(100.0 * b.escaped[k] / b.emitted[k]),
             BAND_NAMES[k]
         );
@@ -631,14 +652,10 @@ pub fn check(
         }
         _ => {}
     }
-    if let SolutionReport::Progressive(_) = solution.report {
-        outln!(
-            "                  (progressive: the unshot power is neither absorbed nor escaped yet)"
-        );
-    }
     outln!("stage times:");
     for (stage, d) in reporter.labelled_timings() {
-        outln!("  {:<14}{}", stage, format_duration(d));
+        // At least one space after a long label ("parse room.scene"; QA of issue #16).
+        outln!("  {:<13} {}", stage, format_duration(d));
     }
 }
 
@@ -926,7 +943,7 @@ pub fn bench_header(
         );
     }
     outln!(
-        "| scene | max area | elements | k | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
+        "| scene | max area | elements | method | parse | mesh | bvh | form factors | solve | shade | render | other | end to end | end to end less render | visibility rays | rays/s |"
     );
     outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
 }
@@ -934,7 +951,9 @@ pub fn bench_header(
 /// A row of the `bench` table: medians over the runs of one configuration, in seconds.
 pub struct BenchRow {
     pub elements: usize,
-    pub steps: u32,
+    /// The form-factor method and its setting, as `check` names it ("area k=2",
+    /// "hemicube resolution=128").
+    pub method: String,
     /// Each stage, in the table's order (parse to render).
     pub stages: Vec<f64>,
     /// The form-factor stage (also in `stages`), for the ray rate.
@@ -958,7 +977,7 @@ pub fn bench_row(scene: &str, max_area: Option<f64>, row: &BenchRow) {
     outln!(
         "| {scene} | {area} | {} | {} | {} | {} | {} | {} | {} | {} |",
         row.elements,
-        row.steps,
+        row.method,
         stages.join(" | "),
         ms(row.other),
         ms(row.total),

@@ -139,12 +139,20 @@ pub enum ViewerError {
 /// out of the message.
 fn window_error(e: eframe::Error) -> ViewerError {
     let text = e.to_string();
+    if text.contains("nor DISPLAY is set") {
+        return ViewerError::NoDisplay;
+    }
     if text.contains("open connection to X server") {
         return ViewerError::DisplayUnreachable {
             display: std::env::var("DISPLAY").unwrap_or_default(),
         };
     }
-    ViewerError::Window(strip_source_location(&text))
+    // The message goes before ". Tried winit": no second full stop.
+    ViewerError::Window(
+        strip_source_location(&text)
+            .trim_end_matches('.')
+            .to_string(),
+    )
 }
 
 /// "os error at /path/file.rs:12: message" -> "os error: message".
@@ -161,10 +169,10 @@ fn strip_source_location(text: &str) -> String {
 /// Opens the window and runs until it is closed; returns notes to print (where the
 /// screenshot went).
 pub fn run(options: ViewerOptions) -> Result<Vec<String>, ViewerError> {
-    if cfg!(target_os = "linux")
-        && std::env::var_os("DISPLAY").is_none()
-        && std::env::var_os("WAYLAND_DISPLAY").is_none()
-    {
+    // An empty variable is no display either (QA of issue #16: `DISPLAY= view` got winit's
+    // "neither WAYLAND_DISPLAY nor DISPLAY is set" with GPU advice).
+    let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+    if cfg!(target_os = "linux") && !set("DISPLAY") && !set("WAYLAND_DISPLAY") {
         return Err(ViewerError::NoDisplay);
     }
     // Fail early, with the adapter search spelled out, when there is no adapter at all.

@@ -75,7 +75,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         );
         let row = BenchRow {
             elements: first.elements,
-            steps: first.steps,
+            method: first.method.clone(),
             stages: (0..BENCH_STAGES.len()).map(stage).collect(),
             form_factors: stage(3),
             solve: stage(4),
@@ -92,7 +92,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
 /// One timed run of the whole pipeline.
 struct BenchRun {
     elements: usize,
-    steps: u32,
+    method: String,
     /// Seconds per stage, in the order of [`BENCH_STAGES`].
     stages: [f64; BENCH_STAGES.len()],
     /// Wall-clock seconds from before parsing to the rendered image.
@@ -188,7 +188,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
     }
     Ok(BenchRun {
         elements: solution.mesh.len(),
-        steps: prepared.settings.integral_steps,
+        method: prepared.method().to_string(),
         stages,
         total,
         rays,

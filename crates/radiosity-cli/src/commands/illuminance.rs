@@ -53,7 +53,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
                 bail!("--grid needs --normal NX,NY,NZ, the way the meters face");
             };
             if normal.length_squared() == 0.0 {
-                bail!("--normal 0,0,0 is no direction; give the way the meters face, e.g. 0,0,1");
+                bail!(
+                    "--normal 0,0,0 is no direction; give the way the meters face: 0,0,1 for a \
+                     horizontal work plane in a z-up scene, 0,1,0 in a y-up one"
+                );
             }
             let Some((points, dims)) = illuminance::grid(a, b, spacing, normal, MAX_GRID_POINTS)
             else {
@@ -103,8 +106,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     let lux = run_stage(&reporter, Stage::Illuminance, points.len() as u64, || {
         illuminance::illuminance_with_progress(&prepared, &solution, &scaled, &reporter)
     });
-    write(&args, &points, &lux)?;
-    if let Some(w) = dark_points(&points, &lux) {
+    crate::progress_bar::run_file_stage(&reporter, Stage::Write, &args.output, || {
+        write(&args, &points, &lux)
+    })?;
+    if let Some(w) = dark_points(&points, &lux, args.grid.is_some()) {
         // Printed even with --quiet: figures that are surely not what was meant.
         errln!("warning: {w}");
     }
@@ -121,8 +126,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
             .grid
             .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing));
         let img = illuminance::grid_picture_with_axes(&totals, dims, axes);
-        radiosity::io::png::write_png(&img, png)
-            .with_context(|| format!("cannot write {}", png.display()))?;
+        crate::progress_bar::run_file_stage(&reporter, Stage::Write, png, || {
+            radiosity::io::png::write_png(&img, png)
+        })
+        .with_context(|| format!("cannot write {}", png.display()))?;
         reporter.note(&format!(
             "wrote {} ({} x {} cells)",
             png.display(),
@@ -137,7 +144,7 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
 /// A warning when some points get no light at all (QA of issue #16: points inside the
 /// cupboard, under the floor and outside the room gave 0 lx without a word, and spoiled a
 /// grid's minimum and uniformity).
-fn dark_points(points: &[CalcPoint], lux: &[illuminance::Lux]) -> Option<String> {
+fn dark_points(points: &[CalcPoint], lux: &[illuminance::Lux], grid: bool) -> Option<String> {
     let dark: Vec<&CalcPoint> = points
         .iter()
         .zip(lux)
@@ -146,15 +153,21 @@ fn dark_points(points: &[CalcPoint], lux: &[illuminance::Lux]) -> Option<String>
         .collect();
     let first = dark.first()?;
     Some(format!(
-        "{} of {} get no light at all, 0 lx (the first: \"{}\" at {},{},{}): inside \
+        "{} of {} {} no light at all, 0 lx (the first: \"{}\" at {},{},{}): inside \
          furniture, under the floor or outside the scene? A meter there sees only the backs \
-         of faces, or nothing; a grid's minimum and uniformity count them",
+         of faces, or nothing{}",
         crate::report::count(dark.len() as u64, "point"),
         points.len(),
+        if dark.len() == 1 { "gets" } else { "get" },
         first.name,
         first.position.x,
         first.position.y,
-        first.position.z
+        first.position.z,
+        if grid {
+            "; the grid's minimum and uniformity count them"
+        } else {
+            ""
+        }
     ))
 }
 

@@ -220,6 +220,24 @@ pub fn exposure_note(
             100.0 * AUTO_EXPOSURE_TOP_AREA,
         );
     }
+    let any_unlit = mesh.elements.iter().any(|el| {
+        prepared
+            .scene
+            .surfaces
+            .get(el.surface as usize)
+            .is_some_and(|s| s.emission.max_band() <= 0.0)
+    });
+    if !any_unlit {
+        // The rule's fallback, said as such (QA of issue #16: a lone emitting triangle was
+        // given "the brightest non-emitting element").
+        return format!(
+            "exposure scale {} (auto: every surface emits, so the mean radiosity of the \
+             brightest {} % of the whole area, {:.4}, is white)",
+            crate::report::significant(scale, 4),
+            100.0 * AUTO_EXPOSURE_TOP_AREA,
+            1.0 / scale,
+        );
+    }
     format!(
         "exposure scale {} (auto: {:.4}, the mean radiosity of the brightest {} % of \
          the non-emitting area, is white; the brightest non-emitting element is {:.4}, \

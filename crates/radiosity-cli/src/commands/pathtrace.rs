@@ -141,10 +141,15 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         let ignored: Vec<&str> = render_given.iter().filter(|g| g.1).map(|g| g.0).collect();
         if !ignored.is_empty() {
             errln!(
-                "warning: {} ignored without --compare: they set the radiosity render \
+                "warning: {} ignored without --compare: {} the radiosity render \
                  --compare draws beside the path-traced view (the path tracer averages over \
                  each pixel with --paths)",
-                ignored.join(", ")
+                ignored.join(", "),
+                if ignored.len() == 1 {
+                    "it sets"
+                } else {
+                    "they set"
+                }
             );
         }
         None

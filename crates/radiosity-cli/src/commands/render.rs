@@ -327,9 +327,11 @@ fn false_colour(
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
     reporter.note(&format!(
-        "wrote {} ({} x {} and a {} pixel scale bar; false colour from 0 to {} lx, the \
-         largest element illuminance is {} lx; {})",
+        "wrote {} ({} x {}: the {} x {} view and a {} pixel wide scale bar; false colour \
+         from 0 to {} lx, the largest element illuminance is {} lx; {})",
         output.display(),
+        image.width(),
+        image.height(),
         camera.width,
         camera.height,
         radiosity::illuminance::SCALE_BAR_WIDTH,

@@ -195,7 +195,7 @@ fn check_gives_the_reason_beside_odd_row_sums_and_the_escaped_share() {
     // is.
     assert!(text.contains(" %) + escaped "), "{text}");
     assert!(
-        text.contains("(escaped: light that reached no element"),
+        text.contains("escaped: light that reached no element"),
         "{text}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
@@ -1846,5 +1846,83 @@ fn points_that_get_no_light_are_warned_of() {
         err.contains("warning: 2 points of 3 get no light at all, 0 lx (the first: \"below\""),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn third_pass_findings_are_said() {
+    // QA of issue #16, third pass: a capped progressive solve's energy account balances
+    // with its unshot power; `check`'s stage table keeps a space after a file's name;
+    // repeated stages of one purpose are numbered; bench names the method; a lone
+    // emitting surface's exposure is said to be the fallback.
+    let dir = scratch_dir("third-pass");
+    let paper = crate::fixtures::example("paper196.scene");
+    let out = radiosity(
+        &[
+            "check",
+            &paper,
+            "--solver",
+            "progressive",
+            "--max-shots",
+            "40",
+        ],
+        &dir,
+    );
+    let text = crate::fixtures::stdout(&out);
+    let energy = text.lines().find(|l| l.starts_with("energy (R)")).unwrap();
+    let emitted = number_after(energy, "emitted ");
+    let parts = number_after(energy, "absorbed ")
+        + number_after(energy, "escaped ")
+        + number_after(energy, "not yet shot ");
+    // The three terms are printed to seven significant digits.
+    assert!((parts - emitted).abs() < 1e-5 * emitted, "{energy}");
+    assert!(text.contains("  parse paper196.scene "), "{text}");
+    let err = stderr(&radiosity(
+        &["compare", "--max-area", "20000", "--adapt-rounds", "1"],
+        &dir,
+    ));
+    let timings = err.lines().find(|l| l.starts_with("timings:")).unwrap();
+    assert!(
+        timings.contains("solve (gauss-seidel, tested) #1")
+            && timings.contains("solve (gauss-seidel, tested) #2"),
+        "{timings}"
+    );
+    let args = [
+        "bench",
+        "--max-area",
+        "20000",
+        "--method",
+        "hemicube",
+        "--repeat",
+        "1",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "-q",
+    ];
+    let table = crate::fixtures::stdout(&radiosity(&args, &dir));
+    assert!(table.contains("| method |"), "{table}");
+    assert!(table.contains("| hemicube resolution=128 |"), "{table}");
+    std::fs::write(
+        dir.join("tri.scene"),
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 2\nSCENEBEGIN\nPATCHBEGIN\n#T\nVERTICES 3\nEr 1\n\
+         Eg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\nVERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 0 1 0\n\
+         PATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    let args = [
+        "render",
+        "tri.scene",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "-o",
+        "t.png",
+    ];
+    let err = stderr(&radiosity(&args, &dir));
+    assert!(err.contains("auto: every surface emits"), "{err}");
+    assert!(!err.contains("non-emitting element"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

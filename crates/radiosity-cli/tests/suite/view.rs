@@ -5,22 +5,28 @@ use crate::fixtures::radiosity_command;
 
 #[test]
 fn view_without_a_display_says_what_to_do() {
-    let out = radiosity_command()
-        .arg("view")
-        .env_remove("DISPLAY")
-        .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .expect("the radiosity binary runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "stderr: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    if cfg!(feature = "viewer") {
-        assert!(
-            err.contains("no display") && err.contains("xvfb-run"),
-            "{err}"
-        );
-    } else {
-        assert!(err.contains("feature `viewer`"), "{err}");
+    // Unset, or set but empty (QA of issue #16: the empty ones got GPU advice).
+    for empty in [false, true] {
+        let mut command = radiosity_command();
+        command.arg("view");
+        if empty {
+            command.env("DISPLAY", "").env("WAYLAND_DISPLAY", "");
+        } else {
+            command.env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY");
+        }
+        let out = command.output().expect("the radiosity binary runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "stderr: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        if cfg!(feature = "viewer") {
+            assert!(
+                err.contains("no display") && err.contains("xvfb-run"),
+                "{err}"
+            );
+            assert!(!err.contains("mesa-vulkan-drivers"), "{err}");
+        } else {
+            assert!(err.contains("feature `viewer`"), "{err}");
+        }
     }
 }
 

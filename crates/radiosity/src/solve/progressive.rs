@@ -300,7 +300,7 @@ pub fn solve_progressive(
         elapsed: start.elapsed(),
     };
     progress.message(&format!(
-        "progressive refinement ({method}): {n} elements, {shots} shots, unshot power {:.3} % of emitted, {} visibility rays, {:.3} s{}",
+        "progressive refinement ({method}): {n} elements, {shots} shots, unshot power {:.3} % of emitted (the band with the most left), {} visibility rays, {:.3} s{}",
         100.0 * report.unshot_fraction,
         report.rays,
         report.elapsed.as_secs_f64(),
