@@ -354,10 +354,10 @@ pub struct CameraArgs {
     #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
     pub fov: Option<f64>,
     /// Image width in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 512, value_parser = parse_at_least_1)]
     pub width: u32,
     /// Image height in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 512, value_parser = parse_at_least_1)]
     pub height: u32,
 }
 
@@ -444,7 +444,7 @@ pub struct PathTraceArgs {
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Paths per pixel (at least 2, for a standard error): the noise falls as 1/sqrt(N).
-    #[arg(long, default_value_t = 256, value_name = "N", value_parser = clap::value_parser!(u32).range(2..))]
+    #[arg(long, default_value_t = 256, value_name = "N", value_parser = parse_at_least_2)]
     pub paths: u32,
     /// Seed of the paths: the same seed gives the same image, bit for bit, on any number of
     /// threads. (--seed is the Monte Carlo form factors' seed.)
@@ -743,6 +743,25 @@ pub struct ViewArgs {
 // for '--eye <X,Y,Z>': ..."); these say what was expected.
 
 /// `--eye`, `--look-at`, `--up`: three finite numbers "x,y,z".
+/// A whole number of at least `min`, refused in the words the other flags use (QA of
+/// issue #16: clap's own "0 is not in 1..=4294967295").
+fn whole_number_at_least(text: &str, min: u32) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
+        Ok(n) if n >= min => Ok(n),
+        _ => Err(format!("give a whole number of at least {min}")),
+    }
+}
+
+/// [`whole_number_at_least`] 1: image sizes.
+pub fn parse_at_least_1(text: &str) -> Result<u32, String> {
+    whole_number_at_least(text, 1)
+}
+
+/// [`whole_number_at_least`] 2: paths a pixel (a standard error needs two).
+pub fn parse_at_least_2(text: &str) -> Result<u32, String> {
+    whole_number_at_least(text, 2)
+}
+
 pub fn parse_vec3(text: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
     let values: Vec<f64> = parts

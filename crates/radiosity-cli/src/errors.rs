@@ -63,11 +63,17 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
             _ => None,
         };
     }
-    if err
-        .downcast_ref::<radiosity::budget::TooMuchWork>()
-        .is_some()
-    {
-        return Some(" (or pass --no-work-limit to run it anyway)".into());
+    if let Some(e) = err.downcast_ref::<radiosity::budget::TooMuchWork>() {
+        // The scene keyword the library names, as the flag to type (QA of issue #16).
+        let steps = e
+            .fits
+            .strip_prefix("at most INTEGRAL_STEPS ")
+            .and_then(|rest| rest.split_whitespace().next())
+            .map(|k| format!(": --steps {k}"))
+            .unwrap_or_default();
+        return Some(format!(
+            "{steps} (or pass --no-work-limit to run it anyway)"
+        ));
     }
     if let Some(e) = err.downcast_ref::<FormFactorFileError>() {
         return match e {

@@ -97,6 +97,9 @@ pub fn progress_line_of(
                 if done == 1 { c.one } else { c.unit },
                 c.until
             ),
+            // A stage that reports no steps (meshing, a whole-scene pass) is only said
+            // to be running (QA of issue #16: "mesh: 0 steps after 10 s").
+            None if done == 0 => format!("{stage}: still running after {secs:.0} s"),
             None => format!(
                 "{stage}: {done} {} after {secs:.0} s",
                 if done == 1 { "step" } else { "steps" }
@@ -406,6 +409,15 @@ pub fn run_file_stage<T>(
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_stage_without_steps_is_said_to_be_running() {
+        // QA of issue #16: meshing printed "mesh: 0 steps after 10 s".
+        let line = progress_line("mesh", 0, 0, Duration::from_secs(10), None);
+        assert_eq!(line, "mesh: still running after 10 s");
+        let line = progress_line("solve", 3, 0, Duration::from_secs(10), None);
+        assert_eq!(line, "solve: 3 steps after 10 s");
+    }
     use super::*;
 
     #[test]

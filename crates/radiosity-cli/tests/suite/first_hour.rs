@@ -1926,3 +1926,18 @@ fn third_pass_findings_are_said() {
     assert!(!err.contains("non-emitting element"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn refusals_give_the_flag_to_type() {
+    // QA of issue #16: the work limit named the scene keyword (INTEGRAL_STEPS 13), clap
+    // said "0 is not in 1..=4294967295".
+    let dir = scratch_dir("flag-to-type");
+    let err = stderr(&radiosity(&["check", "--steps", "100"], &dir));
+    assert!(
+        err.contains(": --steps 13 (or pass --no-work-limit"),
+        "{err}"
+    );
+    let err = stderr(&radiosity(&["render", "--width", "0"], &dir));
+    assert!(err.contains("give a whole number of at least 1"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
