@@ -767,11 +767,19 @@ fn where_escaped(
             lost.join(", ")
         },
         all(lost.len(), out_count, out_total),
-        // Only where the line below is printed (QA of issue #16: "less 0.00 % counted
-        // twice below" with nothing below).
+        // "below" only where the line below is printed (QA of issue #16: "less 0.00 %
+        // counted twice below" with nothing below); a part too small for that line but
+        // large enough to show is still taken off, so the total makes the energy line's.
         if !twice.is_empty() {
             format!(
                 ", less {:.2} % counted twice below: {:.2} % escaped",
+                100.0 * in_total,
+                100.0 * (out_total - in_total)
+            )
+        } else if in_total >= 0.00005 {
+            format!(
+                ", less {:.2} % counted twice (by surfaces of under 0.01 % each): {:.2} % \
+                 escaped",
                 100.0 * in_total,
                 100.0 * (out_total - in_total)
             )

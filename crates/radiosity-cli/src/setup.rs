@@ -497,29 +497,35 @@ pub fn no_emitter(scene: &Scene, format: Format) -> Option<String> {
 /// / 255 off, 3e9 m blotches, 1e10 m lost 28 % of its light.
 const FAR_FROM_ORIGIN: f64 = 1e7;
 
-/// A warning when `scene` lies more than [`FAR_FROM_ORIGIN`] times its size from the
-/// origin (a model in millimetres at map coordinates): its light would be silently wrong.
-/// Above this size in metres (the largest side of the scene's box) a scene read as metres
-/// is more likely a model in millimetres: the Cornell box in millimetres is 559 across.
-const LARGER_THAN_A_BUILDING_M: f64 = 300.0;
+/// Above this area in square metres one surface of a scene read as metres is more likely
+/// a model in millimetres: a face 140 m square (the Cornell box in millimetres has faces
+/// of 310,000 "m^2"; a generated building of any size has none above some 40 m^2, so a
+/// large building does not set it off, where a size across would).
+const LARGER_THAN_A_SURFACE_M2: f64 = 20_000.0;
 
-/// A note when a scene read as metres, unscaled, is larger than a building (QA of issue
-/// #16: examples/cornell_box.scene, in millimetres, was reported as 1874940 m^2 without a
-/// word).
+/// A note when a scene read as metres, unscaled, has a surface larger than any building's
+/// (QA of issue #16: examples/cornell_box.scene, in millimetres, was reported as 1874940
+/// m^2 without a word).
 fn millimetres_perhaps(scene: &radiosity::scene::Scene, unit: &str, scale: f64) -> Option<String> {
-    if scene.surfaces.is_empty() || scale != 1.0 || !unit.starts_with("metres") {
+    if scale != 1.0 || !unit.starts_with("metres") {
         return None;
     }
-    let (lo, hi) = scene.bounds();
-    let side = (hi - lo).max_element();
-    (side > LARGER_THAN_A_BUILDING_M).then(|| {
+    let largest = scene
+        .surfaces
+        .iter()
+        .map(|s| radiosity::geometry::polygon_area(&s.vertices))
+        .fold(0.0, f64::max);
+    (largest > LARGER_THAN_A_SURFACE_M2).then(|| {
         format!(
-            "the scene is {side:.0} m across, read as metres; if its numbers are millimetres, \
-             --scale 0.001 reads them as metres (the lux and areas in m^2 assume metres)"
+            "the largest surface is {largest:.0} m^2, read as metres; if the numbers are \
+             millimetres, --scale 0.001 reads them as metres (the lux and areas in m^2 assume \
+             metres)"
         )
     })
 }
 
+/// A warning when `scene` lies more than [`FAR_FROM_ORIGIN`] times its size from the
+/// origin (a model in millimetres at map coordinates): its light would be silently wrong.
 fn far_from_origin(scene: &radiosity::scene::Scene) -> Option<String> {
     if scene.surfaces.is_empty() {
         return None;

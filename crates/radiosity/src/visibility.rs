@@ -391,7 +391,17 @@ impl PolygonBvh {
     /// `p`, to `tolerance` ([`PolygonBvh::polygon_at`]'s test). Where two faces lie back to
     /// back in one plane (a box's base on the floor) a ray meets both at the same distance
     /// and which [`PolygonBvh::closest_hit`] reports is rounding; this finds the back one.
-    pub fn back_face_at(&self, p: DVec3, dir: DVec3, tolerance: f64) -> bool {
+    ///
+    /// `accept` is given each such polygon's caller's id and decides whether it counts (a
+    /// caller leaves out the back half of a two-sided wall, the same polygon facing the
+    /// other way, which is no box standing on anything).
+    pub fn back_face_at(
+        &self,
+        p: DVec3,
+        dir: DVec3,
+        tolerance: f64,
+        accept: impl Fn(u32) -> bool,
+    ) -> bool {
         let mut candidates = Vec::new();
         self.overlapping(
             p - DVec3::splat(tolerance),
@@ -410,6 +420,7 @@ impl PolygonBvh {
                         2.0 * tolerance,
                     )
                     .is_some()
+                && accept(poly.id)
         })
     }
 

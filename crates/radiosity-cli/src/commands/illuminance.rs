@@ -109,7 +109,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     crate::progress_bar::run_file_stage(&reporter, Stage::Write, &args.output, || {
         write(&args, &points, &lux)
     })?;
-    if let Some(w) = dark_points(&points, &lux, args.grid.is_some()) {
+    // A scene with no light was warned of when it was read: every point is dark there.
+    let lit =
+        crate::setup::no_emitter(&prepared.scene, radiosity::io::import::Format::Scene).is_none();
+    if let Some(w) = dark_points(&points, &lux, args.grid.is_some()).filter(|_| lit) {
         // Printed even with --quiet: figures that are surely not what was meant.
         errln!("warning: {w}");
     }

@@ -1712,7 +1712,8 @@ fn second_pass_findings_are_said() {
         &dir,
     ));
     assert!(
-        err.contains("note: the scene is 559 m across, read as metres")
+        err.contains("note: the largest surface is ")
+            && err.contains("m^2, read as metres")
             && err.contains("--scale 0.001"),
         "{err}"
     );

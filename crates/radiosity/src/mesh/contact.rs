@@ -253,8 +253,19 @@ impl<'a> Probe<'a> {
                     || (self.normals[s as usize].dot(normal) < -1.0 + 1e-9
                         && corners
                             .iter()
-                            .all(|&v| (v - origin).dot(normal).abs() <= self.lift)))
+                            .all(|&v| (v - origin).dot(normal).abs() <= self.lift)
+                        && !self.twins(s, surface)))
         })
+    }
+
+    /// Whether surfaces `a` and `b` are one polygon given twice (a two-sided wall: the same
+    /// corners, one copy facing each way), to the probe's lift.
+    fn twins(&self, a: u32, b: u32) -> bool {
+        let (pa, pb) = (self.polygons[a as usize], self.polygons[b as usize]);
+        pa.len() == pb.len()
+            && pa
+                .iter()
+                .all(|&v| pb.iter().any(|&w| (v - w).length() <= self.lift))
     }
 
     /// Whether the point `p` of a surface with front normal `n` is buried: every probe ray
@@ -280,9 +291,12 @@ impl<'a> Probe<'a> {
             let back = match self.occluders.closest_hit(origin, dir, 0.0, f64::INFINITY) {
                 Some(hit) => {
                     self.normals[hit.id as usize].dot(dir) > 0.0
-                        || self
-                            .occluders
-                            .back_face_at(origin + hit.t * dir, dir, self.lift)
+                        || self.occluders.back_face_at(
+                            origin + hit.t * dir,
+                            dir,
+                            self.lift,
+                            |back| !self.twins(hit.id, back),
+                        )
                 }
                 None => false,
             };
@@ -436,6 +450,32 @@ mod tests {
             .clone()
             .map(|e| mesh.elements[e as usize].area)
             .sum()
+    }
+
+    #[test]
+    fn a_room_of_two_sided_walls_keeps_every_element() {
+        // A 3 x 2 x 4 room whose six faces are each given twice, facing in and facing out
+        // (as CAD and OBJ exports often give walls). A probe ray from a wall meets the
+        // opposite wall's two copies at one distance; the outer copy is a back face there,
+        // but a two-sided wall buries nothing: every element stays (review of issue #16:
+        // counting it as a box's base on the floor dropped whole rooms).
+        let base = axis_aligned_base(dvec3(0., 0., 0.), dvec3(3., 2., 4.));
+        let mut surfaces = Vec::new();
+        for facing in [Facing::In, Facing::Out] {
+            for (k, face) in box_faces(&base, 2.0, facing).into_iter().enumerate() {
+                surfaces.push(surface(&format!("wall{k}"), face));
+            }
+        }
+        let scene = Scene {
+            surfaces,
+            camera: None,
+            lights: Vec::new(),
+        };
+        let grid = mesh_scene(&scene, 1.0).unwrap();
+        let (mesh, report) = refine(&scene);
+        assert_eq!(report.dropped, 0, "{report:?}");
+        assert_eq!(report.split, 0, "{report:?}");
+        assert_eq!(mesh.len(), grid.len());
     }
 
     #[test]
