@@ -597,35 +597,29 @@ pub fn check(
             String::new()
         }
     };
-    if let SolutionReport::Progressive(_) = solution.report {
-        // A progressive solve holds the power it has not shot yet: the third term, by
-        // difference, in the same band (QA of issue #16: a capped run's "relative error
-        // 5.4e-1" was the unshot power, explained lines further down).
+    // A progressive solve holds the power it has not shot yet: the third term, by
+    // difference, in the same band (QA of issue #16: a capped run's "relative error
+    // 5.4e-1" was the unshot power, explained lines further down).
+    let rest = if let SolutionReport::Progressive(_) = solution.report {
         let unshot = b.emitted[k] - b.absorbed[k] - b.escaped[k];
-        outln!(
-            "energy ({})        emitted {} = absorbed {}{} + escaped {}{} + not yet shot {}{} \
-             (progressive refinement: the power still to shoot, by difference)",
-            BAND_NAMES[k],
-            significant(b.emitted[k], 7),
-            significant(b.absorbed[k], 7),
-            share(b.absorbed[k]),
-            significant(b.escaped[k], 7),
-            share(b.escaped[k]),
+        format!(
+            " + not yet shot {}{} (progressive refinement: the power still to shoot, by \
+             difference)",
             significant(unshot, 7),
-            share(unshot),
-        );
+            share(unshot)
+        )
     } else {
-        outln!(
-            "energy ({})        emitted {} = absorbed {}{} + escaped {}{} (relative error {:.1e})",
-            BAND_NAMES[k],
-            significant(b.emitted[k], 7),
-            significant(b.absorbed[k], 7),
-            share(b.absorbed[k]),
-            significant(b.escaped[k], 7),
-            share(b.escaped[k]),
-            b.relative_error()
-        );
-    }
+        format!(" (relative error {:.1e})", b.relative_error())
+    };
+    outln!(
+        "energy ({})        emitted {} = absorbed {}{} + escaped {}{}{rest}",
+        BAND_NAMES[k],
+        significant(b.emitted[k], 7),
+        significant(b.absorbed[k], 7),
+        share(b.absorbed[k]),
+        significant(b.escaped[k], 7),
+        share(b.escaped[k]),
+    );
     if band.is_some() {
         let (_, area_unit) = length_and_area_units();
         outln!(

@@ -373,18 +373,28 @@ impl PolygonBvh {
     /// units, its `EPSILON`, which stands in for the ray's own t_min; about 1e-7 of the
     /// scene's diagonal), so a short enough ray through a point on a polygon finds nothing.
     pub fn polygon_at(&self, p: DVec3, tolerance: f64) -> Option<u32> {
+        self.polygons_containing(p, tolerance)
+            .first()
+            .map(|&k| self.polygons[k as usize].id)
+    }
+
+    /// The polygons (as indices) that contain `p` to `tolerance`, in BVH order: those whose
+    /// boxes meet the point's and whose plane, crossed along the normal within the
+    /// tolerance, is met inside the polygon.
+    fn polygons_containing(&self, p: DVec3, tolerance: f64) -> Vec<u32> {
         let mut candidates = Vec::new();
         self.overlapping(
             p - DVec3::splat(tolerance),
             p + DVec3::splat(tolerance),
             &mut candidates,
         );
-        candidates.into_iter().find_map(|k| {
+        candidates.retain(|&k| {
             let poly = &self.polygons[k as usize];
             let origin = p + tolerance * poly.normal;
             self.intersect(k as usize, origin, -poly.normal, 0.0, 2.0 * tolerance)
-                .map(|_| poly.id)
-        })
+                .is_some()
+        });
+        candidates
     }
 
     /// Whether a polygon whose back faces along `dir` (normal . dir > 0) contains the point
@@ -402,25 +412,9 @@ impl PolygonBvh {
         tolerance: f64,
         accept: impl Fn(u32) -> bool,
     ) -> bool {
-        let mut candidates = Vec::new();
-        self.overlapping(
-            p - DVec3::splat(tolerance),
-            p + DVec3::splat(tolerance),
-            &mut candidates,
-        );
-        candidates.into_iter().any(|k| {
+        self.polygons_containing(p, tolerance).into_iter().any(|k| {
             let poly = &self.polygons[k as usize];
-            poly.normal.dot(dir) > 0.0
-                && self
-                    .intersect(
-                        k as usize,
-                        p + tolerance * poly.normal,
-                        -poly.normal,
-                        0.0,
-                        2.0 * tolerance,
-                    )
-                    .is_some()
-                && accept(poly.id)
+            poly.normal.dot(dir) > 0.0 && accept(poly.id)
         })
     }
 
