@@ -370,7 +370,7 @@ pub struct RayArgs {
     /// Rays per pixel along each axis, at most (1 to 16): 2 or more antialiases edges. An
     /// even N above 2 is adaptive (see --adaptive-contrast); 1 casts one ray through each
     /// pixel centre.
-    #[arg(long, default_value_t = 8, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(long, default_value_t = 8, value_name = "N", value_parser = parse_supersample)]
     pub supersample: u32,
     /// Adaptive antialiasing (an even --supersample N above 2, smooth or flat shading): each
     /// pixel casts four rays first; where they see different surfaces (an object's edge) it
@@ -627,16 +627,16 @@ pub struct BenchArgs {
     pub tolerance: Option<f64>,
     /// Image width and height in pixels (--width or --height sets one side).
     #[arg(long, default_value_t = 512, value_name = "PIXELS",
-          value_parser = clap::value_parser!(u32).range(1..=10_000))]
+          value_parser = parse_bench_pixels)]
     pub size: u32,
     /// Image width in pixels, as for `render` (default: --size).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    #[arg(long, value_parser = parse_bench_pixels)]
     pub width: Option<u32>,
     /// Image height in pixels, as for `render` (default: --size).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    #[arg(long, value_parser = parse_bench_pixels)]
     pub height: Option<u32>,
-    /// Rays per pixel along each axis (as `render --supersample`).
-    #[arg(long, default_value_t = 1, value_name = "N")]
+    /// Rays per pixel along each axis, 1 to 16 (as `render --supersample`).
+    #[arg(long, default_value_t = 1, value_name = "N", value_parser = parse_supersample)]
     pub supersample: u32,
     /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
     #[arg(long, default_value_t = 0.05, value_name = "E")]
@@ -742,7 +742,6 @@ pub struct ViewArgs {
 // Value parsers. clap names the flag and the value in its message ("invalid value '1,2'
 // for '--eye <X,Y,Z>': ..."); these say what was expected.
 
-/// `--eye`, `--look-at`, `--up`: three finite numbers "x,y,z".
 /// A whole number of at least `min`, refused in the words the other flags use (QA of
 /// issue #16: clap's own "0 is not in 1..=4294967295").
 fn whole_number_at_least(text: &str, min: u32) -> Result<u32, String> {
@@ -750,6 +749,25 @@ fn whole_number_at_least(text: &str, min: u32) -> Result<u32, String> {
         Ok(n) if n >= min => Ok(n),
         _ => Err(format!("give a whole number of at least {min}")),
     }
+}
+
+/// A whole number from `min` to `max`, in the same words (clap's range parser said
+/// "0 is not in 1..=10000").
+fn whole_number_in(text: &str, min: u32, max: u32) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
+        Ok(n) if (min..=max).contains(&n) => Ok(n),
+        _ => Err(format!("give a whole number from {min} to {max}")),
+    }
+}
+
+/// [`whole_number_in`] 1 to 16: rays per pixel along each axis.
+pub fn parse_supersample(text: &str) -> Result<u32, String> {
+    whole_number_in(text, 1, 16)
+}
+
+/// [`whole_number_in`] 1 to 10,000: `bench`'s image sides.
+pub fn parse_bench_pixels(text: &str) -> Result<u32, String> {
+    whole_number_in(text, 1, 10_000)
 }
 
 /// [`whole_number_at_least`] 1: image sizes.
@@ -762,6 +780,7 @@ pub fn parse_at_least_2(text: &str) -> Result<u32, String> {
     whole_number_at_least(text, 2)
 }
 
+/// `--eye`, `--look-at`, `--up`: three finite numbers "x,y,z".
 pub fn parse_vec3(text: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
     let values: Vec<f64> = parts
@@ -806,7 +825,7 @@ pub fn parse_exposure(text: &str) -> Result<Exposure, String> {
 pub fn parse_positive(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
-        _ => Err("expected a positive number".into()),
+        _ => Err("give a number above 0".into()),
     }
 }
 
@@ -814,7 +833,7 @@ pub fn parse_positive(text: &str) -> Result<f64, String> {
 pub fn parse_fraction(text: &str) -> Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x >= 0.0 && x.is_finite() => Ok(x),
-        _ => Err("expected a number of at least 0".into()),
+        _ => Err("give a number of at least 0".into()),
     }
 }
 

@@ -174,7 +174,7 @@ pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared,
         MethodArg::Hemicube => {
             if m.resolution < 2 || m.resolution > 16_384 {
                 bail!(
-                    "--resolution must be between 2 and 16384, got {}",
+                    "--resolution {}: give the hemicube's cells along a side, 2 to 16384",
                     m.resolution
                 );
             }
@@ -184,7 +184,7 @@ pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared,
         }
         MethodArg::Montecarlo => {
             if m.samples == 0 {
-                bail!("--samples must be at least 1");
+                bail!("--samples 0: give the Monte Carlo rays per element, at least 1");
             }
             FormFactorMethod::MonteCarlo {
                 samples: m.samples,
@@ -264,28 +264,28 @@ pub fn check_scene_flags(args: &SceneArgs) -> Result<()> {
 pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
     if let Some(t) = options.tolerance {
         if !(t > 0.0 && t.is_finite()) {
-            bail!("--tolerance must be a positive number, got {t}");
+            bail!("--tolerance {t}: give where the solver stops, a number above 0");
         }
         if options.solver.0 == SolverKind::Hierarchical && t >= 1.0 {
-            bail!("--tolerance must be a number in (0, 1) for --solver hierarchical, got {t}");
+            bail!("--tolerance {t}: give hierarchical radiosity's stopping change, a number above 0 and below 1");
         }
     }
     if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
         bail!(
-            "--epsilon must be a positive number, got {}",
+            "--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0",
             options.epsilon
         );
     }
     if let Some(a) = options.min_area {
         if !(a > 0.0 && a.is_finite()) {
-            bail!("--min-area must be a positive number, got {a}");
+            bail!("--min-area {a}: give the smallest element area (scene units squared), a number above 0");
         }
     }
     if options.gather_points == 0 {
-        bail!("--gather-points must be at least 1 (--no-final-gather leaves the gather out)");
+        bail!("--gather-points 0: give the most points the final gather gathers at, at least 1 (--no-final-gather leaves the gather out)");
     }
     if options.max_shots == 0 {
-        bail!("--max-shots must be at least 1");
+        bail!("--max-shots 0: give the most shots progressive radiosity takes, at least 1");
     }
     // A step is a fraction of the brighter element's luminance, so 1 or more never splits
     // (QA of issue #16: `--adapt-contrast 2` ran and reported "no visible steps").
@@ -297,7 +297,7 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
         );
     }
     if options.adapt_max_elements == Some(0) {
-        bail!("--adapt-max-elements must be at least 1");
+        bail!("--adapt-max-elements 0: give the most elements adaptive subdivision may make, at least 1");
     }
     Ok(())
 }
@@ -642,7 +642,7 @@ fn solver(
                 .tolerance
                 .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
             if !(tolerance > 0.0 && tolerance < 1.0) {
-                bail!("--tolerance must be a number in (0, 1) for --solver hierarchical, got {tolerance}");
+                bail!("--tolerance {tolerance}: give hierarchical radiosity's stopping change, a number above 0 and below 1");
             }
             Solver::Hierarchical(radiosity::solve::HierarchicalSettings {
                 epsilon: options.epsilon,
@@ -847,7 +847,10 @@ pub fn output_directory(output: &Path, flag: &str) -> Result<()> {
 /// `--gamma`, checked.
 pub fn gamma(args: &ToneArgs) -> Result<f64> {
     if !(args.gamma > 0.0 && args.gamma.is_finite()) {
-        bail!("--gamma must be a positive number, got {}", args.gamma);
+        bail!(
+            "--gamma {}: give the gamma (displayed = value^(1/gamma)), a number above 0",
+            args.gamma
+        );
     }
     Ok(args.gamma)
 }
@@ -855,7 +858,11 @@ pub fn gamma(args: &ToneArgs) -> Result<f64> {
 /// Refuses an image with no pixels or more than 100 megapixels.
 fn image_size(args: &CameraArgs) -> Result<()> {
     if args.width == 0 || args.height == 0 {
-        bail!("--width and --height must be at least 1");
+        bail!(
+            "--width {} --height {}: give image sides of at least 1 pixel",
+            args.width,
+            args.height
+        );
     }
     if (args.width as u64) * (args.height as u64) > 100_000_000 {
         bail!(
@@ -875,12 +882,17 @@ pub fn check_camera_flags(args: &CameraArgs) -> Result<()> {
     image_size(args)?;
     if let Some(fov) = args.fov {
         if !(fov > 0.0 && fov < 180.0) {
-            bail!("--fov must be more than 0 and less than 180 degrees, got {fov}");
+            bail!("--fov {fov}: give the vertical field of view in degrees, above 0 and below 180");
         }
     }
     if let Some(up) = args.up {
         if !(up.length().is_finite() && up.length() > 0.0) {
-            bail!("--up must be a direction of finite, non-zero length, got {up}");
+            bail!(
+                "--up {},{},{}: give a direction of finite, non-zero length",
+                up.x,
+                up.y,
+                up.z
+            );
         }
     }
     if let (Some(eye), Some(at)) = (args.eye, args.look_at) {
@@ -907,7 +919,7 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     }
     if let Some(fov) = args.fov {
         if !(fov > 0.0 && fov < 180.0) {
-            bail!("--fov must be more than 0 and less than 180 degrees, got {fov}");
+            bail!("--fov {fov}: give the vertical field of view in degrees, above 0 and below 180");
         }
         camera.fov_y_degrees = fov;
     }
@@ -943,8 +955,10 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     }
     if !(camera.up.length().is_finite()) {
         bail!(
-            "--up must be a direction of finite length, got {}",
-            camera.up
+            "--up {},{},{}: give a direction of finite, non-zero length",
+            camera.up.x,
+            camera.up.y,
+            camera.up.z
         );
     }
     if forward

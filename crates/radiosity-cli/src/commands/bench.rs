@@ -17,13 +17,12 @@ use crate::setup::prepare_solve;
 
 pub fn run(args: BenchArgs) -> Result<()> {
     if args.repeat == 0 {
-        bail!("--repeat must be at least 1");
-    }
-    if args.supersample == 0 || args.supersample > 16 {
-        bail!("--supersample must be between 1 and 16");
+        bail!("--repeat 0: give the runs per configuration, at least 1");
     }
     if let Some(&a) = args.max_area.iter().find(|a| !(**a > 0.0 && a.is_finite())) {
-        bail!("--max-area must be a positive number, got {a}");
+        bail!(
+            "--max-area {a}: give the largest element area (scene units squared), a number above 0"
+        );
     }
     let name = args
         .scene

@@ -39,7 +39,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
         }
         let max_area = args.scene.max_area.unwrap_or(1.0 / 64.0);
         if !(max_area > 0.0 && max_area <= 1.0) {
-            bail!("--max-area must be in (0, 1] for --compare-methods (unit squares are meshed at it), got {max_area}");
+            bail!("--max-area {max_area}: give the element area --compare-methods meshes its unit squares at, above 0 and at most 1");
         }
         report::method_accuracy(max_area, args.scene.quiet);
         return Ok(());

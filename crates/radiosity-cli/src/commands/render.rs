@@ -85,7 +85,7 @@ pub fn check(args: &RenderArgs) -> Result<Checked> {
         }
     }
     if args.snapshot_every == 0 {
-        bail!("--snapshot-every must be at least 1");
+        bail!("--snapshot-every 0: give the shots between snapshots, at least 1");
     }
     check_scene_flags(&args.scene)?;
     check_solve_flags(&args.solve)?;

@@ -13,7 +13,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
 
     let quiet = args.quiet;
     if args.steps == Some(0) {
-        bail!("--steps must be at least 1");
+        bail!("--steps 0: give the points along each axis of an element, at least 1");
     }
     // Before any thread starts: the window system's libraries complain at every probe
     // where XDG_RUNTIME_DIR is missing (root under Xvfb).
@@ -23,7 +23,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         // and then failed with "MAX_PATCH_AREA ... got inf"; 0 frames printed an inf row).
         if args.bench_elements.contains(&0) {
             bail!(
-                "--bench-elements must be element counts of at least 1, got {}",
+                "--bench-elements {}: give element counts of at least 1",
                 args.bench_elements
                     .iter()
                     .map(|n| n.to_string())
@@ -32,7 +32,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             );
         }
         if args.bench_frames == 0 {
-            bail!("--bench-frames must be at least 1 (the frames timed per scene)");
+            bail!("--bench-frames 0: give the frames timed per scene, at least 1");
         }
         // Progress on stderr, the tables once on stdout.
         let table = radiosity_viewer::bench::run_all(
@@ -83,10 +83,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
         let max_area = args.max_area.unwrap_or(options.settings.max_patch_area);
         let min_area = args.min_area.unwrap_or(max_area / 16.0);
         if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
-            bail!("--epsilon must be a positive number, got {}", args.epsilon);
+            bail!("--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0", args.epsilon);
         }
         if !(min_area > 0.0 && min_area.is_finite()) {
-            bail!("--min-area must be a positive number, got {min_area}");
+            bail!("--min-area {min_area}: give the smallest element area (scene units squared), a number above 0");
         }
         hierarchical = Some(radiosity::solve::HierarchicalSettings {
             epsilon: args.epsilon,

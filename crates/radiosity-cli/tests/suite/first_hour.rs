@@ -710,19 +710,19 @@ fn a_negative_number_is_taken_as_the_flags_value() {
     for (args, needle) in [
         (
             vec!["solve", "--tolerance", "-1", "-o", "x.csv"],
-            "--tolerance must be a positive number, got -1",
+            "--tolerance -1: give where the solver stops, a number above 0",
         ),
         (
             vec!["render", "--gamma", "-2.2", "-o", "x.png"],
-            "--gamma must be a positive number, got -2.2",
+            "--gamma -2.2: give the gamma",
         ),
         (
             vec!["render", "--fov", "-45", "-o", "x.png"],
-            "--fov must be more than 0 and less than 180 degrees, got -45",
+            "--fov -45: give the vertical field of view in degrees, above 0 and below 180",
         ),
         (
             vec!["render", "--solver", "hierarchical", "--epsilon", "-0.5"],
-            "--epsilon must be a positive number, got -0.5",
+            "--epsilon -0.5: give hierarchical radiosity's refinement threshold, a number above 0",
         ),
     ] {
         let out = radiosity(&args, &dir);
@@ -1164,15 +1164,15 @@ fn flag_numbers_are_refused_before_the_scene_is_read() {
         ),
         (
             vec!["solve", "absent.scene", "--epsilon", "-1"],
-            "--epsilon must be a positive number, got -1",
+            "--epsilon -1: give hierarchical radiosity's refinement threshold",
         ),
         (
             vec!["solve", "absent.scene", "--max-shots", "0"],
-            "--max-shots must be at least 1",
+            "--max-shots 0: give the most shots",
         ),
         (
             vec!["render", "absent.scene", "--gather-points", "0"],
-            "--gather-points must be at least 1",
+            "--gather-points 0: give the most points",
         ),
         (
             vec!["render", "absent.scene", "--adapt-contrast", "0"],
@@ -1184,7 +1184,7 @@ fn flag_numbers_are_refused_before_the_scene_is_read() {
         ),
         (
             vec!["check", "absent.scene", "--min-area", "inf"],
-            "--min-area must be a positive number, got inf",
+            "--min-area inf: give the smallest element area",
         ),
         (
             vec![
@@ -1195,7 +1195,7 @@ fn flag_numbers_are_refused_before_the_scene_is_read() {
                 "--tolerance",
                 "2",
             ],
-            "--tolerance must be a number in (0, 1) for --solver hierarchical",
+            "--tolerance 2: give hierarchical radiosity's stopping change, a number above 0 and below 1",
         ),
     ] {
         let out = radiosity(&args, &dir);
@@ -1501,7 +1501,8 @@ fn bench_takes_width_and_height_as_render_does_and_keeps_size() {
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{err}");
         assert!(
-            err.contains(&format!("'{flag} <")) && err.contains("0 is not in 1..=10000"),
+            err.contains(&format!("'{flag} <"))
+                && err.contains("give a whole number from 1 to 10000"),
             "{err}"
         );
     }
@@ -1552,7 +1553,9 @@ fn export_help_wireframe_exposure_and_fov_say_what_is_true() {
     );
     let out = radiosity(&["render", "--fov", "180", "-o", "f.png"], &dir);
     assert!(
-        stderr(&out).contains("more than 0 and less than 180 degrees, got 180"),
+        stderr(&out).contains(
+            "--fov 180: give the vertical field of view in degrees, above 0 and below 180"
+        ),
         "{}",
         stderr(&out)
     );
@@ -1785,15 +1788,15 @@ fn camera_flags_are_refused_before_the_scene_is_read() {
     for (args, needle) in [
         (
             vec!["render", "absent.scene", "--fov", "180"],
-            "--fov must be more than 0",
+            "--fov 180: give the vertical field of view",
         ),
         (
             vec!["pathtrace", "absent.scene", "--up", "0,0,0"],
-            "--up must be a direction",
+            "--up 0,0,0: give a direction of finite, non-zero length",
         ),
         (
             vec!["export", "absent.scene", "-o", "a.glb", "--fov", "0"],
-            "--fov must be",
+            "--fov 0: give",
         ),
     ] {
         let out = radiosity(&args, &dir);

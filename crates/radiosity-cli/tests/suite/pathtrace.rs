@@ -186,7 +186,10 @@ fn bad_flags_exit_2_with_what_was_expected() {
         (vec!["pathtrace", "--paths", "1"], "at least 2"),
         (vec!["pathtrace", "--width", "0"], "--width"),
         (vec!["pathtrace", "--supersample", "0"], "--supersample"),
-        (vec!["pathtrace", "--error-scale", "0"], "positive number"),
+        (
+            vec!["pathtrace", "--error-scale", "0"],
+            "give a number above 0",
+        ),
         (vec!["pathtrace", "--eye", "1,2"], "three numbers"),
         (
             vec![

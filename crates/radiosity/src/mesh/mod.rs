@@ -172,6 +172,56 @@ fn compact(x: f64) -> String {
     }
 }
 
+/// Elements a [`plan`] makes, counted in f64: a refused request may be astronomically large.
+fn planned_count(plan: &Result<Plan, f64>) -> f64 {
+    plan.map_or_else(|n| n, |p| p.element_count() as f64)
+}
+
+/// The largest MAX_PATCH_AREA at which `scene` meshes to at most [`MAX_ELEMENTS`]: a
+/// property of the scene, found by bisection on the planned counts, so that the refusal
+/// suggests the same value whatever too-small area was asked (QA of issue #16: 1.498e-5
+/// against 1.500e-5 from the old proportional estimate). Where even one element per
+/// surface is too many, the total area over the limit.
+fn largest_area_that_fits(scene: &Scene) -> f64 {
+    let count_at = |a: f64| -> f64 {
+        scene
+            .surfaces
+            .iter()
+            .map(|s| planned_count(&plan(&s.vertices, a)))
+            .sum()
+    };
+    let fallback = scene.total_area() / MAX_ELEMENTS as f64;
+    let limit = MAX_ELEMENTS as f64;
+    if !(fallback > 0.0 && fallback.is_finite()) {
+        return fallback;
+    }
+    // `fits` meshes within the limit, `over` does not; start from the area that the
+    // limit's elements would have without rounding (every grid rounds up, so it is over).
+    let (mut over, mut fits) = (fallback, fallback);
+    for _ in 0..200 {
+        if count_at(fits) <= limit {
+            break;
+        }
+        fits *= 2.0;
+    }
+    if count_at(fits) > limit {
+        return fallback; // more surfaces than the limit: no area fits
+    }
+    if count_at(over) <= limit {
+        return over;
+    }
+    // Geometric bisection to a relative width of 1e-9.
+    while fits / over > 1.0 + 1e-9 {
+        let mid = (over * fits).sqrt();
+        if count_at(mid) <= limit {
+            fits = mid;
+        } else {
+            over = mid;
+        }
+    }
+    fits
+}
+
 /// The most elements [`mesh_scene`] will make: about 1.2 GB of mesh (112 bytes per element
 /// and about as many vertices of 24 bytes), enough for the million-element scenes that
 /// progressive and hierarchical radiosity handle; larger requests are refused before any
@@ -345,24 +395,14 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
         .iter()
         .map(|s| plan(&s.vertices, max_area))
         .collect();
-    // Counted in f64: a refused request may be astronomically large.
-    let estimate: f64 = planned
-        .iter()
-        .map(|p| p.map_or_else(|n| n, |p| p.element_count() as f64))
-        .sum();
+    let estimate: f64 = planned.iter().map(planned_count).sum();
     if estimate > MAX_ELEMENTS as f64 {
         let count = estimate.min(u64::MAX as f64) as u64;
-        let mut suggested = max_area * estimate / MAX_ELEMENTS as f64 * 1.05;
-        if !suggested.is_finite() {
-            // The estimate overflowed (a MAX_PATCH_AREA of 1e-300): the area alone says
-            // what would fit.
-            suggested = scene.total_area() / MAX_ELEMENTS as f64 * 1.05;
-        }
         return Err(MeshError::TooManyElements {
             max_area,
             count,
             limit: MAX_ELEMENTS,
-            suggested,
+            suggested: largest_area_that_fits(scene),
         });
     }
 
