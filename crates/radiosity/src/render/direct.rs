@@ -244,6 +244,8 @@ impl DirectLight {
     /// in a building, most emitters that face a point are in other rooms, hidden whole,
     /// and their sixteen rays each were most of a render's time. Where those rays disagree
     /// the fine pass runs as for any emitter, so penumbrae are sampled as finely as before.
+    /// The weak emitters' shares together are capped at [`WEAK_TOTAL`] (a point seeing
+    /// fifty equal small lights samples most of them as strong ones).
     pub fn surface_irradiance(&self, x: DVec3, n: DVec3, salt: u64) -> Rgb {
         let mut sum = Rgb::default();
         // The form factors, on the stack for up to 64 emitters.
@@ -262,11 +264,18 @@ impl DirectLight {
                 unoccluded += e.exitance.max_band() * f;
             }
         }
+        // The weak emitters' shares together stay within WEAK_TOTAL, so that a point seeing
+        // fifty equal small lights past a thin occluder does not sample them all coarsely.
+        let mut weak_budget = WEAK_TOTAL * unoccluded;
         for (e, &f) in self.emitters.iter().zip(factors.iter()) {
             if f <= 0.0 {
                 continue;
             }
-            let weak = e.exitance.max_band() * f < WEAK_SHARE * unoccluded;
+            let share = e.exitance.max_band() * f;
+            let weak = share < WEAK_SHARE * unoccluded && share <= weak_budget;
+            if weak {
+                weak_budget -= share;
+            }
             let coarse = if weak { e.coarse.div_ceil(2) } else { e.coarse };
             let (mut seen, mut total, agreed) = e.visible(&self.occluders, x, n, coarse, salt);
             if !agreed {
@@ -283,6 +292,10 @@ impl DirectLight {
 /// The share of a point's unoccluded direct light below which an emitter's first pass of
 /// shadow rays is a quarter as many (see [`DirectLight::surface_irradiance`]).
 pub const WEAK_SHARE: f64 = 0.02;
+
+/// The most of a point's unoccluded direct light that weak emitters together may bring
+/// (taken in the scene's order of emitters): what a coarse first pass can misjudge at most.
+pub const WEAK_TOTAL: f64 = 0.2;
 
 /// Salts the fine pass apart from the coarse one.
 const FINE_SALT: u64 = 0x6a09_e667_f3bc_c909;
