@@ -124,8 +124,8 @@ pub struct SceneArgs {
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,
     /// Override the scene's INTEGRAL_STEPS (points along each axis of each element, for
-    /// the area, contour and analytic methods).
-    #[arg(long, value_name = "K")]
+    /// the area, contour and analytic methods; 1 or more).
+    #[arg(long, value_name = "K", value_parser = parse_steps)]
     pub steps: Option<u32>,
     #[command(flatten)]
     pub method: MethodArgs,
@@ -666,7 +666,7 @@ pub struct ViewArgs {
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,
     /// Override the scene's INTEGRAL_STEPS.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", value_parser = parse_steps)]
     pub steps: Option<u32>,
     /// Always solve by progressive refinement (no form-factor matrix; colour edits re-run
     /// it). By default the dense solve is used up to 6,000 elements (see --dense).
@@ -742,6 +742,43 @@ pub struct ViewArgs {
 // Value parsers. clap names the flag and the value in its message ("invalid value '1,2'
 // for '--eye <X,Y,Z>': ..."); these say what was expected.
 
+/// clap's message for a number flag with the standard library's parse error put in the
+/// words the project's own parsers use: "give a whole number", "give a number".
+pub fn plain_number_errors(message: &str) -> String {
+    const WORDS: [(&str, &str); 5] = [
+        ("invalid digit found in string", "give a whole number"),
+        (
+            "cannot parse integer from empty string",
+            "give a whole number",
+        ),
+        (
+            "number too large to fit in target type",
+            "give a smaller whole number",
+        ),
+        (
+            "number too small to fit in target type",
+            "give a whole number of at least 0",
+        ),
+        ("invalid float literal", "give a number"),
+    ];
+    let mut text = message.to_string();
+    for (from, to) in WORDS {
+        text = text.replace(from, to);
+    }
+    // clap's range check of an unsigned flag: "-1 is not in 0..=4294967295".
+    let mut out = String::with_capacity(text.len());
+    for line in text.split_inclusive('\n') {
+        match line.find("': ").map(|i| i + 3) {
+            Some(at) if line[at..].contains(" is not in 0..=") => {
+                out.push_str(&line[..at]);
+                out.push_str("give a whole number of at least 0\n");
+            }
+            _ => out.push_str(line),
+        }
+    }
+    out
+}
+
 /// A whole number of at least `min`, refused in the words the other flags use (QA of
 /// issue #16: clap's own "0 is not in 1..=4294967295").
 fn whole_number_at_least(text: &str, min: u32) -> Result<u32, String> {
@@ -768,6 +805,13 @@ pub fn parse_supersample(text: &str) -> Result<u32, String> {
 /// [`whole_number_in`] 1 to 10,000: `bench`'s image sides.
 pub fn parse_bench_pixels(text: &str) -> Result<u32, String> {
     whole_number_in(text, 1, 10_000)
+}
+
+/// `--steps`: the points along each axis of an element, 1 or more.
+pub fn parse_steps(text: &str) -> Result<u32, String> {
+    whole_number_at_least(text, 1).map_err(|_| {
+        "give the points along each axis of an element, a whole number of at least 1".into()
+    })
 }
 
 /// [`whole_number_at_least`] 1: image sizes.

@@ -87,7 +87,10 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|e| e.exit());
+    let cli = command()
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m))
+        .unwrap_or_else(|e| exit_with(e));
     // No output of this run may replace a file it read (an OBJ's MTL as much as the scene).
     radiosity::io::protect_inputs();
     match run(cli) {
@@ -97,6 +100,19 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Exits on a command-line error as clap does (exit 2; help and version on stdout, 0),
+/// with the number parsers' own words put in the project's: "give a whole number"
+/// (QA of issue #16: `--steps -1` said "-1 is not in 0..=4294967295", `--seed x`
+/// "invalid digit found in string", `--max-area abc` "invalid float literal").
+fn exit_with(e: clap::Error) -> ! {
+    if e.kind() != clap::error::ErrorKind::ValueValidation {
+        e.exit();
+    }
+    let text = radiosity_cli::args::plain_number_errors(&e.to_string());
+    eprint!("{text}");
+    std::process::exit(2);
 }
 
 /// The command line with every flag that takes a value accepting a negative number

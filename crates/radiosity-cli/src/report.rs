@@ -205,7 +205,7 @@ const BAND_NAMES: [&str; 3] = ["R", "G", "B"];
 /// the backs of faces, or counted twice where negative), so every solve says how far its
 /// light can be trusted. `check` prints the same account in full and, for a matrix solve,
 /// says through which surfaces the escaped part goes.
-pub fn energy_note(solution: &Solution, reporter: &Reporter) {
+pub fn energy_note(solution: &Solution, method: FormFactorMethod, reporter: &Reporter) {
     let b = &solution.balance;
     let Some(band) = energy_band(b) else {
         return;
@@ -233,10 +233,16 @@ pub fn energy_note(solution: &Solution, reporter: &Reporter) {
         // issue #16: 100.12 % in all with --method hemicube, and no word why).
         let total = share(b.absorbed[band]) + escaped;
         if (total - 100.0).abs() >= 0.005 {
+            let why = match not_reciprocal(method) {
+                Some(_) => format!(
+                    "{method}'s form factors are not reciprocal (it estimates F_ij and F_ji \
+                     apart, so what one element sends and what the other receives differ)"
+                ),
+                // QA of issue #16: `--tolerance 0.01` blamed the (reciprocal) area method.
+                None => UNSOLVED.to_string(),
+            };
             text.push_str(&format!(
-                "; the two add up to {total:.2} %, not 100 %: the form factors are not \
-                 reciprocal (hemicube, analytic and montecarlo estimate F_ij and F_ji apart, \
-                 so what one element sends and what the other receives differ)"
+                "; the two add up to {total:.2} %, not 100 %: {why}"
             ));
         }
     }
@@ -255,6 +261,16 @@ fn escaped_meaning(percent: f64) -> String {
 /// Where light that reaches no element goes: one wording for the energy note, `check`'s
 /// energy line and its list of surfaces (QA of issue #16: they said it three ways).
 const ESCAPED: &str = "through openings, into gaps and contacts or onto the backs of faces";
+
+/// Why a solve with reciprocal form factors loses part of the account: the relative
+/// residual is the largest single element's, over the brightest emission, so thousands
+/// of elements each within it can leave much more of the power unsolved (QA of issue #16:
+/// `--tolerance 0.01` left a residual of 3.9e-3 and 14 % of the light).
+const UNSOLVED: &str = "the form factors are reciprocal, so it is light the solve has not \
+                        yet passed on: the relative residual is the largest single \
+                        element's, over the brightest emission, and many elements each \
+                        within it leave more of the power unsolved; a smaller --tolerance \
+                        closes it";
 
 /// What a row of form factors above 1 does, in the same places.
 const COUNTED_TWICE: &str = "light counted twice where the form factors' rows sum above 1 \
@@ -386,6 +402,17 @@ pub fn count(n: impl Into<u64>, noun: &str) -> String {
         _ => format!("{noun}s"),
     };
     format!("{n} {many}")
+}
+
+/// `x` as the user would type it: Rust's shortest round-trip digits, with an exponent
+/// outside 1e-4 to 1e15 (QA of issue #16: `--fov 1e300` was echoed as 301 digits, 1e-6 as
+/// 0.000001).
+pub fn typed(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// `x` with `digits` significant digits, without an exponent for everyday magnitudes
@@ -673,9 +700,7 @@ fn account_error_reason(method: FormFactorMethod, solution: &Solution) -> Option
                  each element by the other elements' rows, the solve by the element's own \
                  row, so its two sides differ"
             ),
-            None => "relative error: the form factors are reciprocal, so it is the solve's \
-                     residual or rounding of the f32 matrix"
-                .to_string(),
+            None => format!("relative error: {UNSOLVED} (or it is the f32 matrix's rounding)"),
         }),
         // Progressive: the unshot power, said on its own line; hierarchical: its account
         // is its own (the leaves' B against their gathered irradiance).

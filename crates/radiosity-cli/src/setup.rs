@@ -240,19 +240,17 @@ pub fn check_scene_flags(args: &SceneArgs) -> Result<()> {
     if !(args.scale > 0.0 && args.scale.is_finite()) {
         bail!(
             "--scale {}: give the factor every coordinate is multiplied by, a number above 0",
-            args.scale
+            crate::report::typed(args.scale)
         );
     }
     if let Some(a) = args.max_area {
         if !(a > 0.0 && a.is_finite()) {
+            let a = crate::report::typed(a);
             bail!(
                 "--max-area {a}: give the largest element area (scene units squared), a \
                  number above 0"
             );
         }
-    }
-    if args.steps == Some(0) {
-        bail!("--steps 0: give the points along each axis of an element, at least 1");
     }
     Ok(())
 }
@@ -264,20 +262,23 @@ pub fn check_scene_flags(args: &SceneArgs) -> Result<()> {
 pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
     if let Some(t) = options.tolerance {
         if !(t > 0.0 && t.is_finite()) {
+            let t = crate::report::typed(t);
             bail!("--tolerance {t}: give where the solver stops, a number above 0");
         }
         if options.solver.0 == SolverKind::Hierarchical && t >= 1.0 {
+            let t = crate::report::typed(t);
             bail!("--tolerance {t}: give hierarchical radiosity's stopping change, a number above 0 and below 1");
         }
     }
     if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
         bail!(
             "--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0",
-            options.epsilon
+            crate::report::typed(options.epsilon)
         );
     }
     if let Some(a) = options.min_area {
         if !(a > 0.0 && a.is_finite()) {
+            let a = crate::report::typed(a);
             bail!("--min-area {a}: give the smallest element area (scene units squared), a number above 0");
         }
     }
@@ -293,7 +294,7 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
         bail!(
             "--adapt-contrast {}: give the step that splits, as a fraction of the brighter \
              element's luminance, a number above 0 and below 1",
-            options.adapt_contrast
+            crate::report::typed(options.adapt_contrast)
         );
     }
     if options.adapt_max_elements == Some(0) {
@@ -306,7 +307,7 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
 /// (`room.scene:1: MAX_PATCH_AREA 0.001`), or the built-in box.
 fn max_area_origin(args: &SceneArgs) -> String {
     if let Some(a) = args.max_area {
-        return format!("--max-area {a}");
+        return format!("--max-area {}", crate::report::typed(a));
     }
     let Some(path) = args.scene.as_deref() else {
         return "the built-in Cornell box's MAX_PATCH_AREA".to_string();
@@ -642,6 +643,7 @@ fn solver(
                 .tolerance
                 .unwrap_or(radiosity::solve::DEFAULT_HIERARCHICAL_TOLERANCE);
             if !(tolerance > 0.0 && tolerance < 1.0) {
+                let tolerance = crate::report::typed(tolerance);
                 bail!("--tolerance {tolerance}: give hierarchical radiosity's stopping change, a number above 0 and below 1");
             }
             Solver::Hierarchical(radiosity::solve::HierarchicalSettings {
@@ -849,7 +851,7 @@ pub fn gamma(args: &ToneArgs) -> Result<f64> {
     if !(args.gamma > 0.0 && args.gamma.is_finite()) {
         bail!(
             "--gamma {}: give the gamma (displayed = value^(1/gamma)), a number above 0",
-            args.gamma
+            crate::report::typed(args.gamma)
         );
     }
     Ok(args.gamma)
@@ -882,6 +884,7 @@ pub fn check_camera_flags(args: &CameraArgs) -> Result<()> {
     image_size(args)?;
     if let Some(fov) = args.fov {
         if !(fov > 0.0 && fov < 180.0) {
+            let fov = crate::report::typed(fov);
             bail!("--fov {fov}: give the vertical field of view in degrees, above 0 and below 180");
         }
     }
@@ -889,9 +892,9 @@ pub fn check_camera_flags(args: &CameraArgs) -> Result<()> {
         if !(up.length().is_finite() && up.length() > 0.0) {
             bail!(
                 "--up {},{},{}: give a direction of finite, non-zero length",
-                up.x,
-                up.y,
-                up.z
+                crate::report::typed(up.x),
+                crate::report::typed(up.y),
+                crate::report::typed(up.z)
             );
         }
     }
@@ -919,6 +922,7 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     }
     if let Some(fov) = args.fov {
         if !(fov > 0.0 && fov < 180.0) {
+            let fov = crate::report::typed(fov);
             bail!("--fov {fov}: give the vertical field of view in degrees, above 0 and below 180");
         }
         camera.fov_y_degrees = fov;
@@ -944,21 +948,23 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     for (flag, point) in [("--eye", camera.eye), ("--look-at", camera.look_at)] {
         if far(point) {
             bail!(
-                "{flag} {:e},{:e},{:e} is out of range: farther than {reach:.3e} (1e9 times the \
-                 scene's size, {size:.3e}) from the scene's centre, where rays lose their precision; \
-                 bring it closer (a smaller --fov frames the scene from nearer)",
-                point.x,
-                point.y,
-                point.z
+                "{flag} {},{},{} is out of range: farther than {} (1e9 times the scene's size, \
+                 {}) from the scene's centre, where rays lose their precision; bring it closer \
+                 (a larger --fov frames the scene from nearer)",
+                crate::report::typed(point.x),
+                crate::report::typed(point.y),
+                crate::report::typed(point.z),
+                crate::report::significant(reach, 4),
+                crate::report::significant(size, 4)
             );
         }
     }
     if !(camera.up.length().is_finite()) {
         bail!(
             "--up {},{},{}: give a direction of finite, non-zero length",
-            camera.up.x,
-            camera.up.y,
-            camera.up.z
+            crate::report::typed(camera.up.x),
+            crate::report::typed(camera.up.y),
+            crate::report::typed(camera.up.z)
         );
     }
     if forward
@@ -967,7 +973,23 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
         .length()
         <= 1e-12
     {
-        bail!("--up must not be parallel to the viewing direction (or zero)");
+        // QA of issue #16: with no --up given, the message blamed a flag never typed.
+        match args.up {
+            Some(up) => bail!(
+                "--up {},{},{}: give a direction not parallel to the view (from --eye to \
+                 --look-at)",
+                crate::report::typed(up.x),
+                crate::report::typed(up.y),
+                crate::report::typed(up.z)
+            ),
+            None => bail!(
+                "the camera's up direction ({},{},{}; no --up was given) is parallel to the \
+                 view from the eye to the look-at point; give --up, e.g. --up 0,0,1",
+                crate::report::typed(camera.up.x),
+                crate::report::typed(camera.up.y),
+                crate::report::typed(camera.up.z)
+            ),
+        }
     }
     Ok(camera)
 }

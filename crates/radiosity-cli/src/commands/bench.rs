@@ -20,6 +20,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         bail!("--repeat 0: give the runs per configuration, at least 1");
     }
     if let Some(&a) = args.max_area.iter().find(|a| !(**a > 0.0 && a.is_finite())) {
+        let a = crate::report::typed(a);
         bail!(
             "--max-area {a}: give the largest element area (scene units squared), a number above 0"
         );

@@ -39,6 +39,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
         }
         let max_area = args.scene.max_area.unwrap_or(1.0 / 64.0);
         if !(max_area > 0.0 && max_area <= 1.0) {
+            let max_area = crate::report::typed(max_area);
             bail!("--max-area {max_area}: give the element area --compare-methods meshes its unit squares at, above 0 and at most 1");
         }
         report::method_accuracy(max_area, args.scene.quiet);

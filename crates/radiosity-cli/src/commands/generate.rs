@@ -26,7 +26,8 @@ fn flag_at_fault(e: &BuildingError) -> String {
             min,
             furniture,
         } => format!(
-            "--room-size {size}: give the inner side of a room in metres, {min} to 100{}",
+            "--room-size {}: give the inner side of a room in metres, {min} to 100{}",
+            crate::report::typed(*size),
             if *furniture {
                 " (the furniture needs 5.7; --no-furniture allows 2.5)"
             } else {
@@ -34,16 +35,19 @@ fn flag_at_fault(e: &BuildingError) -> String {
             }
         ),
         BuildingError::Height(h) => {
+            let h = crate::report::typed(*h);
             format!("--height {h}: give the floor-to-ceiling height in metres, 2.4 to 20")
         }
         BuildingError::MaxPatchArea(a) => format!(
-            "--max-area {a}: give the largest element area in square metres, a number above 0"
+            "--max-area {}: give the largest element area in square metres, a number above 0",
+            crate::report::typed(*a)
         ),
         BuildingError::IntegralSteps => {
             "--steps 0: give the points along each axis of an element, at least 1".to_string()
         }
         BuildingError::Light(l) => format!(
-            "--light {l}: give the ceiling panels' exitance in lm/m^2, a number of at least 0"
+            "--light {}: give the ceiling panels' exitance in lm/m^2, a number of at least 0",
+            crate::report::typed(*l)
         ),
         BuildingError::TooManyRooms(n) => format!(
             "--floors x --rooms-x x --rooms-z make {n} rooms, more than the limit of {}",

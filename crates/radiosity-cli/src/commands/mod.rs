@@ -134,7 +134,7 @@ pub fn solve_scene(
     if let (Some(stats), false) = (&solution.form_factors, stats_said) {
         report::form_factor_stats(prepared, &solution.mesh, stats, reporter);
     }
-    report::energy_note(&solution, reporter);
+    report::energy_note(&solution, prepared.method(), reporter);
     let stats = solution.form_factors;
     Ok((solution, stats))
 }

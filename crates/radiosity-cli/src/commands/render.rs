@@ -80,6 +80,7 @@ pub fn check(args: &RenderArgs) -> Result<Checked> {
         }
         if let Some(max) = args.lux_max {
             if !(max.is_finite() && max > 0.0) {
+                let max = crate::report::typed(max);
                 bail!("--lux-max {max}: give the top of the scale in lux, a number above 0");
             }
         }

@@ -12,9 +12,6 @@ pub fn run(args: ViewArgs) -> Result<()> {
     use radiosity_viewer::{worker::ViewSolver, ViewerOptions};
 
     let quiet = args.quiet;
-    if args.steps == Some(0) {
-        bail!("--steps 0: give the points along each axis of an element, at least 1");
-    }
     // Before any thread starts: the window system's libraries complain at every probe
     // where XDG_RUNTIME_DIR is missing (root under Xvfb).
     crate::runtime_dir::ensure_runtime_dir();
@@ -86,6 +83,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             bail!("--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0", args.epsilon);
         }
         if !(min_area > 0.0 && min_area.is_finite()) {
+            let min_area = crate::report::typed(min_area);
             bail!("--min-area {min_area}: give the smallest element area (scene units squared), a number above 0");
         }
         hierarchical = Some(radiosity::solve::HierarchicalSettings {

@@ -910,8 +910,12 @@ fn every_command_that_prints_notes_takes_quiet() {
     // not clap's exit 2 for an unknown flag): the flag check before any window runs.
     let out = radiosity(&["view", "-q", "--steps", "0"], &dir);
     let err = stderr(&out);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(!err.contains("unexpected argument"), "{err}");
+    assert!(
+        err.contains("give the points along each axis of an element, a whole number of at least 1"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -1153,10 +1157,6 @@ fn flag_numbers_are_refused_before_the_scene_is_read() {
         (
             vec!["formfactors", "absent.scene", "--max-area", "-1"],
             "--max-area -1: give the largest element area",
-        ),
-        (
-            vec!["render", "absent.scene", "--steps", "0"],
-            "--steps 0: give the points along each axis",
         ),
         (
             vec!["check", "absent.scene", "--scale", "NaN"],
@@ -1943,5 +1943,42 @@ fn refusals_give_the_flag_to_type() {
     );
     let err = stderr(&radiosity(&["render", "--width", "0"], &dir));
     assert!(err.contains("give a whole number of at least 1"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn number_flags_are_refused_in_one_wording() {
+    // QA of issue #16 (fourth pass): the standard library's parse errors came through
+    // clap as "-1 is not in 0..=4294967295", "invalid digit found in string" and "invalid
+    // float literal", beside the project's "give a whole number of at least 1".
+    let dir = scratch_dir("number-words");
+    for (args, needle) in [
+        (
+            vec!["render", "--steps", "-1"],
+            "'--steps <K>': give the points along each axis of an element, a whole number of at least 1",
+        ),
+        (
+            vec!["check", "--steps", "0"],
+            "'--steps <K>': give the points along each axis of an element, a whole number of at least 1",
+        ),
+        (vec!["render", "--seed", "x"], "'--seed <SEED>': give a whole number"),
+        (vec!["render", "--max-area", "abc"], "'--max-area <AREA>': give a number"),
+        (
+            vec!["render", "--adapt-rounds", "-3"],
+            "'--adapt-rounds <N>': give a whole number of at least 0",
+        ),
+        (
+            vec!["render", "--supersample", "17"],
+            "'--supersample <N>': give a whole number from 1 to 16",
+        ),
+    ] {
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        for clap_words in ["is not in", "invalid digit", "float literal"] {
+            assert!(!err.contains(clap_words), "{args:?}: {err}");
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -121,7 +121,7 @@ fn solve_with_memory(
         stopped,
     };
     progress.message(&format!(
-        "solved {} elements by {solver}: relative residual {:.1e} / {:.1e} / {:.1e}",
+        "solved {} elements by {solver}: relative residual (R / G / B: the largest element's, over the brightest emission) {:.1e} / {:.1e} / {:.1e}",
         f.n(),
         residual[0],
         residual[1],
