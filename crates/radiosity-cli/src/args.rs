@@ -90,8 +90,8 @@ pub struct BuildingArgs {
     /// Seed of door positions, window widths, furniture placement and colours.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// The scene's MAX_PATCH_AREA (m^2): 1 gives about 51,500 elements for the default
-    /// building (33,400 on the grid, split along furniture contacts), 0.0125 about 990,000
+    /// The scene's MAX_PATCH_AREA (m^2): 1 gives 50,931 elements for the default
+    /// building (33,279 on the grid, split along furniture contacts), 0.0125 about 990,000
     /// on the grid (the count is printed when the file is written).
     #[arg(long, default_value_t = 1.0, value_name = "AREA")]
     pub max_area: f64,
@@ -132,7 +132,8 @@ pub struct SceneArgs {
     /// No progress bars, timings or notes (errors and warnings are still printed).
     #[arg(short, long)]
     pub quiet: bool,
-    /// Run even work estimated at hours or more, which is refused otherwise: element pairs
+    /// Run even work estimated at about an hour or more (20 minutes to 2.5 hours by kind,
+    /// at rates measured on two cores), which is refused otherwise: element pairs
     /// x INTEGRAL_STEPS^4 point pairs, Monte Carlo samples, hemicube resolution, and where
     /// the command draws an image, its pixels x --supersample^2 or --paths. Memory limits
     /// still hold.
@@ -222,11 +223,12 @@ pub struct SolveOptions {
     /// wrong where coarse links meet (bright concave corners, darker walls between).
     #[arg(long)]
     pub no_final_gather: bool,
-    /// Hierarchical: the most points the final gather gathers at; above it, the gather
-    /// runs at coarser patches and the leaves under each take its light plus what finer
-    /// links bring. Its time grows with this: at the default, the million-element building
-    /// gathers at 236,916 points in about 110 s of CPU (BENCHMARKS.md), the Cornell box at
-    /// --max-area 10 at its 176,191 leaves in about 40 s (two shared cores).
+    /// Hierarchical: the most points the final gather gathers at (the leaves along
+    /// contacts always gather their own, beyond it); above it, the gather runs at coarser
+    /// patches and the leaves under each take its light plus what finer links bring. Its
+    /// time grows with this: at the default, the million-element building gathers at
+    /// 236,916 points in about 110 s of CPU (BENCHMARKS.md), the Cornell box at --max-area
+    /// 10 at its 176,191 leaves in about 8 s (README, two idle cores).
     #[arg(long, value_name = "N", default_value_t = radiosity::solve::GATHER_POINTS_DEFAULT)]
     pub gather_points: usize,
     /// Dense solvers: rounds of adaptive subdivision after the first solve (each splits
@@ -418,7 +420,7 @@ pub struct RenderArgs {
     /// With --false-colour: the illuminance at the top of the scale, in lux (default: the
     /// largest on any element, rounded up to 4-8 round steps: 150.3 gives 160); brighter
     /// surfaces take the top colour.
-    #[arg(long, value_name = "LUX", requires = "false_colour")]
+    #[arg(long, value_name = "LUX")]
     pub lux_max: Option<f64>,
 }
 
@@ -451,7 +453,7 @@ pub struct PathTraceArgs {
     #[arg(long, default_value_t = 1, value_name = "S")]
     pub path_seed: u64,
     /// The most diffuse reflections a path may make (Russian roulette ends almost all paths
-    /// long before).
+    /// long before); 0 shows the emitters only.
     #[arg(long, default_value_t = 256, value_name = "N")]
     pub max_bounces: u32,
     /// Russian roulette starts after this many reflections (unbiased for any value).
@@ -552,13 +554,12 @@ pub struct IlluminanceArgs {
     /// A rectangular grid instead: corners x0,y0,z0 and x1,y1,z1 (equal in at least one
     /// axis) and the spacing; points from the first corner every SPACING up to the second.
     #[arg(long, value_name = "X0,Y0,Z0:X1,Y1,Z1:SPACING", allow_hyphen_values = true,
-          value_parser = parse_grid, requires = "normal")]
+          value_parser = parse_grid)]
     pub grid: Option<(DVec3, DVec3, f64)>,
     /// The normal of every grid point, required with --grid: 0,0,1 for a horizontal work
     /// plane in a z-up scene, 0,1,0 in a y-up one such as the Cornell box (scenes come both
     /// ways up, so no default would be right for all).
-    #[arg(long, value_name = "NX,NY,NZ", allow_hyphen_values = true, value_parser = parse_vec3,
-          requires = "grid")]
+    #[arg(long, value_name = "NX,NY,NZ", allow_hyphen_values = true, value_parser = parse_vec3)]
     pub normal: Option<DVec3>,
     /// Output CSV: name,x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux.
     #[arg(short, long, value_name = "OUT.csv")]
@@ -608,12 +609,12 @@ pub struct BenchArgs {
     pub scale: f64,
     #[command(flatten)]
     pub method: MethodArgs,
-    /// MAX_PATCH_AREA values to time, one table row each (repeat the option or give several
-    /// values); the scene's own when omitted.
-    #[arg(long, value_name = "AREA", num_args = 1..)]
+    /// MAX_PATCH_AREA values to time, one table row each (several values, separated by
+    /// commas or spaces, or the option repeated); the scene's own when omitted.
+    #[arg(long, value_name = "AREA", num_args = 1.., value_delimiter = ',')]
     pub max_area: Vec<f64>,
     /// Override the scene's INTEGRAL_STEPS.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", value_parser = parse_steps)]
     pub steps: Option<u32>,
     /// Runs per configuration; the table shows the median of each column.
     #[arg(long, default_value_t = 5, value_name = "N")]
@@ -647,6 +648,13 @@ pub struct BenchArgs {
     /// Only the table: no note on what was timed (errors and warnings are still printed).
     #[arg(short, long)]
     pub quiet: bool,
+    /// Time even work estimated at about an hour or more (20 minutes to 2.5 hours by kind,
+    /// at rates measured on two cores), refused otherwise before the first run
+    /// (as for `render --no-work-limit`: element pairs x INTEGRAL_STEPS^4 point pairs,
+    /// Monte Carlo samples, hemicube resolution, pixels x --supersample^2). Memory limits
+    /// still hold.
+    #[arg(long)]
+    pub no_work_limit: bool,
 }
 
 /// Options of `radiosity view`.

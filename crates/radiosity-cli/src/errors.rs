@@ -22,6 +22,7 @@ pub fn describe(err: &anyhow::Error) -> String {
     if let Some(hint) = err.chain().find_map(hint) {
         text.push_str(&hint);
     }
+    let text = plain_io_words(&text);
     // Messages in the compiler's form ("file:line: error: what") carry their own prefix:
     // scene and import errors always, and any other library error that names a place in a
     // file (a points CSV, an IES file).
@@ -36,6 +37,38 @@ pub fn describe(err: &anyhow::Error) -> String {
     } else {
         format!("error: {text}")
     }
+}
+
+/// The operating system's words put in the project's: "No such file or directory (os
+/// error 2)" becomes "no such file or folder" (QA of issue #16: the raw text and its error
+/// number puzzled more than they told).
+fn plain_io_words(text: &str) -> String {
+    const WORDS: [(&str, &str); 4] = [
+        ("No such file or directory", "no such file or folder"),
+        ("Permission denied", "permission denied"),
+        ("Is a directory", "is a folder"),
+        (
+            "Not a directory",
+            "a part of the path is a file, not a folder",
+        ),
+    ];
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(" (os error ") {
+        out.push_str(&rest[..at]);
+        let tail = &rest[at + " (os error ".len()..];
+        let digits = tail.bytes().take_while(u8::is_ascii_digit).count();
+        if digits > 0 && tail[digits..].starts_with(')') {
+            rest = &tail[digits + 1..];
+        } else {
+            out.push_str(" (os error ");
+            rest = tail;
+        }
+    }
+    out.push_str(rest);
+    WORDS
+        .iter()
+        .fold(out, |text, (os, ours)| text.replace(os, ours))
 }
 
 /// What to run instead, in this program's commands and flags, for a library error that can
@@ -161,6 +194,15 @@ mod tests {
     /// 100,000 x 100,000 f32 (44 GB with headroom) in 1 GiB.
     fn oom() -> OutOfMemory {
         check_dense_fits("the form-factor matrix (f32)", 100_000, 4.0, 1 << 30).unwrap_err()
+    }
+
+    #[test]
+    fn operating_system_words_are_plain() {
+        let err = std::io::Error::from_raw_os_error(2);
+        let text = describe(&anyhow::Error::new(err).context("cannot read x.csv"));
+        assert_eq!(text, "error: cannot read x.csv: no such file or folder");
+        // Not an error number: left as it is.
+        assert_eq!(plain_io_words("a (os error x)"), "a (os error x)");
     }
 
     #[test]

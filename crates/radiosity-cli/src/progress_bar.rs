@@ -340,6 +340,10 @@ pub fn format_duration(d: Duration) -> String {
 }
 
 impl Progress for Reporter {
+    fn file(&self, name: &str) {
+        self.name_last(name);
+    }
+
     fn start(&self, stage: Stage, total: u64) {
         if self.lines_enabled {
             self.start_ticker(stage, total);

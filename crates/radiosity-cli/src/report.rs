@@ -33,7 +33,7 @@ pub fn form_factor_stats(
         reporter.note(&text);
     }
     if let Some(text) = over_rows_text(&prepared.scene, mesh, prepared.method(), stats) {
-        reporter.note(&format!("warning: {text}"));
+        reporter.note(&text);
     }
 }
 
@@ -154,6 +154,10 @@ fn zero_rows_text(scene: &Scene, mesh: &Mesh, stats: &FormFactorStats) -> Option
     ))
 }
 
+/// Above this largest row sum, rows summing above [`ROW_SUM_OVER`] are a warning (or where
+/// more than one element in twenty has one); below, a note.
+const ROW_SUM_WARN: f64 = 1.1;
+
 /// What rows summing above [`ROW_SUM_OVER`] mean, when there are any.
 fn over_rows_text(
     scene: &Scene,
@@ -176,12 +180,17 @@ fn over_rows_text(
             "--method contour --steps 4 reduces it".to_string()
         }
     };
+    // A warning where the excess can show: a row well above 1, or many of them. A few rows
+    // a few per cent over pass on a few per cent too much of a little light (QA of issue
+    // #16: the shipped room, 0.19 % of its power counted twice, was warned on every run).
+    let serious = rows.max > ROW_SUM_WARN || rows.over * 20 > mesh.len();
     Some(format!(
-        "{} {} form-factor rows summing above {ROW_SUM_OVER} (the largest {:.4}, \
+        "{}{} {} form-factor rows summing above {ROW_SUM_OVER} (the largest {:.4}, \
          {}): they pass on more light than reaches them, so the solution holds light that \
          was never emitted (`check` lists it as \"counted twice\"). It comes from pairs much \
          closer than their elements are large (a wall a few cm behind furniture, surfaces \
          meeting at an edge), whose visibility the {method} points cannot resolve; {cure}",
+        if serious { "warning: " } else { "" },
         count(rows.over as u64, "element"),
         if rows.over == 1 { "has" } else { "have" },
         rows.max,
@@ -415,6 +424,17 @@ pub fn typed(x: f64) -> String {
     }
 }
 
+/// `x` with `decimals` decimals and its sign, or none where it rounds to zero: "+0.125",
+/// "-1.500", "0.000" (QA of issue #16: `validate` printed "-0.000").
+pub fn signed(x: f64, decimals: usize) -> String {
+    let text = format!("{x:+.decimals$}");
+    if text[1..].bytes().all(|b| b == b'0' || b == b'.') {
+        text[1..].to_string()
+    } else {
+        text
+    }
+}
+
 /// `x` with `digits` significant digits, without an exponent for everyday magnitudes
 /// (1e-4 to 1e9) and without trailing zeros: 0.5080691785954333 -> "0.5081" at 4 (QA of
 /// issue #16: the exposure scale came with 16 digits, `check`'s areas as "7.2977e0").
@@ -424,7 +444,15 @@ pub fn significant(x: f64, digits: usize) -> String {
     }
     let magnitude = x.abs().log10().floor();
     if !(-4.0..=9.0).contains(&magnitude) {
-        return format!("{x:.prec$e}", prec = digits.saturating_sub(1));
+        // Without trailing zeros there too (QA of issue #16: "MAX_PATCH_AREA 1.00000e300").
+        let text = format!("{x:.prec$e}", prec = digits.saturating_sub(1));
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let mantissa = if mantissa.contains('.') {
+            mantissa.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            mantissa
+        };
+        return format!("{mantissa}e{exponent}");
     }
     let decimals = (digits as f64 - 1.0 - magnitude).max(0.0) as usize;
     let text = format!("{x:.decimals$}");
@@ -533,14 +561,16 @@ pub fn check(
             stats.row_sums.mean,
             stats.row_sums.max
         );
+        // Under the "row sums" label, without its own (QA of issue #16).
         if let Some(text) = zero_rows_text(scene, &solution.mesh, stats) {
+            let text = text.strip_prefix("row sums: ").unwrap_or(&text);
             outln!("                  {text}");
         }
         if let Some(text) = over_rows_text(scene, &solution.mesh, prepared.method(), stats) {
-            outln!("                  warning: {text}");
+            outln!("                  {text}");
         }
         outln!(
-            "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max; {:.3e} of all exchanged power",
+            "reciprocity error {:.3e} largest |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji); {:.3e} of all exchanged power",
             stats.reciprocity.max_relative, stats.reciprocity.total_relative
         );
         if let (Some(why), true) = (
@@ -604,7 +634,7 @@ pub fn check(
         }
         SolutionReport::Progressive(report) => {
             outln!(
-                "progressive       {}; unshot power {:.3} % of emitted (the band with the most left); ambient {:.3e} / {:.3e} / {:.3e}",
+                "progressive       {}; unshot power {:.3} % of emitted (the band with the most left); ambient {:.3e} / {:.3e} / {:.3e} (R / G / B: the unshot power's estimated share of every radiosity, added for display, Cohen et al. 1988)",
                 count(report.shots as u64, "shot"),
                 100.0 * report.unshot_fraction,
                 report.ambient[0],
@@ -648,15 +678,40 @@ pub fn check(
         share(b.escaped[k]),
     );
     if band.is_some() {
-        let (_, area_unit) = length_and_area_units();
+        let (length_unit, area_unit) = length_and_area_units();
+        // Said for the scene's own unit (QA of issue #16: the built-in box, in millimetres,
+        // was told "lengths in metres").
+        let watts = match length_unit.as_str() {
+            "m" => "W or lm where E is in W/m^2 or lm/m^2".to_string(),
+            "mm" => "millionths of a W or lm where E is in W/m^2 or lm/m^2".to_string(),
+            _ => format!("W or lm where E is in W/m^2 or lm/m^2 and {length_unit} are metres"),
+        };
         outln!(
-            "                  (powers: exitance E times {area_unit}, so W or lm where E is in \
-             W/m^2 or lm/m^2 and lengths in metres; escaped: {}; {} is the band emitting most)",
+            "                  (powers: exitance E times {area_unit}, so {watts}; escaped: \
+             {}; {} is the band emitting most)",
             escaped_meaning(100.0 * b.escaped[k] / b.emitted[k]),
             BAND_NAMES[k]
         );
         if let Some(why) = account_error_reason(prepared.method(), solution) {
             outln!("                  ({why})");
+        }
+        if !scene.lights.is_empty() {
+            // QA of issue #16: "emitted" did not match the luminaires' lumens, with no word
+            // why. The surfaces' own emission, the rest is the luminaires' first bounce.
+            let own: f64 = solution
+                .mesh
+                .elements
+                .iter()
+                .map(|e| e.area * scene.surfaces[e.surface as usize].emission.0[k])
+                .sum();
+            outln!(
+                "                  (with point luminaires the account starts at their first \
+                 bounce: \"emitted\" is the surfaces' own emission, {}, plus the luminaires' \
+                 light on them times their reflectance, {}; what the surfaces absorb of the \
+                 luminaires' direct light is not in it)",
+                significant(own, 7),
+                significant(b.emitted[k] - own, 7)
+            );
         }
     }
     match (escaped_by_surface, band) {
@@ -674,9 +729,11 @@ pub fn check(
         _ => {}
     }
     outln!("stage times:");
-    for (stage, d) in reporter.labelled_timings() {
-        // At least one space after a long label ("parse room.scene"; QA of issue #16).
-        outln!("  {:<13} {}", stage, format_duration(d));
+    let timings = reporter.labelled_timings();
+    // The times in one column, however long a label ("parse room.scene"; QA of issue #16).
+    let width = timings.iter().map(|t| t.0.len()).max().unwrap_or(0).max(13);
+    for (stage, d) in timings {
+        outln!("  {stage:<width$} {}", format_duration(d));
     }
 }
 
@@ -698,7 +755,19 @@ fn account_error_reason(method: FormFactorMethod, solution: &Solution) -> Option
                 "relative error: {method}'s form factors are not reciprocal (A_i F_ij != A_j \
                  F_ji, the reciprocity error above); the account counts the power reaching \
                  each element by the other elements' rows, the solve by the element's own \
-                 row, so its two sides differ"
+                 row, so its two sides differ{}",
+                match method {
+                    // What lowers it (QA of issue #16: `--samples 1` came with no way out).
+                    FormFactorMethod::MonteCarlo { samples, .. } => format!(
+                        "; more rays (--samples {}) bring them closer",
+                        (4 * samples).max(crate::args::MethodArgs::SAMPLES)
+                    ),
+                    FormFactorMethod::Hemicube { resolution } => format!(
+                        "; a finer hemicube (--resolution {}) brings them closer",
+                        2 * resolution
+                    ),
+                    _ => String::new(),
+                }
             ),
             None => format!("relative error: {UNSOLVED} (or it is the f32 matrix's rounding)"),
         }),
@@ -909,7 +978,7 @@ pub fn compare(row: &CompareRow) {
             radiosity::form_factor::format_mib(r.matrix_bytes),
             format!("{:.2}", 100.0 * r.difference.rms),
             format!("{:.1}", 100.0 * r.difference.max),
-            format!("{:+.2}", 100.0 * r.difference.bias),
+            signed(100.0 * r.difference.bias, 2),
         ),
         None => (dash(), dash(), dash(), dash(), dash()),
     };
@@ -1067,22 +1136,37 @@ pub fn path_traced(view: &PathTraced, settings: &PathTraceSettings) {
     let noise = view.noise();
     let pixels = view.width() * view.height();
     outln!(
-        "paths             {} a pixel, seed {}, at most {} bounces, roulette after {}, light sampling {}",
+        "paths             {} a pixel, seed {}, at most {}, roulette after {}, light sampling {}",
         view.samples_per_pixel(),
         settings.seed,
-        settings.max_bounces,
-        settings.roulette_after_bounces,
-        if settings.next_event_estimation { "on" } else { "off" }
+        count(settings.max_bounces, "bounce"),
+        count(settings.roulette_after_bounces, "bounce"),
+        if settings.next_event_estimation {
+            "on"
+        } else {
+            "off"
+        }
     );
-    outln!(
-        "noise             {:.2} % (RMS standard error of luminance over the mean luminance \
-         {}; mean standard error {}; {} pixels, {} showing an emitter left out)",
-        100.0 * noise.relative(),
-        significant(noise.mean_luminance, 4),
-        significant(noise.mean_standard_error, 4),
-        noise.pixels,
+    let pixels_counted = format!(
+        "{}, {} showing an emitter left out",
+        count(noise.pixels as u64, "pixel"),
         pixels - noise.pixels
     );
+    if noise.relative().is_finite() {
+        outln!(
+            "noise             {:.2} % (RMS standard error of luminance over the mean luminance \
+             {}; mean standard error {}; {pixels_counted})",
+            100.0 * noise.relative(),
+            significant(noise.mean_luminance, 4),
+            significant(noise.mean_standard_error, 4),
+        );
+    } else {
+        // QA of issue #16: `--max-bounces 0` printed "NaN %".
+        outln!(
+            "noise             none to measure: the pixels that show no emitter are black \
+             ({pixels_counted}; light reaches them after one bounce or more)"
+        );
+    }
 }
 
 /// Prints a radiosity render's difference from the path-traced view: RMS, mean and largest
@@ -1098,7 +1182,7 @@ pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
         significant(c.reference_rms_luminance, 4)
     );
     outln!("rms               {:.2} %", 100.0 * c.rms);
-    outln!("bias              {:+.2} %", 100.0 * c.bias);
+    outln!("bias              {} %", signed(100.0 * c.bias, 2));
     outln!("max               {:.2} %", 100.0 * c.max);
     if let Some(noise) = c.reference_noise {
         outln!(
@@ -1113,7 +1197,7 @@ pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
 
 #[cfg(test)]
 mod tests {
-    use super::significant;
+    use super::{signed, significant};
 
     #[test]
     fn significant_figures_read_as_plain_numbers() {
@@ -1126,8 +1210,15 @@ mod tests {
         assert_eq!(significant(106.83529, 6), "106.835");
         assert_eq!(significant(123456.7, 4), "123457");
         assert_eq!(significant(-2.5, 4), "-2.5");
-        // Outside everyday magnitudes: an exponent, with the figures asked for.
-        assert_eq!(significant(1.5e-7, 4), "1.500e-7");
+        // Outside everyday magnitudes: an exponent, with the figures asked for and no
+        // trailing zeros.
+        assert_eq!(significant(1.5e-7, 4), "1.5e-7");
+        assert_eq!(significant(1.23456e-7, 4), "1.235e-7");
+        assert_eq!(significant(1e300, 6), "1e300");
+        assert_eq!(signed(-0.0001, 3), "0.000");
+        assert_eq!(signed(0.0004, 3), "0.000");
+        assert_eq!(signed(-0.0006, 3), "-0.001");
+        assert_eq!(signed(2.5, 2), "+2.50");
         assert_eq!(significant(0.0, 4), "0");
     }
 }

@@ -237,13 +237,19 @@ pub fn method_name(method: MethodArg) -> &'static str {
 /// #16: `--max-area 0` was refused as "MAX_PATCH_AREA must be a positive number" and
 /// `--scale 0` as "the scale", after the scene file was read, seconds on a large one).
 pub fn check_scene_flags(args: &SceneArgs) -> Result<()> {
-    if !(args.scale > 0.0 && args.scale.is_finite()) {
+    check_scale_and_area(args.scale, args.max_area)
+}
+
+/// `--scale` and `--max-area`, checked before the scene is read ([`check_scene_flags`],
+/// and `view`'s own flags).
+pub fn check_scale_and_area(scale: f64, max_area: Option<f64>) -> Result<()> {
+    if !(scale > 0.0 && scale.is_finite()) {
         bail!(
             "--scale {}: give the factor every coordinate is multiplied by, a number above 0",
-            crate::report::typed(args.scale)
+            crate::report::typed(scale)
         );
     }
-    if let Some(a) = args.max_area {
+    if let Some(a) = max_area {
         if !(a > 0.0 && a.is_finite()) {
             let a = crate::report::typed(a);
             bail!(
@@ -363,15 +369,20 @@ pub fn stem_of(scene: Option<&Path>) -> String {
     }
 }
 
-/// Refuses, before any work, to write `output` over one of the `inputs` (what it is, its
-/// path): the same file by device and inode, whatever the spelling (`./x.scene`, a link).
-pub fn refuse_overwriting_inputs(output: &Path, inputs: &[(&str, Option<&Path>)]) -> Result<()> {
+/// Refuses, before any work, to write `output` (given with `flag`) over one of the
+/// `inputs` (what it is, its path): the same file by device and inode, whatever the
+/// spelling (`./x.scene`, a link).
+pub fn refuse_overwriting_inputs(
+    output: &Path,
+    flag: &str,
+    inputs: &[(&str, Option<&Path>)],
+) -> Result<()> {
     for &(what, input) in inputs {
         if let Some(input) = input {
             if radiosity::io::is_same_file(output, input) {
                 bail!(
-                    "the output {} is the {what} {}: writing it would destroy the input; \
-                     name another output with -o FILE",
+                    "{flag} {}: this is the {what} {}: writing it would destroy the input; \
+                     give {flag} another file name",
                     output.display(),
                     input.display()
                 );
@@ -610,6 +621,12 @@ fn solver(
             "--epsilon, --min-area, --no-final-gather and --gather-points"
         );
     }
+    if choice == SolverKind::Hierarchical
+        && options.no_final_gather
+        && options.gather_points != radiosity::solve::GATHER_POINTS_DEFAULT
+    {
+        errln!("warning: --gather-points ignored: --no-final-gather leaves the gather out");
+    }
     Ok(match choice {
         SolverKind::Auto => unreachable!("auto is resolved above"),
         SolverKind::Lu => {
@@ -764,7 +781,7 @@ pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
     };
     if out.is_dir() {
         bail!(
-            "-o {}: this is a folder; give the image a file name in it, ending .png \
+            "-o {}: is a folder; give the image a file name in it, ending .png \
              (tone-mapped) or .exr (linear radiance)",
             out.display()
         );
@@ -776,8 +793,8 @@ pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
         Some("png") => Ok(ImageFormat::Png),
         Some("exr") => Ok(ImageFormat::Exr),
         _ => bail!(
-            "{}: images are written as PNG (tone-mapped) or OpenEXR (linear radiance); \
-             give the output a .png name, or .exr for linear radiance",
+            "-o {}: images are written as PNG (tone-mapped) or OpenEXR (linear radiance); \
+             give it a .png name, or .exr for linear radiance",
             out.display()
         ),
     }
@@ -817,7 +834,7 @@ pub fn check_output(
     extensions: &[&str],
     inputs: &[(&str, Option<&Path>)],
 ) -> Result<()> {
-    refuse_overwriting_inputs(output, inputs)?;
+    refuse_overwriting_inputs(output, flag, inputs)?;
     output_extension(output, flag, what, extensions)?;
     output_directory(output, flag)
 }
@@ -827,7 +844,7 @@ pub fn check_output(
 pub fn output_directory(output: &Path, flag: &str) -> Result<()> {
     if output.is_dir() {
         bail!(
-            "{flag} {}: is a directory; give a file name in it",
+            "{flag} {}: is a folder; give a file name in it",
             output.display()
         );
     }

@@ -424,6 +424,7 @@ pub fn parse_points(text: &str, source_name: &str) -> Result<Vec<CalcPoint>, Poi
             ),
         ));
     }
+    let header_line = i + 1;
     let mut out = Vec::new();
     for (i, line) in lines {
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
@@ -463,6 +464,14 @@ pub fn parse_points(text: &str, source_name: &str) -> Result<Vec<CalcPoint>, Poi
             position: DVec3::new(v[0], v[1], v[2]),
             normal,
         });
+    }
+    if out.is_empty() {
+        return Err(bad(
+            header_line + 1,
+            "no points after the header: expected one point a line \
+             (name,x,y,z,nx,ny,nz)"
+                .to_string(),
+        ));
     }
     Ok(out)
 }

@@ -151,6 +151,10 @@ fn points_files_are_read_and_bad_lines_named() {
         err("name,x,y,z,nx,ny,nz\nA,1,q,3,0,0,1\n").contains("finite number for y, found \"q\"")
     );
     assert!(err("name,x,y,z,nx,ny,nz\nA,1,2,3,0,0,0\n").contains("the normal nx,ny,nz is 0,0,0"));
+    // A header and nothing else is a mistake, not an empty table (QA of issue #16).
+    assert!(
+        err("name,x,y,z,nx,ny,nz\n\n").starts_with("p.csv:2: error: no points after the header")
+    );
     let mut out = Vec::new();
     write_lux_csv(
         &pts[..1],

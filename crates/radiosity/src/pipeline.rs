@@ -484,10 +484,17 @@ impl Prepared {
         path: &Path,
         progress: &dyn Progress,
     ) -> Result<FormFactorMatrix, PipelineError> {
-        let matrix = run_stage(progress, Stage::FormFactors, 0, || {
+        // Timed as reading a file, not as computing form factors (QA of issue #16).
+        let matrix = run_stage(progress, Stage::Parse, 0, || {
             read_form_factors(path, self.fingerprint(), Some(self.method()))
-        })
-        .map_err(|e| match e {
+        });
+        progress.file(
+            &path
+                .file_name()
+                .unwrap_or(path.as_os_str())
+                .to_string_lossy(),
+        );
+        let matrix = matrix.map_err(|e| match e {
             e @ FormFactorFileError::Stale { .. } => PipelineError::FormFactorsForAnotherMesh {
                 source: e,
                 elements: self.mesh.len(),

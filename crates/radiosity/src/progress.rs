@@ -73,6 +73,9 @@ pub trait Progress: Sync {
     fn finish(&self, stage: Stage, elapsed: Duration);
     /// An informational message (for example the reciprocity error found).
     fn message(&self, _text: &str) {}
+    /// Names the file the stage that just finished read or wrote ("cornell.ff"), for
+    /// reports that label stage times.
+    fn file(&self, _name: &str) {}
 }
 
 /// A sink that ignores every report.

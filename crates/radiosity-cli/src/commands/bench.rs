@@ -25,6 +25,31 @@ pub fn run(args: BenchArgs) -> Result<()> {
             "--max-area {a}: give the largest element area (scene units squared), a number above 0"
         );
     }
+    let areas: Vec<Option<f64>> = if args.max_area.is_empty() {
+        vec![None]
+    } else {
+        args.max_area.iter().copied().map(Some).collect()
+    };
+    // Every flag and every configuration checked before the header, so that a mistake or
+    // work past the limits is refused before any time is spent on the runs before it (QA
+    // of issue #16): each area's scene is read and meshed once, quietly, as a run would.
+    let (width, height) = image_size(&args);
+    radiosity::budget::check_render_memory(
+        width,
+        height,
+        args.supersample,
+        false,
+        radiosity::form_factor::available_memory_bytes(),
+    )?;
+    if !args.no_work_limit {
+        radiosity::budget::check_render_work(width, height, args.supersample)?;
+    }
+    for &max_area in &areas {
+        let (scene_args, options) = run_settings(&args, max_area);
+        crate::setup::check_scene_flags(&scene_args)?;
+        crate::setup::check_solve_flags(&options)?;
+        prepare_solve(&scene_args, &options, &Reporter::new(true))?;
+    }
     let name = args
         .scene
         .as_deref()
@@ -32,11 +57,6 @@ pub fn run(args: BenchArgs) -> Result<()> {
         .map_or("cornell (built in)".to_string(), |s| {
             s.to_string_lossy().into_owned()
         });
-    let areas: Vec<Option<f64>> = if args.max_area.is_empty() {
-        vec![None]
-    } else {
-        args.max_area.iter().copied().map(Some).collect()
-    };
     // Flags the method does not use, said once here, not once per run.
     let ignored = crate::setup::ignored_method_flags(&args.method, args.steps.is_some());
     if !ignored.is_empty() {
@@ -111,7 +131,8 @@ const BENCH_STAGES: [Stage; 7] = [
     Stage::Render,
 ];
 
-fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
+/// The scene and solver options of one configuration's runs.
+fn run_settings(args: &BenchArgs, max_area: Option<f64>) -> (SceneArgs, SolveOptions) {
     let scene_args = SceneArgs {
         scene: args.scene.clone(),
         scale: args.scale,
@@ -123,8 +144,7 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         },
         method: args.method.without_unused(),
         quiet: true,
-        // A benchmark measures what it is asked to, however long.
-        no_work_limit: true,
+        no_work_limit: args.no_work_limit,
     };
     let options = SolveOptions {
         solver: args.solver,
@@ -139,6 +159,11 @@ fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
         adapt_contrast: radiosity::mesh::DEFAULT_CONTRAST,
         adapt_max_elements: None,
     };
+    (scene_args, options)
+}
+
+fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
+    let (scene_args, options) = run_settings(args, max_area);
     let settings = RenderSettings {
         supersample: args.supersample,
         ..RenderSettings::default()

@@ -37,6 +37,21 @@ pub fn run(args: CheckArgs) -> Result<()> {
                  elements' size)"
             );
         }
+        // Nothing is solved: the solver's flags would do nothing either (QA of issue #16).
+        let o = &args.solve;
+        let solver_flags = [
+            ("--solver", o.solver.0 != radiosity::solve::SolverKind::Auto),
+            ("--tolerance", o.tolerance.is_some()),
+            ("--form-factors", o.form_factors.is_some()),
+            ("--adapt-rounds", o.adapt_rounds.is_some()),
+        ];
+        let given: Vec<&str> = solver_flags.iter().filter(|f| f.1).map(|f| f.0).collect();
+        if !given.is_empty() {
+            bail!(
+                "check --compare-methods computes form factors and solves nothing: drop {}",
+                given.join(", ")
+            );
+        }
         let max_area = args.scene.max_area.unwrap_or(1.0 / 64.0);
         if !(max_area > 0.0 && max_area <= 1.0) {
             let max_area = crate::report::typed(max_area);

@@ -56,7 +56,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
         Format::Glb => {}
     }
     for out in &outputs {
-        refuse_overwriting_inputs(out, &inputs)?;
+        refuse_overwriting_inputs(out, "-o", &inputs)?;
     }
     output_directory(output, "-o")?;
     // Printed even with --quiet: the file will not hold what the scene holds.

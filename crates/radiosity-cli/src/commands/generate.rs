@@ -11,7 +11,7 @@ use crate::report;
 /// The library's refusal of the building's parameters in the words of the flags (QA of
 /// issue #16: `--max-area 0` was refused as "MAX_PATCH_AREA must be ...", `--rooms-x 0` as
 /// "floors, rooms-x and rooms-z must be at least 1").
-fn flag_at_fault(e: &BuildingError) -> String {
+fn flag_at_fault(e: &BuildingError, args: &BuildingArgs) -> String {
     match e {
         BuildingError::NoRooms(what) => {
             let (flag, what) = match *what {
@@ -50,7 +50,11 @@ fn flag_at_fault(e: &BuildingError) -> String {
             crate::report::typed(*l)
         ),
         BuildingError::TooManyRooms(n) => format!(
-            "--floors x --rooms-x x --rooms-z make {n} rooms, more than the limit of {}",
+            "--floors {}, --rooms-x {}, --rooms-z {}: they make {n} rooms, more than the \
+             limit of {}; give fewer",
+            args.floors,
+            args.rooms_x,
+            args.rooms_z,
             scene::BuildingParams::MAX_ROOMS
         ),
     }
@@ -80,9 +84,19 @@ pub fn building(args: BuildingArgs) -> Result<()> {
         &[],
     )?;
     if let Err(e) = params.check() {
-        bail!("{}", flag_at_fault(&e));
+        bail!("{}", flag_at_fault(&e, &args));
     }
     let built = scene::building(&params);
+    // A building no other command could mesh is refused before its file is written (QA of
+    // issue #16: it was written, then refused by every command that read it).
+    let grid =
+        radiosity::mesh::mesh_scene(&built.scene, built.settings.max_patch_area).map_err(|e| {
+            anyhow::Error::new(e).context(format!(
+                "--max-area {} (the file's MAX_PATCH_AREA): no file written, the other \
+                 commands could not mesh it",
+                crate::report::typed(args.max_area)
+            ))
+        })?;
     scene::write_scene_file(&built.scene, built.settings, &args.output)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
     if args.light == 0.0 {
@@ -101,24 +115,21 @@ pub fn building(args: BuildingArgs) -> Result<()> {
     // contact refinement that splits elements along the furniture's footprints (so the
     // count `check` and `render` print); the grid's alone where meshing would refuse it
     // (more than MAX_ELEMENTS).
-    let elements = match radiosity::mesh::mesh_scene(&built.scene, built.settings.max_patch_area) {
+    let elements = if grid.len() > PREPARE_MAX_ELEMENTS {
         // The refinement takes seconds past this; the grid's count is then given alone.
-        Ok(grid) if grid.len() > PREPARE_MAX_ELEMENTS => format!(
+        format!(
             "{} elements on the grid (contact refinement adds some when the file is loaded)",
             grid.len()
-        ),
-        Ok(grid) => match Prepared::new(built.scene.clone(), built.settings, &NoProgress) {
+        )
+    } else {
+        match Prepared::new(built.scene.clone(), built.settings, &NoProgress) {
             Ok(prepared) if prepared.mesh.len() != grid.len() => format!(
                 "{} elements ({} on the grid, split along furniture contacts)",
                 prepared.mesh.len(),
                 grid.len()
             ),
             _ => format!("{} elements", grid.len()),
-        },
-        Err(radiosity::mesh::MeshError::TooManyElements { count, limit, .. }) => {
-            format!("{count} elements (more than the meshing limit of {limit})")
         }
-        Err(e) => return Err(e.into()),
     };
     report::building(&args.output, &params, &built.scene, &elements);
     Ok(())

@@ -46,11 +46,24 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         )?;
     }
     let (points, dims) = match (&args.points, args.grid) {
-        (Some(path), _) => (illuminance::read_points(path)?, None),
+        (Some(path), _) => {
+            if args.normal.is_some() {
+                // Printed even with --quiet (QA of issue #16: clap refused the pair, asking
+                // for a --grid that --points excludes).
+                errln!(
+                    "warning: --normal ignored with --points: each point's normal is in the \
+                     file (nx,ny,nz)"
+                );
+            }
+            (illuminance::read_points(path)?, None)
+        }
         (None, Some((a, b, spacing))) => {
             let Some(normal) = args.normal else {
-                // clap requires --normal with --grid (the help says why there is no default).
-                bail!("--grid needs --normal NX,NY,NZ, the way the meters face");
+                // No default: the help says why.
+                bail!(
+                    "--grid needs --normal NX,NY,NZ, the way the meters face: 0,0,1 for a \
+                     horizontal work plane in a z-up scene, 0,1,0 in a y-up one"
+                );
             };
             if normal.length_squared() == 0.0 {
                 bail!(

@@ -40,6 +40,22 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         )?;
     }
     if let Some(path) = &args.reference {
+        // Before any work, in the flag's name (QA of issue #16: a missing file was named
+        // only after the scene was read, without the flag).
+        if !path.is_file() {
+            bail!(
+                "--reference {}: {}; save a path-traced view with --save-reference FILE.exr \
+                 first",
+                path.display(),
+                if path.is_dir() {
+                    "is a folder"
+                } else {
+                    "no such file"
+                }
+            );
+        }
+    }
+    if let Some(path) = &args.reference {
         // The tracing flags do nothing when the view is read back (QA of issue #16:
         // `--paths` was dropped without a word). Printed even with --quiet.
         let default = PathTraceSettings::DEFAULT;
@@ -127,7 +143,6 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                 "--direct-light",
                 args.rays.direct_light != crate::args::DirectLightArg::Gather,
             ),
-            ("--error-scale", args.error_scale != 0.2),
         ];
         let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
         if !ignored.is_empty() {
@@ -136,6 +151,12 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                  polygons (the meshing, form-factor and solver flags set the radiosity solve \
                  --compare adds)",
                 ignored.join(", ")
+            );
+        }
+        if args.error_scale != 0.2 {
+            errln!(
+                "warning: --error-scale ignored without --compare: it sets the colours of the \
+                 error map --compare draws"
             );
         }
         let ignored: Vec<&str> = render_given.iter().filter(|g| g.1).map(|g| g.0).collect();
@@ -181,12 +202,12 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     }
     outputs.extend(args.save_reference.clone());
     for out in &outputs {
-        setup::refuse_overwriting_inputs(out, &inputs)?;
         let flag = if args.save_reference.as_ref() == Some(out) {
             "--save-reference"
         } else {
             "-o"
         };
+        setup::refuse_overwriting_inputs(out, flag, &inputs)?;
         setup::output_directory(out, flag)?;
     }
 
@@ -310,11 +331,19 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         ),
         Exposure::Fixed(_) => String::new(),
     };
+    let exposure = match format {
+        ImageFormat::Png => format!(
+            "exposure scale {} for both{whose}",
+            report::significant(scale, 4)
+        ),
+        // Linear radiance: no exposure was applied (QA of issue #16: the note gave one
+        // "for both" images that have none).
+        ImageFormat::Exr => "both views in linear radiance, unexposed".to_string(),
+    };
     reporter.note(&format!(
-        "exposure scale {} for both{whose}; error map: white 0, blue darker and red brighter \
-         than the path tracer, full colour at {} % of its RMS luminance, black left out",
-        report::significant(scale, 4),
-        100.0 * args.error_scale
+        "{exposure}; error map: white 0, blue darker and red brighter than the path tracer, \
+         full colour at {} % of its RMS luminance, black left out",
+        report::significant(100.0 * args.error_scale, 4)
     ));
     reporter.print_timings();
     Ok(())

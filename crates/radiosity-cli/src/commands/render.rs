@@ -39,6 +39,7 @@ pub fn check(args: &RenderArgs) -> Result<Checked> {
         .unwrap_or_else(|| PathBuf::from(format!("{}.png", stem_of(args.scene.scene.as_deref()))));
     refuse_overwriting_inputs(
         &output,
+        "-o",
         &[
             ("scene file", args.scene.scene.as_deref()),
             ("form-factor file", args.solve.form_factors.as_deref()),
@@ -109,6 +110,20 @@ pub fn run(args: RenderArgs) -> Result<()> {
         // Printed even with --quiet: the run does not do what the flags say.
         errln!("warning: --snapshot-every ignored: no --snapshots DIR to write snapshots to");
     }
+    if !args.false_colour && args.lux_max.is_some() {
+        // A warning, as for every flag the run does not use (QA of issue #16: clap refused
+        // it with "the following required arguments were not provided").
+        errln!("warning: --lux-max ignored: it sets the top of --false-colour's scale");
+    }
+    if args.false_colour {
+        // The colours stand for lux, not for exposed light.
+        if args.tone.exposure != radiosity::shade::Exposure::Auto {
+            errln!("warning: --exposure ignored with --false-colour: its colours are lux");
+        }
+        if args.tone.gamma != 2.2 {
+            errln!("warning: --gamma ignored with --false-colour: its colours are lux");
+        }
+    }
     let wireframe = settings.shading == render::Shading::Wireframe;
     if wireframe && args.tone.exposure != radiosity::shade::Exposure::Auto {
         // Printed even with --quiet (QA of issue #16): the lines are drawn white whatever
@@ -129,7 +144,24 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let camera = camera(&args.camera, &prepared.scene)?;
     let exposure = args.tone.exposure;
     if let Some(dir) = &args.snapshots {
+        let existed = dir.is_dir();
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        // What the snapshots will cost, before the solve (QA of issue #16: a long run of
+        // snapshots gave no estimate, and a new folder appeared without a word).
+        let radiosity::solve::Solver::Progressive(p) = &solver else {
+            unreachable!("--snapshots without progressive refinement is refused above")
+        };
+        reporter.note(&format!(
+            "snapshots to {}{}: a picture every {}, at most {} (--max-shots {}), each a \
+             {} x {} render named shot-NNNNN.png",
+            dir.display(),
+            if existed { " (created)" } else { "" },
+            crate::report::count(args.snapshot_every as u64, "shot"),
+            p.max_shots / args.snapshot_every,
+            p.max_shots,
+            camera.width,
+            camera.height
+        ));
     }
     // Snapshots render the display radiosity (B plus the ambient term) with a quiet
     // reporter, so that their shading and rendering do not count in the stage times.
@@ -327,9 +359,19 @@ fn false_colour(
         render::write_png(&image, output)
     })
     .with_context(|| format!("cannot write {}", output.display()))?;
+    // A view lower than the scale bar needs leaves white below it (QA of issue #16: a
+    // 128 x 128 view came out 238 x 160 with a white strip and no word why).
+    let taller = if image.height() > camera.height {
+        format!(
+            ", {} pixels tall for the scale's labels (white below the view)",
+            image.height()
+        )
+    } else {
+        String::new()
+    };
     reporter.note(&format!(
-        "wrote {} ({} x {}: the {} x {} view and a {} pixel wide scale bar; false colour \
-         from 0 to {} lx, the largest element illuminance is {} lx; {})",
+        "wrote {} ({} x {}: the {} x {} view and a {} pixel wide scale bar{taller}; false \
+         colour from 0 to {} lx, the largest element illuminance is {} lx; {})",
         output.display(),
         image.width(),
         image.height(),

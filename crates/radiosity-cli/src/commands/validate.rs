@@ -98,7 +98,7 @@ pub fn verdict(values: usize, failures: &[String]) -> (String, bool) {
 
 fn table_row(row: &Row, case: &Case) -> String {
     let difference = match row.difference_percent() {
-        Some(d) => format!("{d:+.3}"),
+        Some(d) => crate::report::signed(d, 3),
         None => "(reference 0)".to_string(),
     };
     format!(

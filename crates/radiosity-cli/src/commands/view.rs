@@ -46,6 +46,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         outln!("{table}");
         return Ok(());
     }
+    check_flags(&args)?;
     let file = match &args.scene {
         Some(path) => {
             let options = radiosity::io::import::ImportOptions {
@@ -102,6 +103,44 @@ pub fn run(args: ViewArgs) -> Result<()> {
         if !quiet {
             outln!("{note}");
         }
+    }
+    Ok(())
+}
+
+/// `view`'s numbers and output, checked before the scene is read and the window opens
+/// (QA of issue #16: `--max-area -1` or `--screenshot shot.txt` was refused only after the
+/// solve, or by the window).
+#[cfg(feature = "viewer")]
+fn check_flags(args: &ViewArgs) -> Result<()> {
+    use anyhow::bail;
+    use radiosity::solve::SolverKind;
+    crate::setup::check_scale_and_area(args.scale, args.max_area)?;
+    if let Some(shot) = &args.screenshot {
+        crate::setup::check_output(
+            shot,
+            "--screenshot",
+            "the window is saved as a PNG",
+            &["png"],
+            &[("scene file", args.scene.as_deref())],
+        )?;
+        if args.frames == 0 {
+            bail!("--frames 0: give the frames drawn before the screenshot, at least 1");
+        }
+    } else if args.frames != 30 || args.panel {
+        // Printed even with --quiet: the run does not do what the flags say.
+        errln!("warning: --frames and --panel apply to --screenshot; ignored without it");
+    }
+    let hierarchical = args.solver == SolverKind::Hierarchical;
+    if !hierarchical && (args.epsilon != 0.05 || args.min_area.is_some()) {
+        errln!(
+            "warning: --epsilon and --min-area apply to --solver hierarchical; ignored with \
+             the {} solver",
+            if args.progressive {
+                "progressive"
+            } else {
+                args.solver.name()
+            }
+        );
     }
     Ok(())
 }

@@ -80,14 +80,14 @@ fn generate_help_states_the_element_count_it_makes() {
     let dir = scratch_dir("generate-help");
     let help = radiosity(&["generate", "building", "--help"], &dir);
     let help = crate::fixtures::stdout(&help);
-    assert!(help.contains("1 gives about 51,500 elements"), "{help}");
+    assert!(help.contains("1 gives 50,931 elements"), "{help}");
     // The default building at --max-area 1 (the default) makes what the help promises,
     // within 5 % (the count moves a little with the seed's furniture), counted as the
     // other commands mesh it (contact refinement included).
     let out = radiosity(&["generate", "building", "-o", "b.scene"], &dir);
     assert!(out.status.success(), "{}", stderr(&out));
     let n = printed_elements(&out) as f64;
-    assert!((n - 51_500.0).abs() < 0.05 * 51_500.0, "{n}");
+    assert!((n - 50_931.0).abs() < 0.05 * 50_931.0, "{n}");
     // One room is "1 room".
     let out = radiosity(
         &[
@@ -187,8 +187,11 @@ fn check_gives_the_reason_beside_odd_row_sums_and_the_escaped_share() {
             && text.contains(".base\"): faces pressed against another surface"),
         "{text}"
     );
+    // Explained, but not a warning: 44 of 906 rows, the largest 1.07, count 0.19 % of the
+    // power twice (below ROW_SUM_WARN = 1.1 and one element in twenty).
     assert!(
-        text.contains("warning: ") && text.contains("rows summing above 1.01"),
+        text.contains("44 elements have form-factor rows summing above 1.01")
+            && !text.contains("warning: 44 elements"),
         "{text}"
     );
     // The escaped power as a share of the emitted, beside the absolute figure, and what it
@@ -791,7 +794,7 @@ fn an_output_name_of_a_format_not_written_is_refused_before_any_work() {
         ),
         (
             vec!["render", "-o", "out.jpg"],
-            "give the output a .png name, or .exr for linear radiance",
+            "-o out.jpg: images are written as PNG (tone-mapped) or OpenEXR (linear radiance); give it a .png name, or .exr for linear radiance",
             "out.jpg",
         ),
         (
@@ -1234,7 +1237,7 @@ fn outputs_that_cannot_be_written_are_refused_before_any_work() {
         ),
         (
             vec!["solve", "absent.scene", "-o", "taken.csv"],
-            "-o taken.csv: is a directory",
+            "-o taken.csv: is a folder",
         ),
         (
             vec!["render", "absent.scene", "-o", "nowhere/x.png"],
@@ -1590,9 +1593,9 @@ fn errors_say_error_once_and_name_a_folder_as_a_folder() {
         ),
         (
             vec!["render", "-o", "folder"],
-            "-o folder: this is a folder; give the image a file name in it",
+            "-o folder: is a folder; give the image a file name in it",
         ),
-        (vec!["check", "lamp.scene"], "bad.ies:"),
+        (vec!["check", "lamp.scene"], "IES file \"bad.ies\""),
     ] {
         let out = radiosity(&args, &dir);
         let err = stderr(&out);

@@ -30,7 +30,7 @@ fn an_output_that_is_an_input_is_refused_before_any_work() {
         assert!(!out.status.success(), "{args:?} succeeded");
         let err = stderr(&out);
         assert!(err.contains("is the scene file x.scene"), "{args:?}: {err}");
-        assert!(err.contains("-o FILE"), "{err}");
+        assert!(err.contains("give -o another file name"), "{err}");
         assert_eq!(
             std::fs::read(dir.join("x.scene")).unwrap(),
             before,

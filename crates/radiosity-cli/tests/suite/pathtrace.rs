@@ -214,7 +214,7 @@ fn bad_flags_exit_2_with_what_was_expected() {
         ),
         (
             vec!["pathtrace", "-o", "view.jpg"],
-            "give the output a .png name",
+            "-o view.jpg: images are written as PNG",
         ),
         (
             vec!["pathtrace", "--save-reference", "ref.png"],

@@ -144,12 +144,13 @@ pub enum FormFactorFileError {
         computed: u32,
     },
     /// The file was computed for a different mesh (other scene, area limit or geometry).
-    /// The file records its element count and method, not the scene or MAX_PATCH_AREA.
+    /// The file records its element count, method and a fingerprint of the mesh's
+    /// geometry, not the scene's name or MAX_PATCH_AREA.
     #[error(
         "form-factor file {path} was computed for a different mesh: it holds {elements} \
-         elements, made with method `{method}` (fingerprint {found:016x}, this mesh is \
-         {expected:016x}; the file records only the element count and method, not the scene or \
-         the MAX_PATCH_AREA it was made for)"
+         elements, made with method `{method}` (geometry fingerprint {found:016x}, this mesh is \
+         {expected:016x}; the file records the element count, the method and this hash of the \
+         elements' corners, not the scene or the MAX_PATCH_AREA it was made for)"
     )]
     Stale {
         /// The file.

@@ -164,7 +164,7 @@ fn four_digits_up(x: f64) -> String {
 
 /// `x` as Rust writes it where that is short (1e-4 to 1e15 in magnitude, or 0), else with
 /// an exponent: a MAX_PATCH_AREA of 1e-300 is not three hundred zeros.
-fn compact(x: f64) -> String {
+pub(crate) fn compact(x: f64) -> String {
     if x == 0.0 || (1e-4..1e15).contains(&x.abs()) {
         format!("{x}")
     } else {

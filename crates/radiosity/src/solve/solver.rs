@@ -8,6 +8,8 @@
 use std::fmt;
 use std::str::FromStr;
 
+use crate::mesh::compact;
+
 use super::hierarchical::HierarchicalSettings;
 use super::progressive::DEFAULT_PROGRESSIVE_TOLERANCE;
 
@@ -169,7 +171,8 @@ impl fmt::Display for DenseSolver {
                 max_iterations,
             }) => write!(
                 f,
-                "Gauss-Seidel (tolerance {tolerance:e}, at most {max_iterations} sweeps)"
+                "Gauss-Seidel (tolerance {}, at most {max_iterations} sweeps)",
+                compact(*tolerance)
             ),
         }
     }
@@ -184,12 +187,13 @@ impl fmt::Display for Solver {
                 max_shots,
             }) => write!(
                 f,
-                "progressive refinement (unshot power below {tolerance:e} of emitted, at most {max_shots} shots)"
+                "progressive refinement (unshot power below {} of emitted, at most {max_shots} shots)",
+                compact(*tolerance)
             ),
             Solver::Hierarchical(h) => write!(
                 f,
-                "hierarchical radiosity with clustering (BF refinement, epsilon {:e}, minimum area {:e}, changing power below {:e} of emitted)",
-                h.epsilon, h.min_area, h.tolerance
+                "hierarchical radiosity with clustering (BF refinement, epsilon {}, minimum area {}, changing power below {} of emitted)",
+                compact(h.epsilon), compact(h.min_area), compact(h.tolerance)
             ),
         }
     }

@@ -531,10 +531,57 @@ impl<'a> Parser<'a> {
 
     // ----- file structure -----
 
-    /// `MAX_PATCH_AREA`, `INTEGRAL_STEPS` and `SCENEBEGIN`.
+    /// `MAX_PATCH_AREA`, `INTEGRAL_STEPS` and `SCENEBEGIN`. The two values swapped, or one
+    /// given twice, is one error, not one for every line after it (QA of issue #16).
     fn header(&mut self) -> Option<MeshSettings> {
-        let area = self
-            .header_value(Keyword::MaxPatchArea)
+        let next_keyword = |p: &Self| p.lines.get(p.pos + 1).map(|l| l.keyword());
+        let swapped = self.current_keyword() == Some(Keyword::IntegralSteps)
+            && next_keyword(self) == Some(Keyword::MaxPatchArea);
+        let (area, steps) = if swapped {
+            let line = self.current().expect("checked above");
+            let head = line.head();
+            self.error_at(
+                head,
+                &line,
+                "expected MAX_PATCH_AREA, found \"INTEGRAL_STEPS\": the file starts with \
+                 MAX_PATCH_AREA, then INTEGRAL_STEPS (Appendix A); swap the two lines",
+            );
+            let steps = self.steps_line();
+            (self.area_line(), steps)
+        } else {
+            let area = self.area_line();
+            self.repeated_header_lines(&[Keyword::MaxPatchArea]);
+            (area, self.steps_line())
+        };
+        self.repeated_header_lines(&[Keyword::MaxPatchArea, Keyword::IntegralSteps]);
+        let _ =
+            self.skip_unless_known(|p| p.expect(Keyword::SceneBegin).map(|l| p.line_end(&l, 1)));
+        Some(MeshSettings {
+            max_patch_area: area?,
+            integral_steps: steps?,
+        })
+    }
+
+    /// Reports and passes over header lines of `keywords` already read.
+    fn repeated_header_lines(&mut self, keywords: &[Keyword]) {
+        while let Some(k) = self.current_keyword().filter(|k| keywords.contains(k)) {
+            let line = self.current().expect("a keyword was read");
+            let head = line.head();
+            self.error_at(
+                head,
+                &line,
+                format!(
+                    "{} is given twice; remove this line (the first is used)",
+                    k.spelling()
+                ),
+            );
+            self.pos += 1;
+        }
+    }
+
+    /// The `MAX_PATCH_AREA` line's value, checked.
+    fn area_line(&mut self) -> Option<f64> {
+        self.header_value(Keyword::MaxPatchArea)
             .and_then(|(v, t, l)| {
                 if v > 0.0 {
                     return Some(v);
@@ -545,9 +592,12 @@ impl<'a> Parser<'a> {
                 );
                 self.error_at(t, &l, msg);
                 None
-            });
-        let steps = self
-            .header_value(Keyword::IntegralSteps)
+            })
+    }
+
+    /// The `INTEGRAL_STEPS` line's value, checked.
+    fn steps_line(&mut self) -> Option<u32> {
+        self.header_value(Keyword::IntegralSteps)
             .and_then(
                 |(v, t, l)| match Self::whole(v).and_then(|k| u32::try_from(k).ok()) {
                     Some(k) if k >= 1 => Some(k),
@@ -562,13 +612,7 @@ impl<'a> Parser<'a> {
                         None
                     }
                 },
-            );
-        let _ =
-            self.skip_unless_known(|p| p.expect(Keyword::SceneBegin).map(|l| p.line_end(&l, 1)));
-        Some(MeshSettings {
-            max_patch_area: area?,
-            integral_steps: steps?,
-        })
+            )
     }
 
     /// A header line; a line with an unknown keyword in its place is taken as a misspelling.
@@ -602,8 +646,8 @@ impl<'a> Parser<'a> {
                 None => {
                     let (l, c) = self.eof;
                     let msg = if blocks == 0 {
-                        "no patches: expected PATCHBEGIN or BOXBEGIN after SCENEBEGIN, found \
-                         end of file"
+                        "no patches: expected PATCHBEGIN, BOXBEGIN, SPHEREBEGIN, CYLINDERBEGIN \
+                         or CONEBEGIN after SCENEBEGIN, found end of file"
                     } else {
                         "expected SCENEEND, found end of file"
                     };
@@ -679,7 +723,8 @@ impl<'a> Parser<'a> {
             self.error_at(
                 head,
                 &line,
-                "no patches: expected PATCHBEGIN or BOXBEGIN after SCENEBEGIN, found \"SCENEEND\"",
+                "no patches: expected PATCHBEGIN, BOXBEGIN, SPHEREBEGIN, CYLINDERBEGIN or \
+                 CONEBEGIN after SCENEBEGIN, found \"SCENEEND\"",
             );
         }
         if let Some(after) = self.current() {
@@ -697,7 +742,9 @@ impl<'a> Parser<'a> {
 
     /// Reports a line where a block should start and skips to the next block.
     fn stray_line(&mut self) {
-        self.unexpected("PATCHBEGIN, BOXBEGIN or SCENEEND (or LIGHTBEGIN)");
+        self.unexpected(
+            "PATCHBEGIN, BOXBEGIN, SPHEREBEGIN, CYLINDERBEGIN, CONEBEGIN, LIGHTBEGIN or SCENEEND",
+        );
         self.pos += 1;
         while let Some(k) = self.current_keyword() {
             if is_block_start(k) {
@@ -1204,13 +1251,22 @@ impl<'a> Parser<'a> {
             }),
             Err(e) => {
                 let column = line.tokens.get(2).map_or(word.column, |t| t.column);
-                // The IES error reads "file:line: error: what"; inside this message,
-                // which has its own "error:", the inner one is dropped.
-                let inner = e.to_string().replacen(": error: ", ": ", 1);
-                let msg = format!(
-                    "the light's IES file \"{written}\" (relative to the scene file's folder) \
-                     cannot be used: {inner}"
-                );
+                // The file is named once, here (QA of issue #16: the IES error's own
+                // "file:line: error:" repeated it).
+                let msg = match (&e, e.problem()) {
+                    (crate::photometry::ies::IesError::Io { source, .. }, _) => format!(
+                        "the light's IES file \"{written}\" (relative to the scene file's \
+                         folder): cannot read it: {source}"
+                    ),
+                    (_, Some((ies_line, problem))) => format!(
+                        "the light's IES file \"{written}\" (relative to the scene file's \
+                         folder) cannot be used: its line {ies_line}: {problem}"
+                    ),
+                    (_, None) => format!(
+                        "the light's IES file \"{written}\" (relative to the scene file's \
+                         folder) cannot be used: {e}"
+                    ),
+                };
                 Err(self.error(line.number, column, msg))
             }
         }

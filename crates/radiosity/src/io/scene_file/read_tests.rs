@@ -162,7 +162,7 @@ fn missing_or_misordered_keyword() {
         &with_line(4, ""),
         4,
         1,
-        "expected PATCHBEGIN, BOXBEGIN or SCENEEND",
+        "expected PATCHBEGIN, BOXBEGIN, SPHEREBEGIN, CYLINDERBEGIN, CONEBEGIN, LIGHTBEGIN or SCENEEND",
     );
 }
 
@@ -243,6 +243,19 @@ fn missing_header_lines_give_one_error_each() {
         1,
         "expected SCENEBEGIN, found \"PATCHBEGIN\"",
     );
+    // The two header lines swapped, or one given twice: one error, not one for every line
+    // after it (QA of issue #16: three).
+    let (area, steps) = (VALID.lines().next().unwrap(), VALID.lines().nth(1).unwrap());
+    one_error(
+        &with_lines(&[(1, steps), (2, area)]),
+        1,
+        1,
+        "swap the two lines",
+    );
+    let doubled = format!("{area}\n{VALID}");
+    one_error(&doubled, 2, 1, "MAX_PATCH_AREA is given twice");
+    let doubled = VALID.replacen(steps, &format!("{steps}\n{steps}"), 1);
+    one_error(&doubled, 3, 1, "INTEGRAL_STEPS is given twice");
 }
 
 #[test]
