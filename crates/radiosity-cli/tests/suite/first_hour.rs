@@ -1985,3 +1985,47 @@ fn number_flags_are_refused_in_one_wording() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Fourth QA pass of issue #16: work no command could do is refused before anything is
+/// written or timed, in the flag's words.
+#[test]
+fn impossible_work_is_refused_before_anything_is_written_or_timed() {
+    let dir = scratch_dir("refused-first");
+    // A building that would mesh past MAX_ELEMENTS: no file, and the area that fits.
+    let out = radiosity(
+        &[
+            "generate",
+            "building",
+            "-o",
+            "big.scene",
+            "--max-area",
+            "0.0001",
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--max-area 0.0001") && stderr(&out).contains("no file written"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!dir.join("big.scene").exists());
+    // bench: a bad number or work past the limit before the table's header.
+    for args in [
+        vec!["bench", "--tolerance", "-1"],
+        vec!["bench", "--size", "10000", "--supersample", "16"],
+    ] {
+        let out = radiosity(&args, &dir);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {}", stderr(&out));
+        assert!(out.stdout.is_empty(), "{args:?} printed its header");
+    }
+    // pathtrace: a missing reference named with its flag, before the scene is traced.
+    let out = radiosity(&["pathtrace", "--reference", "nope.exr", "--compare"], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).starts_with("error: --reference nope.exr: no such file"),
+        "{}",
+        stderr(&out)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
