@@ -70,13 +70,13 @@ pub struct BuildingArgs {
     #[arg(short, long, value_name = "FILE.scene")]
     pub output: PathBuf,
     /// Storeys.
-    #[arg(long, default_value_t = 2, value_name = "N")]
+    #[arg(long, default_value_t = 2, value_name = "N", value_parser = parse_at_least_1)]
     pub floors: u32,
     /// Rooms along x on each floor.
-    #[arg(long, default_value_t = 6, value_name = "N")]
+    #[arg(long, default_value_t = 6, value_name = "N", value_parser = parse_at_least_1)]
     pub rooms_x: u32,
     /// Rooms along z on each floor.
-    #[arg(long, default_value_t = 6, value_name = "N")]
+    #[arg(long, default_value_t = 6, value_name = "N", value_parser = parse_at_least_1)]
     pub rooms_z: u32,
     /// Inner side of each square room (m; 5.7 to 100 with furniture, from 2.5 without).
     #[arg(long, default_value_t = 6.0, value_name = "M")]
@@ -769,7 +769,20 @@ pub fn plain_number_errors(message: &str) -> String {
         ),
         ("invalid float literal", "give a number"),
     ];
-    let mut text = message.to_string();
+    // A negative value for an unsigned flag: Rust's "invalid digit" is the minus sign.
+    let mut text = message
+        .split_inclusive('\n')
+        .map(|line| {
+            if line.contains("invalid value '-") {
+                line.replace(
+                    "invalid digit found in string",
+                    "give a whole number of at least 0",
+                )
+            } else {
+                line.to_string()
+            }
+        })
+        .collect::<String>();
     for (from, to) in WORDS {
         text = text.replace(from, to);
     }
@@ -894,7 +907,14 @@ pub fn parse_fraction(text: &str) -> Result<f64, String> {
 pub fn parse_view_solver(text: &str) -> Result<SolverKind, String> {
     match text {
         "dense" => Ok(SolverKind::GaussSeidel),
-        name => name.parse::<SolverKind>().map_err(|e| e.to_string()),
+        name => name.parse::<SolverKind>().map_err(|_| {
+            // The library's list leaves out `dense`, which only the window takes (QA of
+            // issue #16).
+            format!(
+                "unknown solver {name:?} (expected one of auto, dense, lu, gauss-seidel, \
+                 progressive, hierarchical)"
+            )
+        }),
     }
 }
 

@@ -42,7 +42,7 @@ pub fn describe(err: &anyhow::Error) -> String {
 /// The operating system's words put in the project's: "No such file or directory (os
 /// error 2)" becomes "no such file or folder" (QA of issue #16: the raw text and its error
 /// number puzzled more than they told).
-fn plain_io_words(text: &str) -> String {
+pub fn plain_io_words(text: &str) -> String {
     const WORDS: [(&str, &str); 4] = [
         ("No such file or directory", "no such file or folder"),
         ("Permission denied", "permission denied"),

@@ -187,7 +187,7 @@ fn over_rows_text(
     Some(format!(
         "{}{} {} form-factor rows summing above {ROW_SUM_OVER} (the largest {:.4}, \
          {}): they pass on more light than reaches them, so the solution holds light that \
-         was never emitted (`check` lists it as \"counted twice\"). It comes from pairs much \
+         was never emitted (`check` lists it under \"counted twice by\"). It comes from pairs much \
          closer than their elements are large (a wall a few cm behind furniture, surfaces \
          meeting at an edge), whose visibility the {method} points cannot resolve; {cure}",
         if serious { "warning: " } else { "" },
@@ -424,6 +424,16 @@ pub fn typed(x: f64) -> String {
     }
 }
 
+/// `x` in exponent form with `decimals` decimals, "1.5e-9", or "0" for zero (QA of issue
+/// #16: "0.0e0").
+pub fn exponent(x: f64, decimals: usize) -> String {
+    if x == 0.0 {
+        "0".to_string()
+    } else {
+        format!("{x:.decimals$e}")
+    }
+}
+
 /// `x` with `decimals` decimals and its sign, or none where it rounds to zero: "+0.125",
 /// "-1.500", "0.000" (QA of issue #16: `validate` printed "-0.000").
 pub fn signed(x: f64, decimals: usize) -> String {
@@ -599,10 +609,10 @@ pub fn check(
         SolutionReport::Matrix(report) => {
             let r = report.residual;
             outln!(
-                "solve residual    {:.1e} / {:.1e} / {:.1e} (relative, R / G / B)",
-                r[0],
-                r[1],
-                r[2]
+                "solve residual    {} / {} / {} (relative, R / G / B)",
+                exponent(r[0], 1),
+                exponent(r[1], 1),
+                exponent(r[2], 1)
             );
         }
         SolutionReport::Hierarchical(report) => {
@@ -666,7 +676,7 @@ pub fn check(
             share(unshot)
         )
     } else {
-        format!(" (relative error {:.1e})", b.relative_error())
+        format!(" (relative error {})", exponent(b.relative_error(), 1))
     };
     outln!(
         "energy ({})        emitted {} = absorbed {}{} + escaped {}{}{rest}",
@@ -917,7 +927,7 @@ pub fn method_accuracy(max_area: f64, quiet: bool) {
     outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in rows {
         outln!(
-            "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.1} | {:.2e} |",
+            "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {} | {:.1} | {:.2e} |",
             r.method,
             r.opposed,
             r.perpendicular,
@@ -925,7 +935,7 @@ pub fn method_accuracy(max_area: f64, quiet: bool) {
             r.differential,
             r.mean_error(),
             r.closed_box,
-            r.reciprocity,
+            exponent(r.reciprocity, 2),
             r.seconds * 1e3,
             r.mean_error() * r.seconds
         );
@@ -1164,7 +1174,12 @@ pub fn path_traced(view: &PathTraced, settings: &PathTraceSettings) {
         // QA of issue #16: `--max-bounces 0` printed "NaN %".
         outln!(
             "noise             none to measure: the pixels that show no emitter are black \
-             ({pixels_counted}; light reaches them after one bounce or more)"
+             ({pixels_counted}; {})",
+            if settings.max_bounces == 0 {
+                "--max-bounces 0 shows the emitters only"
+            } else {
+                "no light reaches what the view shows: does anything in the scene emit?"
+            }
         );
     }
 }

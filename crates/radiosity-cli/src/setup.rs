@@ -450,7 +450,7 @@ pub fn load_scene(
                 read_any_scene(path, &options)
             })?;
             for w in &imported.warnings {
-                errln!("{w}");
+                errln!("{}", crate::errors::plain_io_words(&w.to_string()));
             }
             reporter.note(&format!(
                 "{}: read as {}; unit: {}",
@@ -835,8 +835,9 @@ pub fn check_output(
     inputs: &[(&str, Option<&Path>)],
 ) -> Result<()> {
     refuse_overwriting_inputs(output, flag, inputs)?;
-    output_extension(output, flag, what, extensions)?;
-    output_directory(output, flag)
+    // A folder is named as one before its (missing) extension is (QA of issue #16).
+    output_directory(output, flag)?;
+    output_extension(output, flag, what, extensions)
 }
 
 /// Refuses an output whose directory does not exist or that is a directory (QA of issue

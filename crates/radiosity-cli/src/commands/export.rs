@@ -29,12 +29,18 @@ fn format(output: &Path) -> Result<Format> {
     let ext = output
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if output.is_dir() {
+        bail!(
+            "-o {}: is a folder; give a file name in it",
+            output.display()
+        );
+    }
     match ext.as_deref() {
         Some("glb") => Ok(Format::Glb),
         Some("gltf") => Ok(Format::Gltf),
         Some("obj") => Ok(Format::Obj),
         _ => bail!(
-            "{}: export writes glTF (.glb, or .gltf with a .bin beside it) or OBJ (.obj, with \
+            "-o {}: export writes glTF (.glb, or .gltf with a .bin beside it) or OBJ (.obj, with \
              an .mtl beside it); give the output one of these extensions",
             output.display()
         ),

@@ -32,6 +32,15 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         seed: args.path_seed,
     };
     settings.check()?;
+    if format == ImageFormat::Exr {
+        // Printed even with --quiet, as `render` does (QA of issue #16).
+        if args.tone.exposure != Exposure::Auto {
+            errln!("warning: --exposure ignored: an .exr holds linear radiance, not exposed");
+        }
+        if args.tone.gamma != 2.2 {
+            errln!("warning: --gamma ignored: an .exr holds linear radiance, without gamma");
+        }
+    }
     if !args.scene.no_work_limit && args.reference.is_none() {
         radiosity::budget::check_path_trace_work(
             args.camera.width,
@@ -398,7 +407,7 @@ fn check_exr(path: &Path) -> Result<()> {
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
     {
         bail!(
-            "{}: references are OpenEXR files; give it an .exr name",
+            "--save-reference {}: references are OpenEXR files; give it an .exr name",
             path.display()
         );
     }

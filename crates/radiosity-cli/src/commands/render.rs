@@ -86,6 +86,15 @@ pub fn check(args: &RenderArgs) -> Result<Checked> {
             }
         }
     }
+    if let Some(dir) = &args.snapshots {
+        if dir.exists() && !dir.is_dir() {
+            bail!(
+                "--snapshots {}: is a file; give a folder for the snapshots (it is created if \
+                 missing)",
+                dir.display()
+            );
+        }
+    }
     if args.snapshot_every == 0 {
         bail!("--snapshot-every 0: give the shots between snapshots, at least 1");
     }

@@ -55,7 +55,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             };
             let imported = radiosity::io::import::read_any_scene(path, &options)?;
             for w in &imported.warnings {
-                errln!("{w}");
+                errln!("{}", crate::errors::plain_io_words(&w.to_string()));
             }
             imported.file
         }

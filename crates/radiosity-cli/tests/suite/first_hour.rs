@@ -1285,15 +1285,20 @@ fn generate_refusals_name_the_flag_at_fault() {
     // QA of issue #16: `--rooms-z 0` was "floors, rooms-x and rooms-z must be at least 1",
     // `--max-area 0` "MAX_PATCH_AREA must be a positive number".
     let dir = scratch_dir("generate-flags");
+    // The counts are refused as every whole-number flag is (exit 2, "at least 1"; QA of
+    // issue #16: `--floors -1` said "at least 0" and `--floors 0` then "at least 1").
+    for flag in ["--floors", "--rooms-x", "--rooms-z"] {
+        for value in ["0", "-1"] {
+            let out = radiosity(
+                &["generate", "building", "-o", "b.scene", flag, value],
+                &dir,
+            );
+            let err = stderr(&out);
+            assert_eq!(out.status.code(), Some(2), "{flag} {value}: {err}");
+            assert!(err.contains("give a whole number of at least 1"), "{err}");
+        }
+    }
     for (flags, needle) in [
-        (
-            vec!["--rooms-z", "0"],
-            "--rooms-z 0: a building needs at least 1 room along z",
-        ),
-        (
-            vec!["--floors", "0"],
-            "--floors 0: a building needs at least 1 floor",
-        ),
         (
             vec!["--room-size", "3"],
             "--room-size 3: give the inner side of a room in metres, 5.7 to 100",

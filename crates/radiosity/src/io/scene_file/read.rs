@@ -115,6 +115,19 @@ pub fn read_scene(path: &Path) -> Result<SceneFile, SceneError> {
 /// end of that block and goes on. The scene's `camera` is `None`.
 pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneError> {
     let (lines, eof) = lex(text);
+    if lines.is_empty() {
+        // One error, not one per expected header line (QA of issue #16: four at 1:1).
+        return Err(SceneError {
+            errors: vec![ParseError {
+                file: source_name.to_string(),
+                line: 1,
+                column: 1,
+                message: "the file is empty (or holds only comments): expected MAX_PATCH_AREA, \
+                          INTEGRAL_STEPS, then SCENEBEGIN and the blocks (Appendix A)"
+                    .to_string(),
+            }],
+        });
+    }
     let mut parser = Parser {
         file: source_name,
         lines,

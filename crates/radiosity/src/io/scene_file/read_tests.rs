@@ -252,6 +252,8 @@ fn missing_header_lines_give_one_error_each() {
         1,
         "swap the two lines",
     );
+    one_error("", 1, 1, "the file is empty");
+    one_error("// only a comment\n\n", 1, 1, "the file is empty");
     let doubled = format!("{area}\n{VALID}");
     one_error(&doubled, 2, 1, "MAX_PATCH_AREA is given twice");
     let doubled = VALID.replacen(steps, &format!("{steps}\n{steps}"), 1);
@@ -444,12 +446,10 @@ fn scene_structure_errors() {
         1,
         "expected end of file after SCENEEND, found \"PATCHBEGIN\"",
     );
-    // An empty file.
+    // An empty file: one error that says so and what the file starts with.
     let errs = errors("");
-    assert_eq!(errs[0].0, 1);
-    assert!(errs[0]
-        .2
-        .contains("expected MAX_PATCH_AREA, found end of file"));
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    assert!(errs[0].2.contains("the file is empty") && errs[0].2.contains("MAX_PATCH_AREA"));
 }
 
 #[test]
