@@ -939,10 +939,11 @@ pub fn element_illuminance_with_progress(
 
 /// A scale for `max` that reads at a glance: the smallest top at or above `max` that is
 /// n steps of 1, 2, 2.5 or 5 times a power of ten, n from 4 to 8 (150.3 lux: 8 steps of
-/// 20 up to 160), and n. `(0, 5)` for a `max` that is not a positive number.
+/// 20 up to 160), and n. `(1, 5)` for a `max` that is not a positive number: a scale of
+/// steps where every value is 0 (QA of issue #16: six labels of "0").
 pub fn nice_scale(max: f64) -> (f64, usize) {
     if !(max.is_finite() && max > 0.0) {
-        return (0.0, 5);
+        return (1.0, 5);
     }
     let e = max.log10().floor() as i32;
     let mut best = (f64::INFINITY, 5);

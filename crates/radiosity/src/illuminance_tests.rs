@@ -310,7 +310,7 @@ fn nice_scales_step_in_round_numbers() {
     // Small and large values: 0.37 -> 0.4 (4 x 0.1, or 8 x 0.05); 12 345 -> 12 500 (5 x 2500).
     assert!((nice_scale(0.37).0 - 0.4).abs() < 1e-12);
     assert_eq!(nice_scale(12_345.0), (12_500.0, 5));
-    assert_eq!(nice_scale(0.0), (0.0, 5));
+    assert_eq!(nice_scale(0.0), (1.0, 5));
 }
 
 #[test]

@@ -125,11 +125,13 @@ pub fn run(args: ExportArgs) -> Result<()> {
         Format::Glb | Format::Obj => String::new(),
     };
     reporter.note(&format!(
-        "wrote {}{extra} ({} surfaces, {} elements; COLOR_0 = min(1, {scale} x radiosity), \
+        "wrote {}{extra} ({} surfaces, {} elements; COLOR_0 = min(1, {} x radiosity), \
          linear, on KHR_materials_unlit)",
         output.display(),
         prepared.scene.surfaces.len(),
         solution.mesh.len(),
+        // As the exposure note gives it (QA of issue #16: 1.535 there, 16 digits here).
+        crate::report::significant(scale, 4),
     ));
     reporter.print_timings();
     Ok(())

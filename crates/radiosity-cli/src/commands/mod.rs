@@ -144,11 +144,11 @@ pub fn solve_scene(
 pub fn shot_cap_note(max_shots: usize, tolerance: f64, unshot: f64) -> String {
     format!(
         "progressive refinement stopped at --max-shots {max_shots}: the unshot power is \
-         {:.1} % of the emitted power, not yet below the tolerance {:.1} %; the output holds \
+         {:.3} % of the emitted power, not yet below the tolerance {} %; the output holds \
          the light shot so far (the unshot part is left out; --max-shots or --tolerance \
          takes it further)",
         100.0 * unshot,
-        100.0 * tolerance
+        crate::report::significant(100.0 * tolerance, 4)
     )
 }
 

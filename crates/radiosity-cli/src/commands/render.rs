@@ -145,9 +145,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (prepared, _, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
     if args.snapshots.is_some() && !matches!(solver, radiosity::solve::Solver::Progressive(_)) {
         bail!(
-            "--snapshots needs --solver progressive (the solver is {}, which has no shots to \
-             take pictures of)",
-            solver.kind().name()
+            "--snapshots needs --solver progressive (the solver is {}{}, which has no shots \
+             to take pictures of)",
+            solver.kind().name(),
+            // QA of issue #16: the user chose `auto`, not the solver it picked.
+            if args.solve.solver.0 == radiosity::solve::SolverKind::Auto {
+                ", auto's choice"
+            } else {
+                ""
+            }
         );
     }
     let camera = camera(&args.camera, &prepared.scene)?;

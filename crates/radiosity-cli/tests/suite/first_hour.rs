@@ -40,7 +40,7 @@ fn progressive_max_shots_caps_the_run_and_still_writes_the_picture() {
     assert!(!dir.join("snaps/shot-00004.png").exists(), "{err}");
     assert!(
         err.contains("stopped at --max-shots 3: the unshot power is")
-            && err.contains("not yet below the tolerance 1.0 %"),
+            && err.contains("not yet below the tolerance 1 %"),
         "says how far it got: {err}"
     );
     // Reaching the tolerance first is no cap: nothing said.
