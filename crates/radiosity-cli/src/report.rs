@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use radiosity::form_factor::{FormFactorMethod, ROW_SUM_OVER};
+use radiosity::form_factor::{FormFactorMethod, RowSums, ROW_SUM_OVER};
 use radiosity::mesh::Mesh;
 use radiosity::pathtrace::{FilmComparison, PathTraceSettings, PathTraced};
 use radiosity::pipeline::{AdaptReport, FormFactorStats, Prepared, Solution, SolutionReport};
@@ -29,10 +29,15 @@ pub fn form_factor_stats(
         stats.row_sums.max,
         reciprocity_text(prepared.method(), stats),
     ));
-    if let Some(text) = zero_rows_text(&prepared.scene, mesh, stats) {
+    row_sum_notes(prepared, mesh, &stats.row_sums, reporter);
+}
+
+/// Notes the rows of form factors that see nothing or sum above 1, with their reasons.
+pub fn row_sum_notes(prepared: &Prepared, mesh: &Mesh, rows: &RowSums, reporter: &Reporter) {
+    if let Some(text) = zero_rows_text(&prepared.scene, mesh, rows) {
         reporter.note(&text);
     }
-    if let Some(text) = over_rows_text(&prepared.scene, mesh, prepared.method(), stats) {
+    if let Some(text) = over_rows_text(&prepared.scene, mesh, prepared.method(), rows) {
         reporter.note(&text);
     }
 }
@@ -129,8 +134,7 @@ fn element_name(scene: &Scene, mesh: &Mesh, e: usize) -> String {
 }
 
 /// What rows summing to 0 mean, when there are any.
-fn zero_rows_text(scene: &Scene, mesh: &Mesh, stats: &FormFactorStats) -> Option<String> {
-    let rows = &stats.row_sums;
+fn zero_rows_text(scene: &Scene, mesh: &Mesh, rows: &RowSums) -> Option<String> {
     if rows.zero == 0 {
         return None;
     }
@@ -163,9 +167,8 @@ fn over_rows_text(
     scene: &Scene,
     mesh: &Mesh,
     method: FormFactorMethod,
-    stats: &FormFactorStats,
+    rows: &RowSums,
 ) -> Option<String> {
-    let rows = &stats.row_sums;
     if rows.over == 0 {
         return None;
     }
@@ -572,11 +575,13 @@ pub fn check(
             stats.row_sums.max
         );
         // Under the "row sums" label, without its own (QA of issue #16).
-        if let Some(text) = zero_rows_text(scene, &solution.mesh, stats) {
+        if let Some(text) = zero_rows_text(scene, &solution.mesh, &stats.row_sums) {
             let text = text.strip_prefix("row sums: ").unwrap_or(&text);
             outln!("                  {text}");
         }
-        if let Some(text) = over_rows_text(scene, &solution.mesh, prepared.method(), stats) {
+        if let Some(text) =
+            over_rows_text(scene, &solution.mesh, prepared.method(), &stats.row_sums)
+        {
             outln!("                  {text}");
         }
         outln!(

@@ -86,7 +86,14 @@ pub fn solve_scene(
         (FormFactors::Compute, None) if solver.needs_matrix() => {
             let (f, stats) = prepared.form_factors(reporter)?;
             report::form_factor_stats(prepared, &prepared.mesh, &stats, reporter);
-            Some((f, stats))
+            Some((f, Some(stats)))
+        }
+        // A matrix read from a file gets the same notes on its rows (QA of issue #16: the
+        // rows that see nothing or sum above 1 went unsaid with --form-factors).
+        (FormFactors::File(path), None) if solver.needs_matrix() => {
+            let f = prepared.load_form_factors(path, reporter)?;
+            report::row_sum_notes(prepared, &prepared.mesh, &f.row_sums(), reporter);
+            Some((f, None))
         }
         _ => None,
     };
@@ -120,7 +127,9 @@ pub fn solve_scene(
     let stats_said = match computed {
         Some((f, stats)) => {
             drop(f);
-            solution.form_factors = Some(stats);
+            if stats.is_some() {
+                solution.form_factors = stats;
+            }
             true
         }
         None => false,
