@@ -433,7 +433,7 @@ fn outputs_are_refused_before_any_rank_reads_the_scene() {
         ),
         (
             &["render", missing, "-o", txt],
-            "give the output a .png name",
+            "give it a .png name, or .exr",
         ),
         (
             &["solve", missing, "-o", &csv, "--epsilon", "-1"],
