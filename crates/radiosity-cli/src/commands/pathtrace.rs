@@ -63,8 +63,6 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                 }
             );
         }
-    }
-    if let Some(path) = &args.reference {
         // The tracing flags do nothing when the view is read back (QA of issue #16:
         // `--paths` was dropped without a word). Printed even with --quiet.
         let default = PathTraceSettings::DEFAULT;

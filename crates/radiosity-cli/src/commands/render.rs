@@ -170,7 +170,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "snapshots to {}{}: a picture every {}, at most {} (--max-shots {}), each a \
              {} x {} render named shot-NNNNN.png",
             dir.display(),
-            if existed { " (created)" } else { "" },
+            if existed { "" } else { " (created)" },
             crate::report::count(args.snapshot_every as u64, "shot"),
             p.max_shots / args.snapshot_every,
             p.max_shots,

@@ -126,19 +126,38 @@ fn check_flags(args: &ViewArgs) -> Result<()> {
         if args.frames == 0 {
             bail!("--frames 0: give the frames drawn before the screenshot, at least 1");
         }
-    } else if args.frames != 30 || args.panel {
-        // Printed even with --quiet: the run does not do what the flags say.
-        errln!("warning: --frames and --panel apply to --screenshot; ignored without it");
+    } else {
+        // Printed even with --quiet: the run does not do what the flags say. Only the flags
+        // given are named (QA of issue #16).
+        let given: Vec<&str> = [("--frames", args.frames != 30), ("--panel", args.panel)]
+            .iter()
+            .filter(|f| f.1)
+            .map(|f| f.0)
+            .collect();
+        if !given.is_empty() {
+            errln!(
+                "warning: {} ignored: without --screenshot the window stays open",
+                given.join(", ")
+            );
+        }
     }
     let hierarchical = args.solver == SolverKind::Hierarchical;
-    if !hierarchical && (args.epsilon != 0.05 || args.min_area.is_some()) {
+    let given: Vec<&str> = [
+        ("--epsilon", args.epsilon != 0.05),
+        ("--min-area", args.min_area.is_some()),
+    ]
+    .iter()
+    .filter(|f| !hierarchical && f.1)
+    .map(|f| f.0)
+    .collect();
+    if !given.is_empty() {
         errln!(
-            "warning: --epsilon and --min-area apply to --solver hierarchical; ignored with \
-             the {} solver",
-            if args.progressive {
-                "progressive"
+            "warning: {} ignored: {} hierarchical radiosity's (--solver hierarchical)",
+            given.join(", "),
+            if given.len() == 1 {
+                "it is"
             } else {
-                args.solver.name()
+                "they are"
             }
         );
     }

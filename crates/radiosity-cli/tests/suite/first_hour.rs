@@ -38,6 +38,12 @@ fn progressive_max_shots_caps_the_run_and_still_writes_the_picture() {
     assert!(dir.join("capped.png").exists(), "{err}");
     assert!(dir.join("snaps/shot-00003.png").exists(), "{err}");
     assert!(!dir.join("snaps/shot-00004.png").exists(), "{err}");
+    // The folder is announced before the solve, as made by this run, with the most
+    // pictures the shot cap allows (3 shots, one picture each).
+    assert!(
+        err.contains("snapshots to snaps (created): a picture every 1 shot, at most 3"),
+        "{err}"
+    );
     assert!(
         err.contains("stopped at --max-shots 3: the unshot power is")
             && err.contains("not yet below the tolerance 1 %"),
