@@ -108,17 +108,18 @@ fn main() -> ExitCode {
     }
 }
 
-/// Exits on a command-line error as clap does (exit 2; help and version on stdout, 0),
-/// with the number parsers' own words put in the project's: "give a whole number"
-/// (QA of issue #16: `--steps -1` said "-1 is not in 0..=4294967295", `--seed x`
-/// "invalid digit found in string", `--max-area abc` "invalid float literal").
+/// Exits on a command-line error: a wrong value in the project's frame and exit status,
+/// as the checks after parsing give it (`error: --steps 0: give a whole number of at least
+/// 1`, exit 1; [`radiosity_cli::args::value_error`]); anything else (an unknown flag, a
+/// missing value) as clap does (exit 2; help and version on stdout, 0).
 fn exit_with(e: clap::Error) -> ! {
-    if e.kind() != clap::error::ErrorKind::ValueValidation {
-        e.exit();
+    match radiosity_cli::args::value_error(&e) {
+        Some(line) => {
+            errln!("error: {line}");
+            std::process::exit(1);
+        }
+        None => e.exit(),
     }
-    let text = radiosity_cli::args::plain_number_errors(&e.to_string());
-    eprint!("{text}");
-    std::process::exit(2);
 }
 
 /// The command line with every flag that takes a value accepting a negative number

@@ -155,17 +155,7 @@ pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared,
         e => e.into(),
     })?;
     let m = &args.method;
-    let ignored = ignored_method_flags(m, args.steps.is_some());
-    if !ignored.is_empty() {
-        // Printed even with --quiet: the run does not do what the flags say.
-        errln!(
-            "warning: {} ignored: the form-factor method is {} (--steps applies to the area, \
-             contour and analytic methods, --resolution to hemicube, --samples and --seed to \
-             montecarlo)",
-            ignored.join(", "),
-            method_name(m.method.unwrap_or(MethodArg::Area))
-        );
-    }
+    warn_ignored_method_flags(m, args.steps.is_some());
     let steps = prepared.settings.integral_steps;
     prepared.method = match m.method.unwrap_or(MethodArg::Area) {
         MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
@@ -193,6 +183,28 @@ pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared,
         }
     };
     Ok((prepared, stem))
+}
+
+/// The names of the flags given, from `(name, given)` pairs: for the warnings and errors
+/// that name only the flags a user typed (QA of issue #16).
+pub fn flags_given<'a>(flags: &[(&'a str, bool)]) -> Vec<&'a str> {
+    flags.iter().filter(|f| f.1).map(|f| f.0).collect()
+}
+
+/// Warns (even with --quiet: the run does not do what the flags say) of the method flags
+/// [`ignored_method_flags`] finds, with the methods they apply to; `render` and `bench`
+/// alike (QA of issue #16: bench's warning gave no reason).
+pub fn warn_ignored_method_flags(m: &MethodArgs, steps_given: bool) {
+    let ignored = ignored_method_flags(m, steps_given);
+    if !ignored.is_empty() {
+        errln!(
+            "warning: {} ignored: the form-factor method is {} (--steps applies to the area, \
+             contour and analytic methods, --resolution to hemicube, --samples and --seed to \
+             montecarlo)",
+            ignored.join(", "),
+            method_name(m.method.unwrap_or(MethodArg::Area))
+        );
+    }
 }
 
 /// The form-factor flags given (told from their defaults, as a flag at its default value
@@ -377,6 +389,7 @@ pub fn refuse_overwriting_inputs(
     flag: &str,
     inputs: &[(&str, Option<&Path>)],
 ) -> Result<()> {
+    note_output(output, flag, &format!("{flag} {}", output.display()));
     for &(what, input) in inputs {
         if let Some(input) = input {
             if radiosity::io::is_same_file(output, input) {
@@ -387,6 +400,51 @@ pub fn refuse_overwriting_inputs(
                     input.display()
                 );
             }
+        }
+    }
+    Ok(())
+}
+
+/// An output this run will write, as [`refuse_outputs_read`] names it.
+#[derive(Clone)]
+struct Output {
+    path: std::path::PathBuf,
+    /// The flag that names it ("-o").
+    flag: String,
+    /// How to name it: "-o x.gltf", or "-o x.gltf (its buffer x.bin)" for a file written
+    /// beside the one given.
+    label: String,
+}
+
+/// The outputs [`refuse_overwriting_inputs`] was asked about, checked again against the
+/// files a scene names itself once it is read ([`refuse_outputs_read`]).
+static OUTPUTS: std::sync::Mutex<Vec<Output>> = std::sync::Mutex::new(Vec::new());
+
+/// Notes `path` as an output of this run, named by `flag`, described as `label`.
+pub fn note_output(path: &Path, flag: &str, label: &str) {
+    if let Ok(mut outputs) = OUTPUTS.lock() {
+        outputs.push(Output {
+            path: path.to_path_buf(),
+            flag: flag.to_string(),
+            label: label.to_string(),
+        });
+    }
+}
+
+/// Refuses, right after the scene is read and before any work, an output that is a file
+/// the scene named and was read with it: an OBJ's MTL, a glTF's buffer, a DXF's materials
+/// (QA of issue #16: `export scene.gltf -o copy.gltf`, its buffer `copy.bin` one the scene
+/// read, was refused only when written, after the solve; nothing was overwritten).
+fn refuse_outputs_read(scene: &Path) -> Result<()> {
+    let outputs = OUTPUTS.lock().map(|o| o.clone()).unwrap_or_default();
+    for Output { path, flag, label } in outputs {
+        if let Some(input) = radiosity::io::input_at(&path) {
+            bail!(
+                "{label}: {} is a file the scene {} reads; writing it would destroy the \
+                 input; give {flag} another file name",
+                input.display(),
+                scene.display()
+            );
         }
     }
     Ok(())
@@ -459,6 +517,7 @@ pub fn load_scene(
                 imported.unit
             ));
             note_unit(&imported.unit);
+            refuse_outputs_read(path)?;
             if let Some(n) = millimetres_perhaps(&imported.file.scene, &imported.unit, scale) {
                 errln!("{}: note: {n}", path.display());
             }
@@ -468,9 +527,54 @@ pub fn load_scene(
             if let Some(w) = no_emitter(&imported.file.scene, imported.format) {
                 errln!("{}: warning: {w}", path.display());
             }
+            for w in sideways_lights(&imported.file.scene) {
+                errln!("{}: warning: {w}", path.display());
+            }
             Ok((imported.file, stem_of(Some(path))))
         }
     }
+}
+
+/// Warnings for luminaires with a shaped distribution (COSINE, IES) aimed along the default
+/// AIM 0 0 -1 in a scene whose largest surface faces along y, where -z is horizontal: a
+/// downlight left at the default aim in a y-up room lights a wall (QA of issue #16: `check`
+/// said all its lumens land and nothing more). The default, straight down in a z-up scene,
+/// is the format's; an aim written as 0 0 -1 on purpose is warned of too, which AIM 0 0
+/// -1.0001 silences.
+pub fn sideways_lights(scene: &Scene) -> Vec<String> {
+    let largest_normal = scene
+        .surfaces
+        .iter()
+        .map(|s| {
+            (
+                radiosity::geometry::polygon_area(&s.vertices),
+                radiosity::geometry::polygon_normal(&s.vertices),
+            )
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .and_then(|(_, n)| n);
+    let y_up = largest_normal.is_some_and(|n| n.y.abs() > 0.9);
+    if !y_up {
+        return Vec::new();
+    }
+    scene
+        .lights
+        .iter()
+        .filter(|l| {
+            !matches!(
+                l.distribution,
+                radiosity::luminaire::Distribution::Isotropic
+            ) && l.aim == radiosity::luminaire::DEFAULT_AIM
+        })
+        .map(|l| {
+            format!(
+                "light {:?} is aimed along AIM 0 0 -1 (the default: straight down in a z-up \
+                 scene), which is horizontal here, where the largest surface faces along y; \
+                 for a downlight in a y-up scene give AIM 0 -1 0",
+                l.name
+            )
+        })
+        .collect()
 }
 
 /// A warning when nothing in `scene` emits light (QA of issue #16: such a scene rendered
@@ -527,13 +631,31 @@ fn millimetres_perhaps(scene: &radiosity::scene::Scene, unit: &str, scale: f64) 
         .iter()
         .map(|s| radiosity::geometry::polygon_area(&s.vertices))
         .fold(0.0, f64::max);
-    (largest > LARGER_THAN_A_SURFACE_M2).then(|| {
-        format!(
-            "the largest surface is {largest:.0} m^2, read as metres; if the numbers are \
-             millimetres, --scale 0.001 reads them as metres (the lux and areas in m^2 assume \
-             metres)"
-        )
-    })
+    if largest <= LARGER_THAN_A_SURFACE_M2 {
+        return None;
+    }
+    // Whether the light itself depends on the unit: point luminaires' I / d^2 and FLUX's
+    // lumens over an area do; exitances and luminances given as such do not (QA of issue
+    // #16: the note read as an alarm on the shipped examples/cornell_box.scene, whose light
+    // is the same in any unit).
+    use radiosity::scene::EmissionGiven;
+    let light_depends = !scene.lights.is_empty()
+        || scene.surfaces.iter().any(|s| {
+            matches!(
+                s.photometry.emission,
+                EmissionGiven::Flux(_) | EmissionGiven::FluxShare
+            )
+        });
+    let consequence = if light_depends {
+        "its point luminaires' and FLUX surfaces' light assumes metres"
+    } else {
+        "the light does not depend on it here, with no point luminaires or FLUX; only \
+         areas and powers in m^2 do"
+    };
+    Some(format!(
+        "the largest surface is {largest:.0} m^2 read as metres; if the numbers are \
+         millimetres, --scale 0.001 reads them as metres; {consequence}"
+    ))
 }
 
 /// A warning when `scene` lies more than [`FAR_FROM_ORIGIN`] times its size from the
@@ -591,34 +713,51 @@ fn solver(
     // Flags of one solver given to another: said, as --tolerance with LU is (QA of issue
     // #16: they were dropped without a word). A flag at its default value is not told apart
     // from one left out.
-    let mut ignored = Vec::new();
+    let mut hierarchical = Vec::new();
     if choice != SolverKind::Hierarchical {
         if options.epsilon != radiosity::solve::HierarchicalSettings::DEFAULT_EPSILON {
-            ignored.push("--epsilon");
+            hierarchical.push("--epsilon");
         }
         if options.min_area.is_some() {
-            ignored.push("--min-area");
+            hierarchical.push("--min-area");
         }
         if options.no_final_gather {
-            ignored.push("--no-final-gather");
+            hierarchical.push("--no-final-gather");
         }
         if options.gather_points != radiosity::solve::GATHER_POINTS_DEFAULT {
-            ignored.push("--gather-points");
+            hierarchical.push("--gather-points");
         }
     }
-    if choice != SolverKind::Progressive
-        && options.max_shots != radiosity::solve::ProgressiveSettings::default().max_shots
-    {
-        ignored.push("--max-shots");
+    let progressive = choice != SolverKind::Progressive
+        && options.max_shots != radiosity::solve::ProgressiveSettings::default().max_shots;
+    // Each flag's solver named for the flags given, not for all the flags of the command
+    // (QA of issue #16: bench's warning named --no-final-gather, which bench has not).
+    let mut why = Vec::new();
+    if !hierarchical.is_empty() {
+        why.push(format!(
+            "{} {} to hierarchical radiosity",
+            crate::report::and_list(&hierarchical),
+            if hierarchical.len() == 1 {
+                "applies"
+            } else {
+                "apply"
+            }
+        ));
     }
-    if !ignored.is_empty() {
+    if progressive {
+        why.push("--max-shots applies to progressive refinement".to_string());
+    }
+    if !why.is_empty() {
+        let mut ignored = hierarchical.clone();
+        if progressive {
+            ignored.push("--max-shots");
+        }
         // Printed even with --quiet: the run does not do what the flags say.
         errln!(
-            "warning: {} ignored: the solver is {} ({} apply to hierarchical radiosity, \
-             --max-shots to progressive refinement)",
+            "warning: {} ignored: the solver is {} ({})",
             ignored.join(", "),
             choice.name(),
-            "--epsilon, --min-area, --no-final-gather and --gather-points"
+            why.join("; ")
         );
     }
     if choice == SolverKind::Hierarchical
@@ -677,7 +816,8 @@ fn solver(
 
 pub fn render_settings(args: &RenderArgs) -> Result<RenderSettings> {
     image_format(args.output.as_deref())?;
-    image_size(&args.camera)?;
+    let (width, height) = args.camera.size();
+    image_size(width, height)?;
     check_render_budget(
         &args.camera,
         args.rays.supersample,
@@ -700,7 +840,7 @@ pub fn check_render_budget(
     whole_film: bool,
     no_work_limit: bool,
 ) -> Result<()> {
-    let (w, h) = (camera.width, camera.height);
+    let (w, h) = camera.size();
     radiosity::budget::check_render_memory(
         w,
         h,
@@ -875,21 +1015,14 @@ pub fn gamma(args: &ToneArgs) -> Result<f64> {
     Ok(args.gamma)
 }
 
-/// Refuses an image with no pixels or more than 100 megapixels.
-fn image_size(args: &CameraArgs) -> Result<()> {
-    if args.width == 0 || args.height == 0 {
-        bail!(
-            "--width {} --height {}: give image sides of at least 1 pixel",
-            args.width,
-            args.height
-        );
+/// Refuses an image with no pixels or more than 100 megapixels (`render`, `pathtrace` and
+/// `bench` alike; QA of issue #16: bench capped each side at 10,000 where render did not).
+pub fn image_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 {
+        bail!("--width {width} --height {height}: give image sides of at least 1 pixel");
     }
-    if (args.width as u64) * (args.height as u64) > 100_000_000 {
-        bail!(
-            "an image of {} x {} pixels is too large (at most 100 megapixels)",
-            args.width,
-            args.height
-        );
+    if (width as u64) * (height as u64) > 100_000_000 {
+        bail!("an image of {width} x {height} pixels is too large (at most 100 megapixels)");
     }
     Ok(())
 }
@@ -899,7 +1032,8 @@ fn image_size(args: &CameraArgs) -> Result<()> {
 /// `--look-at` (QA of issue #16: these came after the scene was read and meshed, where
 /// `--gamma` and `--exposure` came before). [`camera`] checks them again with the scene.
 pub fn check_camera_flags(args: &CameraArgs) -> Result<()> {
-    image_size(args)?;
+    let (width, height) = args.size();
+    image_size(width, height)?;
     if let Some(fov) = args.fov {
         if !(fov > 0.0 && fov < 180.0) {
             let fov = crate::report::typed(fov);
@@ -924,11 +1058,46 @@ pub fn check_camera_flags(args: &CameraArgs) -> Result<()> {
     Ok(())
 }
 
+/// The camera as flags that give it back, when any of --eye, --look-at and --fov was left
+/// to the scene (QA of issue #16: the automatic camera was never printed, so a user could
+/// not move it a little): "--eye X,Y,Z --look-at X,Y,Z --up X,Y,Z --fov D".
+pub fn camera_note(args: &CameraArgs, camera: &Camera, scene: &Scene) -> Option<String> {
+    if args.eye.is_some() && args.look_at.is_some() && args.fov.is_some() {
+        return None;
+    }
+    let v = |p: DVec3| {
+        format!(
+            "{},{},{}",
+            crate::report::significant(p.x, 6),
+            crate::report::significant(p.y, 6),
+            crate::report::significant(p.z, 6)
+        )
+    };
+    Some(format!(
+        "camera --eye {} --look-at {} --up {} --fov {} ({}{}; give these flags to move it)",
+        v(camera.eye),
+        v(camera.look_at),
+        v(camera.up),
+        crate::report::significant(camera.fov_y_degrees, 4),
+        if scene.camera.is_some() {
+            "the scene's own"
+        } else {
+            "chosen to frame the scene"
+        },
+        if args.eye.is_some() || args.look_at.is_some() || args.up.is_some() || args.fov.is_some() {
+            ", with the camera flags given"
+        } else {
+            ""
+        }
+    ))
+}
+
 /// The camera the flags ask for: the scene's (or one that frames it) at `--width` x
 /// `--height`, with `--eye`, `--look-at`, `--up` and `--fov` put in.
 pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
-    image_size(args)?;
-    let mut camera = Camera::for_scene(scene, args.width, args.height);
+    let (width, height) = args.size();
+    image_size(width, height)?;
+    let mut camera = Camera::for_scene(scene, width, height);
     if let Some(eye) = args.eye {
         camera.eye = eye;
     }

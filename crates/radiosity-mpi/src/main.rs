@@ -112,7 +112,14 @@ fn main() -> ExitCode {
     let cli = match matches.and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(cli) => cli,
         Err(e) => {
-            // Every rank parses the same flags; one copy of the message is enough.
+            // Every rank parses the same flags; one copy of the message is enough. A wrong
+            // value in the frame and exit status of `radiosity`'s (QA of issue #16).
+            if let Some(line) = radiosity_cli::args::value_error(&e) {
+                if rank == 0 {
+                    errln!("error: {line}");
+                }
+                return ExitCode::FAILURE;
+            }
             if rank == 0 {
                 let _ = e.print();
             }

@@ -336,7 +336,10 @@ pub fn grid(
             let mut p = a;
             for (index, &axis) in varying.iter().enumerate() {
                 let k = if index == 0 { i } else { j } as f64;
-                p[axis] = a[axis] + (b[axis] - a[axis]).signum() * k * spacing;
+                // To 12 significant digits: the decimals asked for, not 0.7 + 0.1 =
+                // 0.7999999999999999 (QA of issue #16).
+                let x = a[axis] + (b[axis] - a[axis]).signum() * k * spacing;
+                p[axis] = format!("{x:.11e}").parse().unwrap_or(x);
             }
             out.push(CalcPoint {
                 name: format!("g{i}_{j}"),
@@ -858,6 +861,15 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
     }
     let labels = tick_labels(max, ticks);
     let ticks = labels.len() - 1;
+    // Every tick is drawn, but only every `stride`-th labelled where the bar is too short
+    // for all the labels to stand apart (QA of issue #16: at the smallest picture, 160
+    // pixels tall, eight labels ran into each other). `stride` divides the ticks, so the
+    // top is labelled.
+    let spacing = (by1 - by0 - 1) as f64 / ticks.max(1) as f64;
+    let need = (5 * LEGEND_FONT + 3) as f64;
+    let stride = (1..=ticks.max(1))
+        .find(|&s| ticks % s == 0 && spacing * s as f64 >= need)
+        .unwrap_or(ticks.max(1));
     for (k, label) in labels.iter().enumerate() {
         let t = k as f64 / ticks as f64;
         let y = by1 - 1 - ((by1 - by0 - 1) as f64 * t).round() as i64;
@@ -869,8 +881,10 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
                 }
             }
         }
-        let half = 5 * LEGEND_FONT / 2;
-        draw_text(img, bx + 27, (y - half).max(0), LEGEND_FONT, label, [0; 3]);
+        if k % stride == 0 {
+            let half = 5 * LEGEND_FONT / 2;
+            draw_text(img, bx + 27, (y - half).max(0), LEGEND_FONT, label, [0; 3]);
+        }
     }
 }
 

@@ -676,24 +676,66 @@ fn solve_adaptive(
         rounds: Vec::new(),
     };
     let mut pairs_left = adapt.max_new_pairs;
-    for _ in 0..adapt.rounds {
+    for round in 1..=adapt.rounds {
         let b = radiosity.as_arrays();
+        let mut steps_at_smallest = false;
         let refined = run_stage(progress, Stage::Adapt, 0, || {
             let white = lit_radiosity_top_mean(scene, &mesh, b, AUTO_EXPOSURE_TOP_AREA)?;
             let luminance: Vec<f64> = radiosity.as_slice().iter().map(|b| b.luminance()).collect();
             let marks = mark_steps(&mesh, &luminance, white, adapt, pairs_left);
             let split = marks.iter().filter(|&&m| m).count();
-            (split > 0).then(|| (split, split_marked(&mesh, scene.surfaces.len(), &marks)))
+            if split > 0 {
+                return Some((split, split_marked(&mesh, scene.surfaces.len(), &marks)));
+            }
+            // Whether visible steps are left on elements already at the smallest size, for
+            // the note on why the rounds stop.
+            let unlimited = AdaptSettings {
+                min_area: 0.0,
+                max_elements: usize::MAX,
+                ..*adapt
+            };
+            steps_at_smallest =
+                mark_steps(&mesh, &luminance, white, &unlimited, u64::MAX).contains(&true);
+            None
         });
+        // Said before the solve of the refined mesh, so that each "solved" line follows
+        // what it solved (QA of issue #16: the rounds were told after the last solve).
         let Some((split, (next, origin))) = refined else {
+            // Why it stops short of the rounds asked for (QA of issue #16: `--adapt-rounds 6`
+            // did three without a word): the budget's elements or pairs, or no steps.
+            let n = mesh.len();
+            let stopped = format!(
+                "adaptive subdivision stopped before round {round} of {}",
+                adapt.rounds
+            );
+            progress.message(&if adapt.max_elements.saturating_sub(n) < 3 {
+                format!(
+                    "{stopped}: the mesh has reached the most elements allowed, {} (twice the \
+                     first mesh's, at most {}, unless --adapt-max-elements N is given)",
+                    adapt.max_elements,
+                    crate::mesh::DEFAULT_MAX_ELEMENTS
+                )
+            } else if pairs_left / (4 * n.max(1) as u64) == 0 {
+                format!(
+                    "{stopped}: the new form-factor pairs allowed ({:.2e}, about twice the \
+                     first matrix's; --adapt-max-elements N lifts this limit) are spent",
+                    adapt.max_new_pairs as f64
+                )
+            } else if steps_at_smallest {
+                format!(
+                    "{stopped}: the visible steps left lie on elements already split to the \
+                     smallest size, {} (MAX_PATCH_AREA / 64, three splits)",
+                    adapt.min_area
+                )
+            } else if round == 1 {
+                format!(
+                    "adaptive subdivision: no visible steps between the {n} elements; solved once"
+                )
+            } else {
+                format!("{stopped}: no visible steps left")
+            });
             break;
         };
-        form_factor::check_dense_fits(
-            "the form-factor matrix (f32) of the refined mesh",
-            next.len(),
-            4.0,
-            form_factor::available_memory_bytes(),
-        )?;
         let kept: Vec<Option<u32>> = origin
             .iter()
             .map(|o| match *o {
@@ -701,6 +743,25 @@ fn solve_adaptive(
                 Origin::Child(_) => None,
             })
             .collect();
+        let n = next.len() as u64;
+        let fresh = kept.iter().filter(|k| k.is_none()).count() as u64;
+        let kept_count = n - fresh;
+        let pairs_integrated = n * (n - 1) / 2 - kept_count * kept_count.saturating_sub(1) / 2;
+        pairs_left = pairs_left.saturating_sub(pairs_integrated);
+        progress.message(&format!(
+            "adaptive subdivision, round {round}: {split} of {} elements split where their \
+             radiosity steps visibly from a neighbour's -> {} elements ({:.2e} new pairs \
+             to integrate)",
+            mesh.len(),
+            next.len(),
+            pairs_integrated as f64
+        ));
+        form_factor::check_dense_fits(
+            "the form-factor matrix (f32) of the refined mesh",
+            next.len(),
+            4.0,
+            form_factor::available_memory_bytes(),
+        )?;
         let ctx = FormFactorContext {
             mesh: &next,
             occluders: &prepared.occluders,
@@ -722,11 +783,6 @@ fn solve_adaptive(
         seconds += clock.elapsed().as_secs_f64();
         rays += counter.get();
         candidates += counter.candidates();
-        let n = next.len() as u64;
-        let fresh = kept.iter().filter(|k| k.is_none()).count() as u64;
-        let kept_count = n - fresh;
-        let pairs_integrated = n * (n - 1) / 2 - kept_count * kept_count.saturating_sub(1) / 2;
-        pairs_left = pairs_left.saturating_sub(pairs_integrated);
         let start: Vec<Rgb> = origin
             .iter()
             .map(|o| radiosity.as_slice()[o.parent() as usize])

@@ -34,6 +34,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     // work past the limits is refused before any time is spent on the runs before it (QA
     // of issue #16): each area's scene is read and meshed once, quietly, as a run would.
     let (width, height) = image_size(&args);
+    crate::setup::image_size(width, height)?;
     radiosity::budget::check_render_memory(
         width,
         height,
@@ -58,14 +59,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             s.to_string_lossy().into_owned()
         });
     // Flags the method does not use, said once here, not once per run.
-    let ignored = crate::setup::ignored_method_flags(&args.method, args.steps.is_some());
-    if !ignored.is_empty() {
-        errln!(
-            "warning: {} ignored: the form-factor method is {}",
-            ignored.join(", "),
-            crate::setup::method_name(args.method.method.unwrap_or(crate::args::MethodArg::Area))
-        );
-    }
+    crate::setup::warn_ignored_method_flags(&args.method, args.steps.is_some());
     report::bench_header(
         args.repeat,
         image_size(&args),
@@ -231,7 +225,7 @@ fn median(mut values: Vec<f64>) -> f64 {
 }
 
 /// The rendered image's width and height: `--width` and `--height`, each `--size` when
-/// not given (checked by clap: 1 to 10,000 pixels, worded as for `render --width`).
+/// not given (at least 1 pixel each, checked by clap; at most 100 megapixels, as `render`).
 fn image_size(args: &BenchArgs) -> (u32, u32) {
     (
         args.width.unwrap_or(args.size),

@@ -45,7 +45,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
             ("--form-factors", o.form_factors.is_some()),
             ("--adapt-rounds", o.adapt_rounds.is_some()),
         ];
-        let given: Vec<&str> = solver_flags.iter().filter(|f| f.1).map(|f| f.0).collect();
+        let given: Vec<&str> = crate::setup::flags_given(&solver_flags);
         if !given.is_empty() {
             bail!(
                 "check --compare-methods computes form factors and solves nothing: drop {}",

@@ -55,14 +55,23 @@ pub fn run(args: ExportArgs) -> Result<()> {
         ("scene file", args.scene.scene.as_deref()),
         ("form-factor file", args.solve.form_factors.as_deref()),
     ];
-    let mut outputs = vec![output.clone()];
-    match format {
-        Format::Gltf => outputs.push(gltf::buffer_path(output)),
-        Format::Obj => outputs.push(obj::mtl_path(output)),
-        Format::Glb => {}
-    }
-    for out in &outputs {
-        refuse_overwriting_inputs(out, "-o", &inputs)?;
+    refuse_overwriting_inputs(output, "-o", &inputs)?;
+    let beside = match format {
+        Format::Gltf => Some(("buffer", gltf::buffer_path(output))),
+        Format::Obj => Some(("material library", obj::mtl_path(output))),
+        Format::Glb => None,
+    };
+    if let Some((what, path)) = beside {
+        let label = format!("-o {} (its {what} {})", output.display(), path.display());
+        for &(input_is, input) in &inputs {
+            if input.is_some_and(|input| radiosity::io::is_same_file(&path, input)) {
+                bail!(
+                    "{label}: this is the {input_is}; writing it would destroy the input; \
+                     give -o another file name"
+                );
+            }
+        }
+        crate::setup::note_output(&path, "-o", &label);
     }
     output_directory(output, "-o")?;
     // Printed even with --quiet: the file will not hold what the scene holds.
@@ -161,10 +170,10 @@ fn export_obj(
         ("--look-at", c.look_at.is_some()),
         ("--up", c.up.is_some()),
         ("--fov", c.fov.is_some()),
-        ("--width", c.width != 512),
-        ("--height", c.height != 512),
+        ("--width", c.width.is_some()),
+        ("--height", c.height.is_some()),
     ];
-    let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+    let ignored: Vec<&str> = crate::setup::flags_given(&given);
     if !ignored.is_empty() {
         errln!(
             "warning: {} ignored: an .obj export writes the scene's surfaces with their \

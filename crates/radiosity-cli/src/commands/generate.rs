@@ -83,6 +83,15 @@ pub fn building(args: BuildingArgs) -> Result<()> {
         &["scene"],
         &[],
     )?;
+    // A scene file is what the other commands read: one that exists is kept unless asked
+    // (QA of issue #16: `-o examples/room.scene` replaced the shipped example without a
+    // word; the viewer's modeller never saves over the file it opened either).
+    if args.output.exists() && !args.force {
+        bail!(
+            "-o {}: the file exists; give another name, or --force to replace it",
+            args.output.display()
+        );
+    }
     if let Err(e) = params.check() {
         bail!("{}", flag_at_fault(&e, &args));
     }

@@ -75,6 +75,10 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
             else {
                 bail!("{}", grid_refusal(a, b, spacing));
             };
+            if let Some(short) = grid_short_of_corner(a, b, spacing) {
+                // Printed even with --quiet: the grid does not cover what was asked.
+                errln!("warning: {short}");
+            }
             (points, Some(dims))
         }
         (None, None) => bail!(
@@ -155,6 +159,41 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     }
     reporter.print_timings();
     Ok(())
+}
+
+/// A warning when the grid's spacing does not divide its span along an axis, so that its
+/// last row or column stops short of the second corner (QA of issue #16: `:1.5` over 4 m
+/// stopped 1 m short, `:10` gave one point, without a word).
+fn grid_short_of_corner(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> Option<String> {
+    let short: Vec<String> = (0..3)
+        .filter_map(|axis| {
+            let span = (b[axis] - a[axis]).abs();
+            if span == 0.0 {
+                return None;
+            }
+            let steps = (span / spacing + 1e-9).floor();
+            let last = steps * spacing;
+            if span - last <= 1e-9 * spacing {
+                return None;
+            }
+            let name = ["x", "y", "z"][axis];
+            let end = a[axis] + (b[axis] - a[axis]).signum() * last;
+            Some(format!(
+                "along {name} it stops at {name} = {}, {} short of {}",
+                crate::report::significant(end, 6),
+                crate::report::significant(span - last, 4),
+                crate::report::significant(b[axis], 6),
+            ))
+        })
+        .collect();
+    (!short.is_empty()).then(|| {
+        format!(
+            "--grid spacing {}: the grid does not reach its second corner: {} (corners a \
+             whole number of spacings apart make it reach)",
+            crate::report::typed(spacing),
+            short.join("; ")
+        )
+    })
 }
 
 /// A warning when some points get no light at all (QA of issue #16: points inside the

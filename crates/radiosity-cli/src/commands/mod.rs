@@ -137,13 +137,14 @@ pub fn solve_scene(
     if let (true, Some(s), SolutionReport::Progressive(r)) = (capped, cap, &solution.report) {
         reporter.note(&shot_cap_note(s.max_shots, s.tolerance, r.unshot_fraction));
     }
-    if let Some(a) = &solution.adapt {
-        report::adapt(a, reporter);
-    }
     if let (Some(stats), false) = (&solution.form_factors, stats_said) {
         report::form_factor_stats(prepared, &solution.mesh, stats, reporter);
     }
-    report::energy_note(&solution, prepared.method(), reporter);
+    report::energy_note(&prepared.scene, &solution, prepared.method(), reporter);
+    if let Some(warning) = report::light_lost(&prepared.scene, &solution) {
+        // Printed even with --quiet: every picture of this solution is black.
+        errln!("warning: {warning}");
+    }
     let stats = solution.form_factors;
     Ok((solution, stats))
 }
@@ -154,8 +155,9 @@ pub fn shot_cap_note(max_shots: usize, tolerance: f64, unshot: f64) -> String {
     format!(
         "progressive refinement stopped at --max-shots {max_shots}: the unshot power is \
          {:.3} % of the emitted power, not yet below the tolerance {} %; the output holds \
-         the light shot so far (the unshot part is left out; --max-shots or --tolerance \
-         takes it further)",
+         the light shot so far (the unshot part is left out, where --snapshots pictures \
+         add it as the paper's ambient term for display, so they look brighter; \
+         --max-shots or --tolerance takes it further)",
         100.0 * unshot,
         crate::report::significant(100.0 * tolerance, 4)
     )

@@ -42,25 +42,28 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         }
     }
     if !args.scene.no_work_limit && args.reference.is_none() {
-        radiosity::budget::check_path_trace_work(
-            args.camera.width,
-            args.camera.height,
-            args.paths,
-        )?;
+        let (width, height) = args.camera.size();
+        radiosity::budget::check_path_trace_work(width, height, args.paths)?;
     }
     if let Some(path) = &args.reference {
         // Before any work, in the flag's name (QA of issue #16: a missing file was named
         // only after the scene was read, without the flag).
-        if !path.is_file() {
+        // A device or a pipe (/dev/null) is neither a folder nor missing (QA of issue #16:
+        // it was "no such file").
+        let wrong = if path.is_dir() {
+            Some("is a folder")
+        } else if !path.exists() {
+            Some("no such file")
+        } else if !path.is_file() {
+            Some("is not a file (a device or a pipe)")
+        } else {
+            None
+        };
+        if let Some(wrong) = wrong {
             bail!(
-                "--reference {}: {}; save a path-traced view with --save-reference FILE.exr \
-                 first",
-                path.display(),
-                if path.is_dir() {
-                    "is a folder"
-                } else {
-                    "no such file"
-                }
+                "--reference {}: {wrong}; save a path-traced view with --save-reference \
+                 FILE.exr first",
+                path.display()
             );
         }
         // The tracing flags do nothing when the view is read back (QA of issue #16:
@@ -76,7 +79,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             ),
             ("--no-light-sampling", args.no_light_sampling),
         ];
-        let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+        let ignored: Vec<&str> = crate::setup::flags_given(&given);
         if !ignored.is_empty() {
             errln!(
                 "warning: {} ignored with --reference: the path-traced view is read from {} \
@@ -151,7 +154,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                 args.rays.direct_light != crate::args::DirectLightArg::Gather,
             ),
         ];
-        let ignored: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+        let ignored: Vec<&str> = crate::setup::flags_given(&given);
         if !ignored.is_empty() {
             errln!(
                 "warning: {} ignored without --compare: the path tracer traces the scene's \
@@ -166,7 +169,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                  error map --compare draws"
             );
         }
-        let ignored: Vec<&str> = render_given.iter().filter(|g| g.1).map(|g| g.0).collect();
+        let ignored: Vec<&str> = crate::setup::flags_given(&render_given);
         if !ignored.is_empty() {
             errln!(
                 "warning: {} ignored without --compare: {} the radiosity render \
@@ -191,6 +194,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         }
     };
     let camera = camera(&args.camera, scene)?;
+    if let Some(note) = crate::setup::camera_note(&args.camera, &camera, scene) {
+        reporter.note(&note);
+    }
     let output = args
         .output
         .clone()

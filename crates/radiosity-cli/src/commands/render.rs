@@ -157,15 +157,64 @@ pub fn run(args: RenderArgs) -> Result<()> {
         );
     }
     let camera = camera(&args.camera, &prepared.scene)?;
+    if let Some(note) = crate::setup::camera_note(&args.camera, &camera, &prepared.scene) {
+        reporter.note(&note);
+    }
     let exposure = args.tone.exposure;
     if let Some(dir) = &args.snapshots {
-        let existed = dir.is_dir();
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        // What the snapshots will cost, before the solve (QA of issue #16: a long run of
-        // snapshots gave no estimate, and a new folder appeared without a word).
         let radiosity::solve::Solver::Progressive(p) = &solver else {
             unreachable!("--snapshots without progressive refinement is refused above")
         };
+        // QA of issue #16 (sixth pass): `--max-shots 3` with a picture every 10 shots made
+        // a folder for no picture; nested folders were made where every other output
+        // refuses a missing folder; an earlier run's pictures were left among the new.
+        if p.max_shots < args.snapshot_every {
+            bail!(
+                "--snapshot-every {}: no snapshot would be taken within --max-shots {}; give \
+                 --snapshot-every at most {}",
+                args.snapshot_every,
+                p.max_shots,
+                p.max_shots
+            );
+        }
+        let existed = dir.is_dir();
+        if !existed {
+            if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+                if !parent.is_dir() {
+                    bail!(
+                        "--snapshots {}: the directory {} does not exist; create it first \
+                         (mkdir -p {})",
+                        dir.display(),
+                        parent.display(),
+                        parent.display()
+                    );
+                }
+            }
+            std::fs::create_dir(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        }
+        let earlier = std::fs::read_dir(dir)
+            .map(|entries| {
+                entries
+                    .filter_map(|e| e.ok())
+                    .filter(|e| {
+                        let name = e.file_name().to_string_lossy().into_owned();
+                        name.starts_with("shot-") && name.ends_with(".png")
+                    })
+                    .count()
+            })
+            .unwrap_or(0);
+        if earlier > 0 {
+            // Printed even with --quiet: the folder will not hold this run's pictures only.
+            errln!(
+                "warning: --snapshots {} already holds {} (shot-NNNNN.png); this run writes \
+                 over those with its own numbers and leaves the others: empty the folder for \
+                 one run's pictures",
+                dir.display(),
+                crate::report::count(earlier as u64, "picture")
+            );
+        }
+        // What the snapshots will cost, before the solve (QA of issue #16: a long run of
+        // snapshots gave no estimate, and a new folder appeared without a word).
         reporter.note(&format!(
             "snapshots to {}{}: a picture every {}, at most {} (--max-shots {}), each a \
              {} x {} render named shot-NNNNN.png",
@@ -304,8 +353,36 @@ pub fn run(args: RenderArgs) -> Result<()> {
         image.width(),
         image.height()
     ));
+    if !wireframe && crate::report::light_lost(&prepared.scene, &solution).is_none() {
+        if let Some(warning) = black_picture(&image) {
+            // Printed even with --quiet: the picture shows nothing.
+            errln!("warning: {warning}");
+        }
+    }
     reporter.print_timings();
     Ok(())
+}
+
+/// Above this share of black pixels a picture of a lit scene is said to show nothing.
+const BLACK_PICTURE_SHARE: f64 = 0.95;
+
+/// A warning when nearly every pixel of `image` is black though the scene's light reaches
+/// its surfaces (a lost light is warned of by the solve): the camera outside the scene,
+/// seeing the backs of its faces, or inside a closed piece of furniture (QA of issue #16:
+/// a camera outside a closed room wrote a black picture without a word; `illuminance`
+/// warns of points that see only backs).
+fn black_picture(image: &image::RgbImage) -> Option<String> {
+    let pixels = (image.width() as u64 * image.height() as u64).max(1);
+    let black = image.pixels().filter(|p| p.0 == [0, 0, 0]).count() as u64;
+    let share = black as f64 / pixels as f64;
+    (share > BLACK_PICTURE_SHARE).then(|| {
+        format!(
+            "{:.1} % of the picture is black: the camera sees the backs of faces (outside a \
+             closed room, or inside furniture or a wall) or nothing; move --eye into the \
+             scene",
+            100.0 * share
+        )
+    })
 }
 
 /// `render --false-colour`: the illuminance of every element

@@ -29,9 +29,23 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
     // --write with --case writes only those cases' files (QA of issue #16: --case was
     // ignored and every case written).
     if let Some(dir) = &args.write {
+        // As every other output: a missing folder's parent is not made (QA of issue #16:
+        // `--write nowhere/deep/x` made three folders without a word).
+        if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+            if !parent.is_dir() {
+                bail!(
+                    "--write {}: the directory {} does not exist; create it first (mkdir -p {})",
+                    dir.display(),
+                    parent.display(),
+                    parent.display()
+                );
+            }
+        }
         let written = cie171::write_case_files(dir, &cases)
             .with_context(|| format!("cannot write the validation files into {}", dir.display()))?;
-        println!("wrote {} files into {}", written.len(), dir.display());
+        if !args.quiet {
+            println!("wrote {} files into {}", written.len(), dir.display());
+        }
         return Ok(());
     }
     let dir = tempfile_dir()?;
@@ -63,8 +77,18 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
     let _ = std::fs::remove_dir_all(&dir);
     say("");
     say(&format!("{}.", cie171::GEOMETRY_NOTE));
+    // One paragraph per description, with the ids of all its cases (QA of issue #16: the
+    // 5.8 paragraph was printed seven times, once per reflectance).
+    let mut paragraphs: Vec<(Vec<&str>, String)> = Vec::new();
     for case in &cases {
-        say(&format!("\n{}", case.provenance()));
+        let text = case.provenance_text();
+        match paragraphs.iter_mut().find(|(_, t)| *t == text) {
+            Some((ids, _)) => ids.push(case.id.as_str()),
+            None => paragraphs.push((vec![case.id.as_str()], text)),
+        }
+    }
+    for (ids, text) in &paragraphs {
+        say(&format!("\n{}: {text}", ids.join(", ")));
     }
     let (line, passed) = verdict(values, &failures);
     say("");

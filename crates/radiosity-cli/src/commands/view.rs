@@ -129,11 +129,8 @@ fn check_flags(args: &ViewArgs) -> Result<()> {
     } else {
         // Printed even with --quiet: the run does not do what the flags say. Only the flags
         // given are named (QA of issue #16).
-        let given: Vec<&str> = [("--frames", args.frames != 30), ("--panel", args.panel)]
-            .iter()
-            .filter(|f| f.1)
-            .map(|f| f.0)
-            .collect();
+        let given =
+            crate::setup::flags_given(&[("--frames", args.frames != 30), ("--panel", args.panel)]);
         if !given.is_empty() {
             errln!(
                 "warning: {} ignored: without --screenshot the window stays open",
@@ -142,14 +139,10 @@ fn check_flags(args: &ViewArgs) -> Result<()> {
         }
     }
     let hierarchical = args.solver == SolverKind::Hierarchical;
-    let given: Vec<&str> = [
-        ("--epsilon", args.epsilon != 0.05),
-        ("--min-area", args.min_area.is_some()),
-    ]
-    .iter()
-    .filter(|f| !hierarchical && f.1)
-    .map(|f| f.0)
-    .collect();
+    let given = crate::setup::flags_given(&[
+        ("--epsilon", !hierarchical && args.epsilon != 0.05),
+        ("--min-area", !hierarchical && args.min_area.is_some()),
+    ]);
     if !given.is_empty() {
         errln!(
             "warning: {} ignored: {} hierarchical radiosity's (--solver hierarchical)",

@@ -450,7 +450,8 @@ fn generate_building_writes_a_scene_that_reads_back() {
             ][..],
         ),
     ] {
-        let mut all = vec!["generate", "building", "-o", "x.scene"];
+        // As the README regenerates them: over the file of the last run, with --force.
+        let mut all = vec!["generate", "building", "--force", "-o", "x.scene"];
         all.extend_from_slice(args);
         let out = radiosity(&all, &dir);
         assert!(out.status.success(), "{}", stderr(&out));
@@ -672,7 +673,12 @@ fn adapt_rounds_refine_the_mesh_and_refuse_a_form_factor_file() {
     // The refined solution has more elements, and says how it got them.
     assert!(rows("adapted.csv") > rows("once.csv"));
     let notes = stderr(&twice);
-    assert!(notes.contains("adaptive subdivision from"), "{notes}");
+    // Each round is told before the solve of the mesh it made (QA of issue #16: the rounds
+    // came after the last "solved" line).
+    let round = notes.find("adaptive subdivision, round 1: ").expect(&notes);
+    let solved_before = notes[..round].matches("\nsolved ").count();
+    let solved_after = notes[round..].matches("\nsolved ").count();
+    assert_eq!((solved_before, solved_after), (1, 1), "{notes}");
     // The room's area is kept: the elements are split, none lost (column 3 is the area).
     let area = |f: &str| -> f64 {
         std::fs::read_to_string(dir.join(f))

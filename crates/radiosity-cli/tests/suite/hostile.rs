@@ -389,8 +389,9 @@ fn an_objs_material_file_is_never_written_over() {
             "{args:?}"
         );
     }
-    // Material files with names `solve` and `formfactors` write: refused as inputs by the
-    // library.
+    // Material files with names `solve` and `formfactors` write: refused as soon as the
+    // scene has been read, before any work (QA of issue #16: the library refused them only
+    // when writing, after the solve).
     for (command, flag, name) in [
         ("solve", "-o", "mat.csv"),
         ("solve", "--report", "mat.csv"),
@@ -406,7 +407,10 @@ fn an_objs_material_file_is_never_written_over() {
         let out = radiosity(&args, &dir);
         assert!(!out.status.success(), "{}", stderr(&out));
         assert!(
-            stderr(&out).contains("an output never replaces an input"),
+            stderr(&out).contains(&format!(
+                "{flag} {name}: {name} is a file the scene {scene} reads; writing it would \
+                 destroy the input"
+            )) && !stderr(&out).contains("solved "),
             "{command}: {}",
             stderr(&out)
         );
@@ -417,6 +421,12 @@ fn an_objs_material_file_is_never_written_over() {
     std::fs::write(dir.join("mat.mtl"), mtl).unwrap();
     let out = radiosity(&["export", "other.obj", "-o", "mat.obj"], &dir);
     assert!(!out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("-o mat.obj (its material library mat.mtl): mat.mtl is a file")
+            && !stderr(&out).contains("solved "),
+        "{}",
+        stderr(&out)
+    );
     assert_eq!(std::fs::read_to_string(dir.join("mat.mtl")).unwrap(), mtl);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -14,7 +14,7 @@
 //! Layer attributes say what the file holds: `radiosity.quantity` ("radiance = radiosity
 //! / pi, scene emission units per steradian"), `radiosity.unit` ([`UNIT`]: the values'
 //! unit, cd/m^2 for a photometric scene), `radiosity.lengthUnit` (the scene's length unit
-//! in words, as the importers give it: `scene units`, `metres, taken as (the file's numbers x 0.001; unscaled, metres (glTF's unit))`, ...),
+//! in words, as the importers give it: `scene units`, `metres = the file's numbers x 0.001; unscaled, metres (glTF's unit)`, ...),
 //! the camera (`radiosity.eye.x` ... `radiosity.fovY`, as in the reference files) and the
 //! software.
 

@@ -101,6 +101,16 @@ pub fn release_input(path: &Path) {
     INPUTS.release(path);
 }
 
+/// The input of this process that `path` is (by device and inode), if any, when protected:
+/// for a program that checks its outputs before the work that leads to writing them.
+pub fn input_at(path: &Path) -> Option<PathBuf> {
+    if PROTECTED.load(Ordering::SeqCst) {
+        INPUTS.input_at(path)
+    } else {
+        None
+    }
+}
+
 /// An error when `path` is an input of this process (see [`Inputs::refuse_output`]).
 pub(crate) fn refuse_output(path: &Path) -> io::Result<()> {
     if PROTECTED.load(Ordering::SeqCst) {

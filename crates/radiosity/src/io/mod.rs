@@ -35,4 +35,4 @@ pub mod solution;
 pub mod surface_report;
 
 pub use atomic_write::{is_same_file, write_atomically};
-pub use inputs::{note_input, protect_inputs, release_input};
+pub use inputs::{input_at, note_input, protect_inputs, release_input};

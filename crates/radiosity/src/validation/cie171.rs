@@ -116,15 +116,21 @@ pub const GEOMETRY_NOTE: &str = "CIE 171:2006 itself was not available here (its
     summary and Ashdown's errata page were read): each case follows the published \
     description named below, the dimensions, sources and points not given there are this \
     project's, and every reference is computed for exactly the scene written \
-    (validation/<case>.scene), so no published table is compared";
+    (validation/cie171_<case>.scene, as `--write DIR` writes them), so no published table is \
+    compared";
 
 impl Case {
     /// Where the case comes from, for the notes under the table: its title, the published
     /// description its scene follows, and where its reference comes from and how.
     pub fn provenance(&self) -> String {
+        format!("{}: {}", self.id, self.provenance_text())
+    }
+
+    /// [`Self::provenance`] without the id: the same for the cases of one description (the
+    /// seven reflectances of 5.8), which are listed once with all their ids.
+    pub fn provenance_text(&self) -> String {
         format!(
-            "{}: {}. Scene: after {}. Reference: {}: {}.",
-            self.id,
+            "{}. Scene: after {}. Reference: {}: {}.",
             self.title,
             self.scene_from,
             self.reference_from.label(),

@@ -256,10 +256,11 @@ pub enum ImportError {
         /// What was found and what was expected.
         message: String,
     },
-    /// A face names a vertex the file does not have.
+    /// A face names a vertex the file does not have (before it, in an OBJ: the count is
+    /// of the vertices that can be named there, not of the file's; QA of issue #16).
     #[error(
-        "{}: error: {element}: vertex index {index} is out of range (the file has {count} \
-         vertices)",
+        "{}: error: {element}: vertex index {index} is out of range ({count} vertices can be \
+         named there)",
         location(file, *line)
     )]
     BadIndex {
@@ -335,8 +336,13 @@ pub enum ImportError {
     },
     /// No face was left to make a surface of.
     #[error(
-        "{file}: error: no usable faces: the file has {faces} faces{}",
-        if *faces == 0 { String::new() } else { format!(", all {faces} degenerate (zero area or fewer than 3 distinct corners)") }
+        "{file}: error: no usable faces: the file has {faces} {}{}",
+        if *faces == 1 { "face" } else { "faces" },
+        match *faces {
+            0 => String::new(),
+            1 => ", and it is degenerate (zero area or fewer than 3 distinct corners)".to_string(),
+            _ => format!(", all {faces} degenerate (zero area or fewer than 3 distinct corners)"),
+        }
     )]
     NoSurfaces {
         /// The file.
@@ -406,7 +412,7 @@ pub fn scaled_unit(unit: &str, scale: f64) -> String {
     if scale == 1.0 {
         unit.to_string()
     } else {
-        format!("metres, taken as (the file's numbers x {scale}; unscaled, {unit})")
+        format!("metres = the file's numbers x {scale}; unscaled, {unit}")
     }
 }
 

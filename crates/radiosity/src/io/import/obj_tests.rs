@@ -193,8 +193,8 @@ fn wrong_index_is_an_error_at_its_line() {
     let e = read_text(&format!("{SQUARE}o Box\nf 1 2 5\n"), &[]).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "m.obj:6: error: face 1 of object \"Box\": vertex index 5 is out of range (the file \
-         has 4 vertices)"
+        "m.obj:6: error: face 1 of object \"Box\": vertex index 5 is out of range (4 \
+         vertices can be named there)"
     );
     for bad in ["0", "-5"] {
         let e = read_text(&format!("{SQUARE}f 1 2 {bad}\n"), &[]).unwrap_err();

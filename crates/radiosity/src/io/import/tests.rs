@@ -210,8 +210,8 @@ fn only_degenerate_faces_is_an_error() {
         .unwrap_err();
     assert_eq!(
         e.to_string(),
-        "test.obj: error: no usable faces: the file has 1 faces, all 1 degenerate (zero area \
-         or fewer than 3 distinct corners)"
+        "test.obj: error: no usable faces: the file has 1 face, and it is degenerate (zero \
+         area or fewer than 3 distinct corners)"
     );
 }
 
@@ -222,8 +222,8 @@ fn index_out_of_range_names_the_face_and_line() {
         .unwrap_err();
     assert_eq!(
         e.to_string(),
-        "test.obj:2: error: face 2 of object \"Box\": vertex index 7 is out of range (the \
-         file has 4 vertices)"
+        "test.obj:2: error: face 2 of object \"Box\": vertex index 7 is out of range (4 \
+         vertices can be named there)"
     );
 }
 
@@ -353,8 +353,8 @@ fn scene_file_scaled_meshes_the_same() {
     let half = read_any_scene(&path, &o).unwrap();
     assert_eq!(
         half.unit,
-        "metres, taken as (the file's numbers x 0.5; unscaled, metres (a .scene file \
-         states no unit; metres assumed))"
+        "metres = the file's numbers x 0.5; unscaled, metres (a .scene file states no \
+         unit; metres assumed)"
     );
     // Halving is exact in binary: every coordinate exactly half, the area a quarter.
     assert_eq!(

@@ -371,7 +371,7 @@ fn wrong_indices_are_refused_naming_the_face() {
     assert_eq!(
         err("#VRML V2.0 utf8\nShape { geometry IndexedFaceSet {\ncoord Coordinate { point [0 0 0, 1 0 0, 1 1 0] }\ncoordIndex [ 0 1 2 -1 0 2 9 -1 ] } }"),
         "t.wrl:4: error: IndexedFaceSet of line 2, coordIndex entry 6 (face 2): vertex index 9 \
-         is out of range (the file has 3 vertices)"
+         is out of range (3 vertices can be named there)"
     );
     assert!(err("#VRML V2.0 utf8\nShape { geometry IndexedFaceSet {\ncoord Coordinate { point [0 0 0, 1 0 0, 1 1 0] }\ncoordIndex [ 0 1 -2 ] } }").contains("vertex index -2"));
     assert!(err("#VRML V2.0 utf8\nShape { geometry IndexedFaceSet {\ncoord Coordinate { point [0 0 0, 1 0] } } }").contains("Coordinate.point has 5 numbers"));
