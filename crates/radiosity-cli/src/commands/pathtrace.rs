@@ -265,18 +265,29 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
 
     let Some((prepared, _, solver)) = &prepared else {
         // Alone: the view's own exposure unless one is given.
-        let scale = match args.tone.exposure {
-            Exposure::Fixed(s) => s,
-            Exposure::Auto => view.auto_exposure_scale(),
-        };
         if format == ImageFormat::Exr {
             write_linear(view.film(), &camera, &output, &reporter)?;
             reporter.print_timings();
             return Ok(());
         }
+        let scale = match args.tone.exposure {
+            Exposure::Fixed(s) => s,
+            Exposure::Auto => area_exposure(scene, &settings)?,
+        };
         let shown = report::significant(scale, 4);
+        let how = match args.tone.exposure {
+            Exposure::Auto => format!(
+                "auto: the mean radiosity of the brightest 2 % of the non-emitting area is \
+                 white, as `render` makes it, estimated at {} points by {} paths each; the \
+                 view's own brightest 2 % of pixels would give {}; ",
+                radiosity::pathtrace::EXPOSURE_POINTS,
+                radiosity::pathtrace::EXPOSURE_PATHS,
+                report::significant(view.auto_exposure_scale(), 4)
+            ),
+            Exposure::Fixed(_) => String::new(),
+        };
         reporter.note(&format!(
-            "exposure scale {shown} (`render --exposure {shown}` shows a render with it)"
+            "exposure scale {shown} ({how}`render --exposure {shown}` shows a render with it)"
         ));
         write_image(
             &tonemap::to_image(view.film(), scale, gamma),
@@ -339,8 +350,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     // One line for the exposure (QA of issue #16: it was printed twice).
     let whose = match args.tone.exposure {
         Exposure::Auto => format!(
-            " (auto, the radiosity solution's; the path-traced view's own would be {})",
-            report::significant(view.auto_exposure_scale(), 4)
+            " (auto, the radiosity solution's; the path tracer's own estimate of it would be \
+             {})",
+            report::significant(area_exposure(scene, &settings)?, 4)
         ),
         Exposure::Fixed(_) => String::new(),
     };
@@ -430,4 +442,17 @@ fn write_image(image: &image::RgbImage, path: &Path, reporter: &Reporter) -> Res
         image.height()
     ));
     Ok(())
+}
+
+/// The automatic exposure of `render` estimated by paths
+/// ([`radiosity::pathtrace::PathTracer::area_exposure_scale`]; issue #11: the view's own
+/// statistic made the Cornell box's path-traced picture half as bright as its render).
+fn area_exposure(scene: &Scene, settings: &PathTraceSettings) -> Result<f64> {
+    let tracer = radiosity::pathtrace::PathTracer::new(scene)?;
+    Ok(tracer.area_exposure_scale(
+        scene,
+        settings,
+        radiosity::pathtrace::EXPOSURE_POINTS,
+        radiosity::pathtrace::EXPOSURE_PATHS,
+    ))
 }

@@ -319,7 +319,9 @@ fn compare_prints_one_exposure_line_and_says_how_its_two_noise_figures_differ() 
     assert!(out.status.success(), "{err}");
     assert_eq!(err.matches("exposure scale").count(), 1, "{err}");
     assert!(
-        err.contains("for both (auto, the radiosity solution's; the path-traced view's own"),
+        err.contains(
+            "for both (auto, the radiosity solution's; the path tracer's own estimate of it"
+        ),
         "{err}"
     );
     let text = stdout(&out);

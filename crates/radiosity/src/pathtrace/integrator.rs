@@ -116,6 +116,16 @@ impl PathTracer {
         self.surfaces[surface].emission.max_band() > 0.0
     }
 
+    /// The unit normal of surface `surface` (its front).
+    pub(super) fn normal(&self, surface: usize) -> DVec3 {
+        self.surfaces[surface].normal
+    }
+
+    /// How far beyond the point they leave rays start (see the field).
+    pub(super) fn epsilon(&self) -> f64 {
+        self.epsilon
+    }
+
     /// One path from `origin` along the unit direction `dir`: an unbiased estimate of the
     /// radiosity B = pi L that the ray sees (see the module documentation), drawing its
     /// random numbers from `rng`.

@@ -52,6 +52,7 @@
 
 mod compare;
 mod estimate;
+mod exposure;
 mod integrator;
 mod lights;
 mod sampling;
@@ -65,6 +66,7 @@ pub use compare::{
     DEFAULT_ERROR_FULL_SCALE,
 };
 pub use estimate::{NoiseSummary, PathTraced};
+pub use exposure::{EXPOSURE_PATHS, EXPOSURE_POINTS};
 pub use integrator::{PathSample, PathTracer, MAX_SURVIVAL_PROBABILITY};
 pub use settings::{PathTraceError, PathTraceSettings, MIN_SAMPLES_PER_PIXEL};
 
