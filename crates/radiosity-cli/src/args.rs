@@ -646,14 +646,14 @@ pub struct BenchArgs {
     /// 0.01 unshot for progressive, 1e-6 changing power for hierarchical).
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
-    /// Image width and height in pixels (--width or --height sets one side).
-    #[arg(long, default_value_t = 512, value_name = "PIXELS",
-          value_parser = parse_at_least_1)]
-    pub size: u32,
-    /// Image width in pixels, as for `render` (default: --size).
+    /// Image width and height in pixels (default 512; --width or --height then sets one
+    /// side).
+    #[arg(long, value_name = "PIXELS", value_parser = parse_at_least_1)]
+    pub size: Option<u32>,
+    /// Image width in pixels, as for `render`: alone it sets both sides (default: --size).
     #[arg(long, value_parser = parse_at_least_1)]
     pub width: Option<u32>,
-    /// Image height in pixels, as for `render` (default: --size).
+    /// Image height in pixels, as for `render`: alone it sets both sides (default: --size).
     #[arg(long, value_parser = parse_at_least_1)]
     pub height: Option<u32>,
     /// Rays per pixel along each axis, 1 to 16 (as `render --supersample`).
@@ -829,16 +829,26 @@ pub fn value_error(e: &clap::Error) -> Option<String> {
     // "--steps <K>" or "-o <FILE>" is named by its flag; a positional "[SCENE]" as it is.
     let flag = match arg.split_whitespace().next() {
         Some(f) if f.starts_with('-') => f.to_string(),
-        _ => arg.clone(),
+        _ => arg.trim_matches(['[', ']', '<', '>', '.']).to_string(),
     };
     let reason = match e.kind() {
         ErrorKind::ValueValidation => {
             let reason = std::error::Error::source(e)?.to_string();
             plain_number_reason(&value, &reason)
         }
+        // An empty value where one is needed (`-o ""`: QA of issue #16, "give one of "
+        // with nothing after it): named by the flag's value name.
+        ErrorKind::InvalidValue if value.is_empty() => {
+            let name = arg
+                .split_once('<')
+                .and_then(|(_, rest)| rest.split_once('>'))
+                .map(|(name, _)| name.to_string())
+                .unwrap_or_else(|| arg.trim_matches(['[', ']', '.']).to_string());
+            format!("empty; give a {name} name")
+        }
         ErrorKind::InvalidValue => {
             let valid = match e.get(ContextKind::ValidValue) {
-                Some(ContextValue::Strings(v)) => v.join(", "),
+                Some(ContextValue::Strings(v)) if !v.is_empty() => v.join(", "),
                 _ => return None,
             };
             match text(ContextKind::SuggestedValue) {

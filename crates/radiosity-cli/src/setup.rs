@@ -471,6 +471,15 @@ pub fn scene_unit() -> String {
         .unwrap_or_else(|| "scene units".to_string())
 }
 
+/// The note on the unit of the scene [`load_scene`] read last ([`millimetres_perhaps`]),
+/// for `check`'s report, whose reporter prints no notes.
+static UNIT_NOTE: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// The note on the scene's unit, if it has one.
+pub fn unit_note() -> Option<String> {
+    UNIT_NOTE.lock().ok().and_then(|n| n.clone())
+}
+
 fn note_unit(unit: &str) {
     if let Ok(mut u) = SCENE_UNIT.lock() {
         *u = Some(unit.to_string());
@@ -518,8 +527,13 @@ pub fn load_scene(
             ));
             note_unit(&imported.unit);
             refuse_outputs_read(path)?;
-            if let Some(n) = millimetres_perhaps(&imported.file.scene, &imported.unit, scale) {
-                errln!("{}: note: {n}", path.display());
+            // A note, as -q's help says notes are left out (QA of issue #16).
+            let unit_note = millimetres_perhaps(&imported.file.scene, &imported.unit, scale);
+            if let Some(n) = &unit_note {
+                reporter.note(&format!("{}: note: {n}", path.display()));
+            }
+            if let Ok(mut slot) = UNIT_NOTE.lock() {
+                *slot = unit_note;
             }
             if let Some(w) = far_from_origin(&imported.file.scene) {
                 errln!("{}: warning: {w}", path.display());
@@ -919,6 +933,7 @@ pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
     let Some(out) = output else {
         return Ok(ImageFormat::Png);
     };
+    only_an_extension(out, "-o")?;
     if out.is_dir() {
         bail!(
             "-o {}: is a folder; give the image a file name in it, ending .png \
@@ -940,10 +955,28 @@ pub fn image_format(output: Option<&Path>) -> Result<ImageFormat> {
     }
 }
 
+/// Refuses a file name that is only an extension (`-o .png`: a hidden file with no
+/// extension, which the extension check refused with advice it already followed; QA of
+/// issue #16).
+fn only_an_extension(output: &Path, flag: &str) -> Result<()> {
+    let name = output
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if name.starts_with('.') && name.len() > 1 && output.extension().is_none() {
+        bail!(
+            "{flag} {}: the name is only an extension; give a name before it (room{name})",
+            output.display()
+        );
+    }
+    Ok(())
+}
+
 /// Refuses, before any work, an output named with none of the `extensions` (any case) it
 /// can be written as (QA of issue #16: `solve -o x.txt` wrote CSV into it without a word,
 /// an extensionless name too). `flag` names the option, `what` what is written.
 pub fn output_extension(output: &Path, flag: &str, what: &str, extensions: &[&str]) -> Result<()> {
+    only_an_extension(output, flag)?;
     let ext = output
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
@@ -1228,6 +1261,19 @@ pub fn adapt(
         prepared.settings.max_patch_area,
         rounds,
     );
+    // A budget below the first mesh could split nothing (QA of issue #16: `10` was taken
+    // and the rounds stopped "at the most elements allowed, 10").
+    if let Some(max) = options.adapt_max_elements {
+        let n = prepared.mesh.len();
+        if max < n + 3 {
+            bail!(
+                "--adapt-max-elements {max}: the first mesh already has {} and each split adds \
+                 3; give at least {}",
+                crate::report::count(n as u64, "element"),
+                n + 3
+            );
+        }
+    }
     Ok(Some(match options.adapt_max_elements {
         // Given, only this limit holds.
         Some(max_elements) => AdaptSettings {

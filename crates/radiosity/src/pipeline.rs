@@ -710,8 +710,8 @@ fn solve_adaptive(
             );
             progress.message(&if adapt.max_elements.saturating_sub(n) < 3 {
                 format!(
-                    "{stopped}: the mesh has reached the most elements allowed, {} (twice the \
-                     first mesh's, at most {}, unless --adapt-max-elements N is given)",
+                    "{stopped}: the mesh has reached the most elements allowed, {} \
+                     (--adapt-max-elements N, or by default twice the first mesh's, at most {})",
                     adapt.max_elements,
                     crate::mesh::DEFAULT_MAX_ELEMENTS
                 )

@@ -225,10 +225,17 @@ fn median(mut values: Vec<f64>) -> f64 {
 }
 
 /// The rendered image's width and height: `--width` and `--height`, each `--size` when
-/// not given (at least 1 pixel each, checked by clap; at most 100 megapixels, as `render`).
+/// not given; without `--size`, one side given sets both, as for `render` (QA of issue
+/// #16: `bench --width 64` timed a 64 x 512 picture where `render --width 64` draws 64 x
+/// 64). At least 1 pixel each, checked by clap; at most 100 megapixels, as `render`.
 fn image_size(args: &BenchArgs) -> (u32, u32) {
-    (
-        args.width.unwrap_or(args.size),
-        args.height.unwrap_or(args.size),
-    )
+    match (args.width, args.height) {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, args.size.unwrap_or(w)),
+        (None, Some(h)) => (args.size.unwrap_or(h), h),
+        (None, None) => {
+            let side = args.size.unwrap_or(crate::args::CameraArgs::DEFAULT_SIDE);
+            (side, side)
+        }
+    }
 }

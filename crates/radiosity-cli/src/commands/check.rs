@@ -65,6 +65,16 @@ pub fn run(args: CheckArgs) -> Result<()> {
     // form-factor stage was silent).
     let reporter = Reporter::progress_only(args.scene.quiet);
     let (prepared, stem, solver) = prepare_solve(&args.scene, &args.solve, &reporter)?;
+    // What is being checked, before the long stages (QA of issue #16: a large scene showed
+    // only progress lines until the report came at the end).
+    if !args.scene.quiet {
+        errln!(
+            "checking {stem}: {} by {}, solver {}; the report follows the solve",
+            crate::report::count(prepared.mesh.len() as u64, "element"),
+            prepared.method(),
+            solver.kind().name()
+        );
+    }
     let (solution, stats, escaped) = if solver.needs_matrix() {
         let (f, stats) = match args.solve.form_factors.as_deref() {
             Some(path) => {

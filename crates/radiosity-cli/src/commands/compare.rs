@@ -19,6 +19,19 @@ pub fn run(args: CompareArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
     let (prepared, stem, solver) =
         prepare_solve_with_reference(&args.scene, &args.solve, &reporter)?;
+    // QA of issue #16: with the default `auto` on a small scene the tested solver is the
+    // reference's own, and the row compares it with itself.
+    if !args.no_reference
+        && args.solve.solver.0 == radiosity::solve::SolverKind::Auto
+        && solver == Solver::DEFAULT_GAUSS_SEIDEL
+        && args.solve.adapt_rounds.is_none_or(|r| r == 0)
+    {
+        errln!(
+            "warning: auto chose Gauss-Seidel on the dense matrix, the reference's own \
+             solver: the row compares it with itself (zero differences); give --solver \
+             hierarchical or progressive to test another"
+        );
+    }
     let reset = reset_peak_memory();
     let start = std::time::Instant::now();
     let tested = format!("{}, tested", solver.kind().name());

@@ -213,6 +213,24 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             sibling(&output, "error", ImageFormat::Png),
         ]);
     }
+    // The pictures written beside -o are named as such (QA of issue #16: the refusal named
+    // -o foo-radiosity.exr, which the user never typed).
+    for beside in outputs.iter().skip(1) {
+        let label = format!(
+            "-o {} (the picture written beside it, {})",
+            output.display(),
+            beside.display()
+        );
+        for &(what, input) in &inputs {
+            if input.is_some_and(|input| radiosity::io::is_same_file(beside, input)) {
+                bail!(
+                    "{label}: this is the {what}; writing it would destroy the input; give -o \
+                     another file name"
+                );
+            }
+        }
+        setup::note_output(beside, "-o", &label);
+    }
     outputs.extend(args.save_reference.clone());
     for out in &outputs {
         let flag = if args.save_reference.as_ref() == Some(out) {

@@ -353,8 +353,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
         image.width(),
         image.height()
     ));
-    if !wireframe && crate::report::light_lost(&prepared.scene, &solution).is_none() {
-        if let Some(warning) = black_picture(&image) {
+    if !wireframe && picture_can_be_lit(&prepared, &solution) {
+        if let Some(warning) = black_picture(image.pixels().map(|p| p.0 == [0, 0, 0])) {
             // Printed even with --quiet: the picture shows nothing.
             errln!("warning: {warning}");
         }
@@ -371,18 +371,32 @@ const BLACK_PICTURE_SHARE: f64 = 0.95;
 /// seeing the backs of its faces, or inside a closed piece of furniture (QA of issue #16:
 /// a camera outside a closed room wrote a black picture without a word; `illuminance`
 /// warns of points that see only backs).
-fn black_picture(image: &image::RgbImage) -> Option<String> {
-    let pixels = (image.width() as u64 * image.height() as u64).max(1);
-    let black = image.pixels().filter(|p| p.0 == [0, 0, 0]).count() as u64;
-    let share = black as f64 / pixels as f64;
+fn black_picture(dark: impl Iterator<Item = bool>) -> Option<String> {
+    let (mut pixels, mut black) = (0u64, 0u64);
+    for is_dark in dark {
+        pixels += 1;
+        black += u64::from(is_dark);
+    }
+    let share = black as f64 / pixels.max(1) as f64;
     (share > BLACK_PICTURE_SHARE).then(|| {
         format!(
-            "{:.1} % of the picture is black: the camera sees the backs of faces (outside a \
-             closed room, or inside furniture or a wall) or nothing; move --eye into the \
-             scene",
+            "{:.1} % of the picture shows nothing lit: the camera sees the backs of faces \
+             (outside a closed room, or inside furniture or a wall) or nothing; move --eye \
+             into the scene",
             100.0 * share
         )
     })
+}
+
+/// Whether a black picture is the camera's doing: the scene's light reaches its surfaces
+/// (QA of issue #16: a scene with no light got this warning after the one saying nothing
+/// emits, and its camera, inside the room, was blamed).
+fn picture_can_be_lit(
+    prepared: &radiosity::pipeline::Prepared,
+    solution: &radiosity::pipeline::Solution,
+) -> bool {
+    crate::report::energy_band(&solution.balance).is_some()
+        && crate::report::light_lost(&prepared.scene, solution).is_none()
 }
 
 /// `render --false-colour`: the illuminance of every element
@@ -461,6 +475,18 @@ fn false_colour(
     } else {
         String::new()
     };
+    // The view shows nothing where no pixel met a front (QA of issue #16: a camera
+    // outside the room gave a white false-colour picture without the warning the shaded
+    // render gives).
+    if picture_can_be_lit(prepared, solution) {
+        let nothing = pixel_lux
+            .iter()
+            .zip(&coverage)
+            .map(|(&lux, &c)| c <= 0.0 || lux <= 0.0);
+        if let Some(warning) = black_picture(nothing) {
+            errln!("warning: {warning}");
+        }
+    }
     reporter.note(&format!(
         "wrote {} ({} x {}: the {} x {} view and a {} pixel wide scale bar{taller}; false \
          colour from 0 to {} lx, the largest element illuminance is {} lx; {})",

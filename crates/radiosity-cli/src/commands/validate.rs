@@ -29,6 +29,12 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
     // --write with --case writes only those cases' files (QA of issue #16: --case was
     // ignored and every case written).
     if let Some(dir) = &args.write {
+        if dir.exists() && !dir.is_dir() {
+            bail!(
+                "--write {}: is a file; give a folder to write the cases into",
+                dir.display()
+            );
+        }
         // As every other output: a missing folder's parent is not made (QA of issue #16:
         // `--write nowhere/deep/x` made three folders without a word).
         if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {

@@ -1760,7 +1760,8 @@ fn second_pass_findings_are_said() {
     // --exposure and --gamma, compare's two solves, and bench's rays/s with no
     // form-factor stage.
     let dir = scratch_dir("second-pass");
-    let err = stderr(&radiosity(
+    // In check's report, under the unit line (its reporter prints no notes).
+    let err = crate::fixtures::stdout(&radiosity(
         &[
             "check",
             &crate::fixtures::example("cornell_box.scene"),
@@ -1770,7 +1771,7 @@ fn second_pass_findings_are_said() {
         &dir,
     ));
     assert!(
-        err.contains("note: the largest surface is ")
+        err.contains("(note: the largest surface is ")
             && err.contains("m^2 read as metres")
             && err.contains("--scale 0.001")
             // Its light is given as exitances: the note says the unit changes none of it
@@ -2332,8 +2333,9 @@ fn a_camera_outside_a_closed_room_is_warned_of() {
     let out = radiosity(&outside, &dir);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
-        stderr(&out)
-            .contains("warning: 100.0 % of the picture is black: the camera sees the backs"),
+        stderr(&out).contains(
+            "warning: 100.0 % of the picture shows nothing lit: the camera sees the backs"
+        ),
         "{}",
         stderr(&out)
     );
@@ -2375,5 +2377,133 @@ fn a_downlight_left_at_the_default_aim_in_a_y_up_room_is_warned_of() {
             stderr(&out)
         );
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn seventh_pass_findings_are_said() {
+    // QA of issue #16, seventh pass.
+    let dir = scratch_dir("seventh-pass");
+    let occluder = crate::fixtures::example("occluder.scene");
+    let expect = |args: &[&str], code: i32, needle: &str| {
+        let out = radiosity(args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        err
+    };
+    // An empty file name: "give one of " and nothing after it.
+    expect(
+        &["render", "-o", ""],
+        1,
+        "error: --output \"\": empty; give a FILE name",
+    );
+    expect(
+        &["check", ""],
+        1,
+        "error: SCENE \"\": empty; give a SCENE name",
+    );
+    // A name that is only an extension.
+    expect(
+        &["render", "-o", ".png"],
+        1,
+        "-o .png: the name is only an extension",
+    );
+    // --adapt-max-elements below the first mesh.
+    expect(
+        &[
+            "solve",
+            &occluder,
+            "-o",
+            "x.csv",
+            "--adapt-rounds",
+            "1",
+            "--adapt-max-elements",
+            "10",
+        ],
+        1,
+        "--adapt-max-elements 10: the first mesh already has 1696 elements",
+    );
+    // A file where a folder is asked for.
+    std::fs::write(dir.join("f"), "x").unwrap();
+    expect(
+        &["validate", "cie171", "--write", "f"],
+        1,
+        "--write f: is a file",
+    );
+    // compare's default solver on a small scene is the reference's own.
+    expect(
+        &["compare", "--max-area", "20000", "-q"],
+        0,
+        "warning: auto chose Gauss-Seidel on the dense matrix, the reference's own solver",
+    );
+    // bench --width alone sets both sides, as render's does.
+    let err = expect(
+        &[
+            "bench",
+            "--max-area",
+            "20000",
+            "--repeat",
+            "1",
+            "--width",
+            "12",
+        ],
+        0,
+        "",
+    );
+    assert!(err.contains("render 12x12 at"), "{err}");
+    // The analytic method's account, visibly not adding up, has its reason.
+    let out = radiosity(
+        &["check", "--max-area", "20000", "--method", "analytic"],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        crate::fixtures::stdout(&out)
+            .contains("relative error: analytic k=2's form factors are not reciprocal"),
+        "{}",
+        crate::fixtures::stdout(&out)
+    );
+    // The picture pathtrace --compare writes beside -o is named as such.
+    std::fs::write(dir.join("foo-radiosity.exr"), "x").unwrap();
+    expect(
+        &[
+            "pathtrace",
+            "--max-area",
+            "20000",
+            "--width",
+            "8",
+            "--reference",
+            "foo-radiosity.exr",
+            "--compare",
+            "-o",
+            "foo.exr",
+        ],
+        1,
+        "-o foo.exr (the picture written beside it, foo-radiosity.exr): this is the reference",
+    );
+    // A scene with no light is said so once, not blamed on the camera.
+    let dark = std::fs::read_to_string(&occluder)
+        .unwrap()
+        .replace("Er 15", "Er 0")
+        .replace("Eg 15", "Eg 0")
+        .replace("Eb 15", "Eb 0");
+    std::fs::write(dir.join("dark.scene"), dark).unwrap();
+    let err = expect(
+        &[
+            "render",
+            "dark.scene",
+            "--width",
+            "8",
+            "--supersample",
+            "1",
+            "-o",
+            "d.png",
+            "-q",
+        ],
+        0,
+        "nothing in the scene emits light",
+    );
+    assert!(!err.contains("shows nothing lit"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
