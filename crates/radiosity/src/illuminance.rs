@@ -682,12 +682,21 @@ pub struct GridAxes {
 }
 
 impl GridAxes {
-    /// The axes of [`grid`]`(a, b, spacing, ..)` when it varies along two axes (a line or
-    /// a point has none to print).
+    /// The axes of [`grid`]`(a, b, spacing, ..)` when it varies along two axes, or along
+    /// one (a line: its one row labelled by the first axis it does not vary along, QA of
+    /// issue #16: a line's picture had no coordinates); a point has none to print.
     pub fn of(a: DVec3, b: DVec3, spacing: f64) -> Option<Self> {
         let varying: Vec<usize> = (0..3).filter(|&i| a[i] != b[i]).collect();
-        let [u, v] = varying[..] else { return None };
         let name = |i: usize| ['x', 'y', 'z'][i];
+        if let [u] = varying[..] {
+            let w = (0..3).find(|&i| i != u).unwrap_or(0);
+            return Some(Self {
+                names: [name(u), name(w)],
+                first: [a[u], a[w]],
+                step: [(b[u] - a[u]).signum() * spacing, 0.0],
+            });
+        }
+        let [u, v] = varying[..] else { return None };
         Some(Self {
             names: [name(u), name(v)],
             first: [a[u], a[v]],

@@ -353,8 +353,13 @@ fn the_grid_picture_prints_the_coordinates_of_its_columns_and_rows() {
     assert_eq!(back.names, ['x', 'y']);
     assert_eq!(back.labels(0, 5), ["4", "3", "2", "1", "0"]);
     assert_eq!(back.labels(1, 3), ["2", "1", "0"]);
-    // A line has no second axis to print.
-    assert_eq!(GridAxes::of(DVec3::ZERO, dvec3(1.0, 0.0, 0.0), 0.5), None);
+    // A line's one row is labelled by the first axis it does not vary along (QA of issue
+    // #16: it had no coordinates); a point has none.
+    let line = GridAxes::of(dvec3(0.0, 1.0, 2.0), dvec3(1.0, 1.0, 2.0), 0.5).unwrap();
+    assert_eq!(line.names, ['x', 'y']);
+    assert_eq!(line.labels(0, 3), ["0.0", "0.5", "1.0"]);
+    assert_eq!(line.labels(1, 1), ["1"]);
+    assert_eq!(GridAxes::of(DVec3::ONE, DVec3::ONE, 0.5), None);
     // Drawn: ink left of the cells (the row labels) and below them (the column labels),
     // none there without axes.
     let values = [10.0, 20.0, 30.0, 40.0, 50.0, 60.0];
