@@ -491,7 +491,7 @@ mod tests {
     fn traced() -> (Scene, Camera, PathTraceSettings, PathTraced) {
         let scene = cornell_box().scene;
         let camera = Camera::for_scene(&scene, 7, 5);
-        let settings = PathTraceSettings::DEFAULT.with_samples(4).with_seed(9);
+        let settings = PathTraceSettings::DEFAULT.with_samples(16).with_seed(9);
         let view = path_trace(&scene, &camera, &settings, &NoProgress).unwrap();
         (scene, camera, settings, view)
     }
@@ -505,7 +505,7 @@ mod tests {
         assert_eq!(back.camera, camera);
         assert_eq!(back.settings, settings);
         let r = &back.view;
-        assert_eq!((r.width(), r.height(), r.samples_per_pixel()), (7, 5, 4));
+        assert_eq!((r.width(), r.height(), r.samples_per_pixel()), (7, 5, 16));
         assert_eq!(r.emitter_mask(), view.emitter_mask());
         assert!(
             view.emitter_mask().iter().any(|&e| e),

@@ -11,12 +11,17 @@ use crate::splitmix::splitmix64;
 
 /// The generator of pixel `pixel` (its index, row by row from the top-left corner) under
 /// `seed`: a 128-bit PCG state whose high half is a bijection of the pixel index (so the
-/// pixels of one image never share a state) and whose low half is a hash of the seed. It
-/// depends on nothing else, so the image does not depend on which thread draws which pixel.
+/// pixels of one image never share a state) and whose low half a hash of it and the seed.
+/// It depends on nothing else, so the image does not depend on which thread draws which
+/// pixel. The low half was once the seed's hash alone, the same for every pixel: the first
+/// numbers of consecutive pixels were then far from uniform (chi-square 1,200 to 2,500 over
+/// 64 bins and 32,768 pixels, where 104 is the 99.9 % bound), which put 14 % too few of
+/// the automatic exposure's points on the Cornell box's tall block (issue #11).
 pub(super) fn pixel_rng(seed: u64, pixel: u64) -> Pcg64Mcg {
     let key = splitmix64(seed);
     let high = splitmix64(pixel ^ key);
-    Pcg64Mcg::new((u128::from(high) << 64) | u128::from(key))
+    let low = splitmix64(high ^ key.rotate_left(29));
+    Pcg64Mcg::new((u128::from(high) << 64) | u128::from(low))
 }
 
 /// A uniform number in [0, 1).
@@ -85,6 +90,32 @@ mod tests {
                 assert!(u.dot(v).abs() < 1e-12, "{n}");
             }
             assert!((t.length() - 1.0).abs() < 1e-12 && (b.length() - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn consecutive_pixels_first_numbers_are_uniform() {
+        // The first and second numbers of 32,768 consecutive pixels in 64 bins: chi-square
+        // below 104, its 99.9 % point at 63 degrees of freedom (seeded, so it either holds
+        // or not; the generators that kept the seed's hash as the low half of every state
+        // gave 1,200 to 2,500).
+        for seed in [1u64, 99, 12345] {
+            let (n, bins) = (32_768u64, 64usize);
+            let mut first = vec![0u64; bins];
+            let mut second = vec![0u64; bins];
+            for pixel in 0..n {
+                let mut rng = pixel_rng(seed, pixel);
+                first[(uniform(&mut rng) * bins as f64) as usize] += 1;
+                second[(uniform(&mut rng) * bins as f64) as usize] += 1;
+            }
+            let expected = n as f64 / bins as f64;
+            let chi2 = |h: &[u64]| {
+                h.iter()
+                    .map(|&c| (c as f64 - expected).powi(2) / expected)
+                    .sum::<f64>()
+            };
+            assert!(chi2(&first) < 104.0, "seed {seed}: {}", chi2(&first));
+            assert!(chi2(&second) < 104.0, "seed {seed}: {}", chi2(&second));
         }
     }
 
