@@ -629,8 +629,9 @@ pub struct BenchArgs {
     pub scale: f64,
     #[command(flatten)]
     pub method: MethodArgs,
-    /// MAX_PATCH_AREA values to time, one table row each (several values, separated by
-    /// commas or spaces, or the option repeated); the scene's own when omitted.
+    /// MAX_PATCH_AREA values to time, one table row each (several values: separated by
+    /// commas, as separate arguments, or the option repeated); the scene's own when
+    /// omitted.
     #[arg(long, value_name = "AREA", num_args = 1.., value_delimiter = ',')]
     pub max_area: Vec<f64>,
     /// Override the scene's INTEGRAL_STEPS.

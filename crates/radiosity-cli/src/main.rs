@@ -59,12 +59,14 @@ enum Command {
     /// Path trace a scene (an unbiased Monte Carlo render of the same polygons and camera,
     /// no form factors) to a PNG image and print its noise; with --compare, also render the
     /// radiosity solution and print its pixel difference from the path-traced view.
-    // Its exposure is the view's own alone, the radiosity solution's with --compare (QA
-    // of issue #16: the shared help spoke of radiosities only).
+    // Its exposure is render's rule estimated by paths alone, the radiosity solution's
+    // with --compare (QA of issue #16: the shared help spoke of radiosities only, then of
+    // the view's pixels after the rule had changed).
     #[command(mut_arg("exposure", |a| a.help("Exposure of the PNG images: \"auto\" makes \
-        the mean of the brightest 2 % of the non-emitting view white (with --compare, both \
-        images take the radiosity solution's auto exposure, as `render` would), a number \
-        multiplies the light by it; an .exr output holds linear radiance, unexposed")))]
+        the mean radiosity of the brightest 2 % of the non-emitting area white, as `render` \
+        does, estimated by paths at points over the surfaces (with --compare, both images \
+        take the radiosity solution's auto exposure), a number multiplies the light by it; \
+        an .exr output holds linear radiance, unexposed")))]
     Pathtrace(PathTraceArgs),
     /// Export a scene for other tools: the solved mesh with the radiosity baked into vertex
     /// colours as glTF (-o out.glb or out.gltf), or the scene's surfaces as OBJ + MTL

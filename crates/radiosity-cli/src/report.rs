@@ -368,8 +368,14 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
         }
         return None;
     };
+    // Lost: little absorbed and nearly all escaped (a progressive run that has shot
+    // nothing yet has absorbed nothing and escaped nothing: not lost).
     let absorbed = b.absorbed[band] / b.emitted[band];
-    if absorbed >= LIGHT_LOST_ABSORBED || emitters.is_empty() {
+    let escaped = b.escaped[band] / b.emitted[band];
+    if absorbed >= LIGHT_LOST_ABSORBED
+        || escaped < 1.0 - 2.0 * LIGHT_LOST_ABSORBED
+        || emitters.is_empty()
+    {
         return None;
     }
     Some(format!(

@@ -287,6 +287,12 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
             let t = crate::report::typed(t);
             bail!("--tolerance {t}: give hierarchical radiosity's stopping change, a number above 0 and below 1");
         }
+        // A share of the emitted power of 1 or more stops progressive refinement before any
+        // shot (QA of issue #16: `--tolerance 2` gave 0 shots and a black picture).
+        if options.solver.0 == SolverKind::Progressive && t >= 1.0 {
+            let t = crate::report::typed(t);
+            bail!("--tolerance {t}: give the unshot share of the emitted power at which progressive refinement stops, a number above 0 and below 1 (0.01 is 1 %)");
+        }
     }
     if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
         bail!(
@@ -499,7 +505,8 @@ pub fn load_scene(
         None => {
             if scale != 1.0 {
                 bail!(
-                    "--scale applies to a scene file; the built-in Cornell box is in millimetres"
+                    "--scale applies to a scene file; the built-in Cornell box is in millimetres \
+                     (examples/cornell_box.scene --scale 0.001 reads the same box in metres)"
                 );
             }
             note_unit("millimetres (the built-in Cornell box)");
@@ -893,10 +900,11 @@ pub fn ray_settings(rays: &RayArgs, shading_arg: ShadingArg) -> RenderSettings {
         // QA of issue #16: --direct-light mesh with --shading flat ran without a word.
         errln!(
             "warning: --direct-light ignored: it chooses smooth shading's direct light, and \
-             --shading {} draws each element's own radiosity",
+             --shading {}",
             match shading_arg {
-                ShadingArg::Flat => "flat",
-                _ => "wireframe",
+                ShadingArg::Flat => "flat draws each element's own radiosity",
+                // QA of issue #16: wireframe draws white edges, not radiosity.
+                _ => "wireframe draws the elements' edges",
             }
         );
     }
@@ -1107,20 +1115,21 @@ pub fn camera_note(args: &CameraArgs, camera: &Camera, scene: &Scene) -> Option<
         )
     };
     Some(format!(
-        "camera --eye {} --look-at {} --up {} --fov {} ({}{}; give these flags to move it)",
+        "camera --eye {} --look-at {} --up {} --fov {} ({}; give these flags to move it)",
         v(camera.eye),
         v(camera.look_at),
         v(camera.up),
         crate::report::significant(camera.fov_y_degrees, 4),
-        if scene.camera.is_some() {
-            "the scene's own"
-        } else {
-            "chosen to frame the scene"
-        },
-        if args.eye.is_some() || args.look_at.is_some() || args.up.is_some() || args.fov.is_some() {
-            ", with the camera flags given"
-        } else {
-            ""
+        match (
+            scene.camera.is_some(),
+            args.eye.is_some() || args.look_at.is_some() || args.up.is_some() || args.fov.is_some(),
+        ) {
+            (true, false) => "the scene's own",
+            (false, false) => "chosen to frame the scene",
+            // QA of issue #16: "chosen to frame the scene, with the camera flags given" when
+            // only the field of view was chosen.
+            (true, true) => "the camera flags given, the rest the scene's own",
+            (false, true) => "the camera flags given, the rest chosen to frame the scene",
         }
     ))
 }

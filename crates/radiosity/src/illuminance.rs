@@ -587,14 +587,25 @@ pub fn false_colour(t: f64) -> [u8; 3] {
     c.map(|v| (v * 255.0).round() as u8)
 }
 
-/// A value as lighting tools print it: whole lux from 100, one decimal from 10, two below.
+/// A value as lighting tools print it: whole lux from 100, one decimal from 10, two below,
+/// and two significant figures below 0.1 (exponent form below 1e-6 and from a million).
 pub fn lux_label(v: f64) -> String {
-    if v.abs() >= 100.0 {
+    let a = v.abs();
+    // Below 0.1 and above a million, two or three significant figures (QA of issue #16: a
+    // dim room's grid read 0.00 and 0.01 in every cell beside a scale to 0.014).
+    if a >= 1e6 {
+        format!("{v:.2e}")
+    } else if a >= 100.0 {
         format!("{v:.0}")
-    } else if v.abs() >= 10.0 {
+    } else if a >= 10.0 {
         format!("{v:.1}")
-    } else {
+    } else if a >= 0.1 || a == 0.0 || !a.is_finite() {
         format!("{v:.2}")
+    } else if a >= 1e-6 {
+        let decimals = (-a.log10()).floor() as usize + 2;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.1e}")
     }
 }
 

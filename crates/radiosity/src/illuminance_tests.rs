@@ -199,6 +199,12 @@ fn the_grid_picture_colours_cells_by_value_with_a_legend() {
     assert_eq!(lux_label(1234.4), "1234");
     assert_eq!(lux_label(12.34), "12.3");
     assert_eq!(lux_label(1.234), "1.23");
+    // Dim and bright values keep two or three significant figures.
+    assert_eq!(lux_label(0.01434), "0.014");
+    assert_eq!(lux_label(0.001234), "0.0012");
+    assert_eq!(lux_label(0.0), "0.00");
+    assert_eq!(lux_label(2.5e-9), "2.5e-9");
+    assert_eq!(lux_label(4.5e30), "4.50e30");
 }
 
 #[test]

@@ -243,20 +243,22 @@ pub fn exposure_note(
         // given "the brightest non-emitting element").
         return format!(
             "exposure scale {} (auto: every surface emits, so the mean radiosity of the \
-             brightest {} % of the whole area, {:.4}, is white)",
+             brightest {} % of the whole area, {}, is white)",
             crate::report::significant(scale, 4),
             100.0 * AUTO_EXPOSURE_TOP_AREA,
-            1.0 / scale,
+            crate::report::significant(1.0 / scale, 5),
         );
     }
     format!(
-        "exposure scale {} (auto: {:.4}, the mean radiosity of the brightest {} % of \
-         the non-emitting area, is white; the brightest non-emitting element is {:.4}, \
+        // Significant figures, not four decimals (QA of issue #16: a dim scene's white
+        // read 0.0000, a bright one's 31 digits).
+        "exposure scale {} (auto: {}, the mean radiosity of the brightest {} % of \
+         the non-emitting area, is white; the brightest non-emitting element is {}, \
          {:.2} x white)",
         crate::report::significant(scale, 4),
-        1.0 / scale,
+        crate::report::significant(1.0 / scale, 5),
         100.0 * AUTO_EXPOSURE_TOP_AREA,
-        brightest,
+        crate::report::significant(brightest, 5),
         brightest * scale,
     )
 }

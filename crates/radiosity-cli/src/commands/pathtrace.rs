@@ -288,21 +288,30 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             reporter.print_timings();
             return Ok(());
         }
+        let white = match args.tone.exposure {
+            Exposure::Fixed(_) => None,
+            Exposure::Auto => area_exposure_white(scene, &settings)?,
+        };
         let scale = match args.tone.exposure {
             Exposure::Fixed(s) => s,
-            Exposure::Auto => area_exposure(scene, &settings)?,
+            Exposure::Auto => tonemap::scale_for(white),
         };
         let shown = report::significant(scale, 4);
-        let how = match args.tone.exposure {
-            Exposure::Auto => format!(
-                "auto: the mean radiosity of the brightest 2 % of the non-emitting area is \
-                 white, as `render` makes it, estimated at {} points by {} paths each; the \
-                 view's own brightest 2 % of pixels would give {}; ",
+        let how = match (args.tone.exposure, white) {
+            (Exposure::Auto, Some(white)) => format!(
+                "auto: {}, the mean radiosity of the brightest 2 % of the non-emitting area, \
+                 is white, as `render` makes it, estimated at {} points by {} paths each; \
+                 the view's own brightest 2 % of pixels would give {}; ",
+                report::significant(white, 5),
                 radiosity::pathtrace::EXPOSURE_POINTS,
                 radiosity::pathtrace::EXPOSURE_PATHS,
                 report::significant(view.auto_exposure_scale(), 4)
             ),
-            Exposure::Fixed(_) => String::new(),
+            // QA of issue #16: the fallback was presented as measured.
+            (Exposure::Auto, None) => "auto: nothing is lit (no light reaches the surfaces' \
+                                       points), so scale 1 is the fallback; "
+                .to_string(),
+            (Exposure::Fixed(_), _) => String::new(),
         };
         reporter.note(&format!(
             "exposure scale {shown} ({how}`render --exposure {shown}` shows a render with it)"
@@ -370,7 +379,10 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         Exposure::Auto => format!(
             " (auto, the radiosity solution's; the path tracer's own estimate of it would be \
              {})",
-            report::significant(area_exposure(scene, &settings)?, 4)
+            report::significant(
+                tonemap::scale_for(area_exposure_white(scene, &settings)?),
+                4
+            )
         ),
         Exposure::Fixed(_) => String::new(),
     };
@@ -465,9 +477,9 @@ fn write_image(image: &image::RgbImage, path: &Path, reporter: &Reporter) -> Res
 /// The automatic exposure of `render` estimated by paths
 /// ([`radiosity::pathtrace::PathTracer::area_exposure_scale`]; issue #11: the view's own
 /// statistic made the Cornell box's path-traced picture half as bright as its render).
-fn area_exposure(scene: &Scene, settings: &PathTraceSettings) -> Result<f64> {
+fn area_exposure_white(scene: &Scene, settings: &PathTraceSettings) -> Result<Option<f64>> {
     let tracer = radiosity::pathtrace::PathTracer::new(scene)?;
-    Ok(tracer.area_exposure_scale(
+    Ok(tracer.area_exposure_white(
         scene,
         settings,
         radiosity::pathtrace::EXPOSURE_POINTS,

@@ -2507,3 +2507,67 @@ fn seventh_pass_findings_are_said() {
     assert!(!err.contains("shows nothing lit"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn eighth_pass_findings_are_said() {
+    // QA of issue #16, eighth pass.
+    let dir = scratch_dir("eighth-pass");
+    let run = |args: &[&str]| {
+        let out = radiosity(args, &dir);
+        (out.status.code(), stderr(&out))
+    };
+    // A progressive tolerance of 1 or more would stop before any shot.
+    let (code, err) = run(&[
+        "solve",
+        "--solver",
+        "progressive",
+        "--tolerance",
+        "2",
+        "-o",
+        "t.csv",
+    ]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("--tolerance 2: give the unshot share"),
+        "{err}"
+    );
+    // pathtrace's fallback exposure is said to be one.
+    let (code, err) = run(&[
+        "pathtrace",
+        "--max-bounces",
+        "0",
+        "--paths",
+        "2",
+        "--width",
+        "8",
+        "-o",
+        "p.png",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("auto: nothing is lit"), "{err}");
+    // A .glb that is not binary glTF.
+    std::fs::write(dir.join("r.glb"), "{\"asset\": {\"version\": \"2.0\"}}").unwrap();
+    let (code, err) = run(&["check", "r.glb"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("r.glb: error: not a binary glTF file"),
+        "{err}"
+    );
+    // The camera note says which parts were given.
+    let (_, err) = run(&[
+        "render",
+        "--max-area",
+        "20000",
+        "--width",
+        "8",
+        "--fov",
+        "50",
+        "-o",
+        "c.png",
+    ]);
+    assert!(
+        err.contains("--fov 50 (the camera flags given, the rest the scene's own;"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -94,11 +94,20 @@ impl PathTracer {
         points: usize,
         paths: u32,
     ) -> f64 {
+        scale_for(self.area_exposure_white(scene, settings, points, paths))
+    }
+
+    /// The radiosity [`Self::area_exposure_scale`] makes white: `None` when the scene has
+    /// no area or the estimate is zero (nothing lit), where the scale falls back to 1.
+    pub fn area_exposure_white(
+        &self,
+        scene: &Scene,
+        settings: &PathTraceSettings,
+        points: usize,
+        paths: u32,
+    ) -> Option<f64> {
         let sampler = AreaSampler::new(scene, |j| !self.emits(j))
-            .or_else(|| AreaSampler::new(scene, |_| true));
-        let Some(sampler) = sampler else {
-            return 1.0;
-        };
+            .or_else(|| AreaSampler::new(scene, |_| true))?;
         // Point i, drawn from its own generator, so that both passes find it again; the
         // triangle by a stratified number, so each surface gets its share of the points.
         let point = |i: usize| {
@@ -131,6 +140,6 @@ impl PathTracer {
             .par_iter()
             .map(|&(i, _)| radiosity(i, 1))
             .collect();
-        scale_for(top_mean(again.iter().map(|&b| (b, 1.0)), 1.0))
+        top_mean(again.iter().map(|&b| (b, 1.0)), 1.0).filter(|w| *w > 0.0 && w.is_finite())
     }
 }

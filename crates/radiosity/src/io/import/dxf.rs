@@ -364,7 +364,8 @@ impl Drawing {
                     err(
                         p.line,
                         format!(
-                            "the {name} section of this line has no ENDSEC: the file is truncated"
+                            "the {name} section that starts here has no ENDSEC: the file is \
+                             truncated"
                         ),
                     )
                 })?;

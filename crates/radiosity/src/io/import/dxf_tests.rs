@@ -454,7 +454,8 @@ fn truncated_and_malformed_files_say_where() {
             "0\nSECTION\n2\nENTITIES\n0\n3DFACE\n8\nL\n10\n1\n",
             Some(GREY)
         ),
-        "t.dxf:1: error: the ENTITIES section of this line has no ENDSEC: the file is truncated"
+        "t.dxf:1: error: the ENTITIES section that starts here has no ENDSEC: the file is \
+         truncated"
     );
     assert_eq!(
         err(&dxf("", "0\n3DFACE\n10\nabc\n"), Some(GREY)),

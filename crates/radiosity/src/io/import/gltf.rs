@@ -97,6 +97,20 @@ pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportErro
         file: file.clone(),
         message: e.to_string(),
     })?;
+    // A .glb must be binary glTF (QA of issue #16: random bytes named .glb got the JSON
+    // parser's "expected value at line 1 column 1").
+    let named_glb = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if named_glb && !bytes.starts_with(b"glTF") {
+        return Err(ImportError::Syntax {
+            file,
+            line: 0,
+            message: "not a binary glTF file: a .glb starts with the 4 bytes \"glTF\" (a glTF \
+                      file in JSON is named .gltf)"
+                .to_string(),
+        });
+    }
     let dir = path.parent().unwrap_or(Path::new("."));
     parse(&file, &bytes, Some(dir), options)
 }
