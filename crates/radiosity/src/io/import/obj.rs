@@ -22,7 +22,7 @@
 //! Texture coordinates and normals (`vt`, `vn`), smoothing groups (`s`), points and lines
 //! (`p`, `l`: no area), free-form geometry (`curv`, `surf`, ...), and every other MTL
 //! statement (`Ka`, `Ks`, `Ns`, `d`, `illum`, texture maps). Statements other than those read
-//! or listed are counted in one warning. A missing MTL file, or a `usemtl` naming a material
+//! or listed are counted in one warning; an MTL file's texture maps get one of their own. A missing MTL file, or a `usemtl` naming a material
 //! none of them has, gives a warning and the default grey (reflectance 0.5).
 //!
 //! OBJ states no unit: the numbers are taken as metres, times
@@ -527,6 +527,9 @@ impl Reader {
     /// replaces an earlier one, as in the file).
     fn read_mtl(&mut self, file: &str, text: &str) -> Result<(), ImportError> {
         let mut current: Option<String> = None;
+        // Texture maps, by keyword, with the first line of each: said in one warning, as a
+        // material's colour in a map is lost (QA of issue #16: map_Kd went without a word).
+        let mut maps: Vec<(String, usize)> = Vec::new();
         for (i, raw) in text.lines().enumerate() {
             let n = i + 1;
             let code = raw.split('#').next().unwrap_or("");
@@ -569,8 +572,26 @@ impl Reader {
                         entry.ke = Some((colour, n));
                     }
                 }
+                k if k.starts_with("map_") => {
+                    if maps.len() < 32 && !maps.iter().any(|(m, _)| m == k) {
+                        maps.push((k.to_string(), n));
+                    }
+                }
                 _ => {}
             }
+        }
+        if let Some(&(_, first)) = maps.first() {
+            let names: Vec<&str> = maps.iter().map(|(m, _)| m.as_str()).collect();
+            self.warnings.push(ImportWarning {
+                file: file.to_string(),
+                line: first,
+                message: format!(
+                    "texture maps are not read ({}): each face takes its material's Kd, or the \
+                     default reflectance {DEFAULT_REFLECTANCE} where it has none; give Kd the \
+                     texture's mean colour",
+                    names.join(", ")
+                ),
+            });
         }
         Ok(())
     }

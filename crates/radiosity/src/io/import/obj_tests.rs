@@ -331,3 +331,27 @@ fn a_bad_setting_comment_is_left_out_with_a_warning_at_its_line() {
     assert_eq!(imported.file.settings.max_patch_area, 1e-3);
     assert_eq!(imported.file.settings.integral_steps, 2);
 }
+
+#[test]
+fn texture_maps_are_said_to_be_left_out() {
+    // QA of issue #16 (eighth pass): a material's map_Kd was ignored without a word, so
+    // its faces came out Kd's colour (or grey) with no hint why.
+    let mtl = "newmtl wood\nKd 0.4 0.3 0.2\nmap_Kd wood.png\nmap_Bump n.png\nmap_Kd w2.png\n";
+    let obj = format!("mtllib m.mtl\n{SQUARE}usemtl wood\nf 1 2 3 4\n");
+    let read = read_text(&obj, &[("m.mtl", mtl)]).unwrap();
+    let said: Vec<String> = read.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        said.iter().any(|w| w.contains("m.mtl:3")
+            && w.contains(
+                "texture maps are not read (map_Kd, map_Bump): each face takes its \
+                           material's Kd"
+            )),
+        "{said:?}"
+    );
+    // Without maps, no such warning.
+    let plain = read_text(&obj, &[("m.mtl", "newmtl wood\nKd 0.4 0.3 0.2\n")]).unwrap();
+    assert!(plain
+        .warnings
+        .iter()
+        .all(|w| !w.to_string().contains("texture")));
+}

@@ -855,6 +855,19 @@ impl<'a> Parser<'a> {
                 Self::spread_flux(&head, &mut surfaces);
                 return Some(surfaces);
             }
+            // Not convex and no simple outline: it crosses itself or winds twice (QA of issue
+            // #16: "not convex" read as if non-convex outlines were refused, which an L is
+            // not).
+            self.error(
+                corners.line,
+                corners.column,
+                "the outline crosses itself or goes round more than once (a bow tie: corners \
+                 in the wrong order); list the corners once round the outline, \
+                 counter-clockwise seen from the front (a non-convex outline such as an L is \
+                 split into triangles)"
+                    .to_string(),
+            );
+            return None;
         }
         self.check_polygon(&mut corners)?;
         let mut surfaces = vec![Surface {

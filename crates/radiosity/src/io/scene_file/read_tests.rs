@@ -376,7 +376,7 @@ fn polygon_errors_point_at_vertex0() {
         &with_lines(&[(15, "VERTEX2 0 1 0"), (16, "VERTEX3 2 1 0")]),
         13,
         1,
-        "not convex",
+        "the outline crosses itself or goes round more than once (a bow tie",
     );
     one_error(
         &with_line(15, "VERTEX2 1 0 0"),
