@@ -16,7 +16,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::integrator::PathTracer;
-use super::sampling::{pixel_rng, uniform};
+use super::sampling::{pixel_rng, point_in_triangles, uniform};
 use super::settings::PathTraceSettings;
 use crate::render::tonemap::{scale_for, top_mean, AUTO_EXPOSURE_TOP_AREA};
 use crate::scene::Scene;
@@ -66,19 +66,11 @@ impl AreaSampler {
         })
     }
 
-    /// A point and its surface from three uniform numbers (the square-root map, as
-    /// [`super::lights`] draws points on emitters).
+    /// A point and its surface from three uniform numbers, as [`super::lights`] draws
+    /// points on emitters ([`point_in_triangles`]).
     fn sample(&self, u0: f64, u1: f64, u2: f64) -> (DVec3, usize) {
-        let k = self
-            .cumulative
-            .partition_point(|&c| c <= u0)
-            .min(self.triangles.len() - 1);
-        let [a, b, c] = self.triangles[k];
-        let r = u1.sqrt();
-        (
-            (1.0 - r) * a + (r * (1.0 - u2)) * b + (r * u2) * c,
-            self.surface[k] as usize,
-        )
+        let (k, point) = point_in_triangles(&self.triangles, &self.cumulative, u0, u1, u2);
+        (point, self.surface[k] as usize)
     }
 }
 

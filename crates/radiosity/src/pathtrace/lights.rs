@@ -90,19 +90,14 @@ impl Lights {
     }
 
     /// A point from three uniform numbers in [0, 1): `u0` picks the triangle, (u1, u2)
-    /// a uniform point in it (the square-root map, Pharr, Jakob and Humphreys,
-    /// *Physically Based Rendering*, 3rd ed., 13.6.5). `None` when there are no emitters.
+    /// a uniform point in it ([`super::sampling::point_in_triangles`]). `None` when there
+    /// are no emitters.
     pub(super) fn sample(&self, u0: f64, u1: f64, u2: f64) -> Option<LightPoint> {
         if self.is_empty() {
             return None;
         }
-        let k = self
-            .cumulative
-            .partition_point(|&c| c <= u0)
-            .min(self.triangles.len() - 1);
-        let [a, b, c] = self.triangles[k];
-        let r = u1.sqrt();
-        let position = (1.0 - r) * a + (r * (1.0 - u2)) * b + (r * u2) * c;
+        let (k, position) =
+            super::sampling::point_in_triangles(&self.triangles, &self.cumulative, u0, u1, u2);
         let surface = self.surface[k];
         Some(LightPoint {
             position,

@@ -24,6 +24,25 @@ pub(super) fn pixel_rng(seed: u64, pixel: u64) -> Pcg64Mcg {
     Pcg64Mcg::new((u128::from(high) << 64) | u128::from(low))
 }
 
+/// A point of one of `triangles`, drawn by area or weight: `u0` picks the triangle by the
+/// `cumulative` probabilities (the last is 1), (u1, u2) a uniform point in it (the
+/// square-root map, Pharr, Jakob and Humphreys, *Physically Based Rendering*, 3rd ed.,
+/// 13.6.5). Returns the triangle's index and the point; `triangles` is not empty.
+pub(super) fn point_in_triangles(
+    triangles: &[[DVec3; 3]],
+    cumulative: &[f64],
+    u0: f64,
+    u1: f64,
+    u2: f64,
+) -> (usize, DVec3) {
+    let k = cumulative
+        .partition_point(|&c| c <= u0)
+        .min(triangles.len() - 1);
+    let [a, b, c] = triangles[k];
+    let r = u1.sqrt();
+    (k, (1.0 - r) * a + (r * (1.0 - u2)) * b + (r * u2) * c)
+}
+
 /// A uniform number in [0, 1).
 #[inline]
 pub(super) fn uniform(rng: &mut impl Rng) -> f64 {
