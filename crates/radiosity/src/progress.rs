@@ -37,6 +37,9 @@ pub enum Stage {
     /// Illuminance at calculation points (work unit: one point), see
     /// [`crate::illuminance`].
     Illuminance,
+    /// Estimating a path-traced view's automatic exposure by paths at points over the
+    /// surfaces ([`crate::pathtrace::PathTracer::area_exposure_scale`]).
+    Exposure,
     /// Writing output files.
     Write,
 }
@@ -57,6 +60,7 @@ impl Stage {
             Stage::Render => "render",
             Stage::PathTrace => "path trace",
             Stage::Illuminance => "illuminance",
+            Stage::Exposure => "exposure",
             Stage::Write => "write",
         }
     }

@@ -290,7 +290,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         }
         let white = match args.tone.exposure {
             Exposure::Fixed(_) => None,
-            Exposure::Auto => area_exposure_white(scene, &settings)?,
+            Exposure::Auto => area_exposure_white(scene, &settings, &reporter)?,
         };
         let scale = match args.tone.exposure {
             Exposure::Fixed(s) => s,
@@ -380,7 +380,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             " (auto, the radiosity solution's; the path tracer's own estimate of it would be \
              {})",
             report::significant(
-                tonemap::scale_for(area_exposure_white(scene, &settings)?),
+                tonemap::scale_for(area_exposure_white(scene, &settings, &reporter)?),
                 4
             )
         ),
@@ -477,12 +477,18 @@ fn write_image(image: &image::RgbImage, path: &Path, reporter: &Reporter) -> Res
 /// The automatic exposure of `render` estimated by paths
 /// ([`radiosity::pathtrace::PathTracer::area_exposure_scale`]; issue #11: the view's own
 /// statistic made the Cornell box's path-traced picture half as bright as its render).
-fn area_exposure_white(scene: &Scene, settings: &PathTraceSettings) -> Result<Option<f64>> {
+fn area_exposure_white(
+    scene: &Scene,
+    settings: &PathTraceSettings,
+    reporter: &Reporter,
+) -> Result<Option<f64>> {
     let tracer = radiosity::pathtrace::PathTracer::new(scene)?;
-    Ok(tracer.area_exposure_white(
-        scene,
-        settings,
-        radiosity::pathtrace::EXPOSURE_POINTS,
-        radiosity::pathtrace::EXPOSURE_PATHS,
-    ))
+    Ok(run_stage(reporter, Stage::Exposure, 0, || {
+        tracer.area_exposure_white(
+            scene,
+            settings,
+            radiosity::pathtrace::EXPOSURE_POINTS,
+            radiosity::pathtrace::EXPOSURE_PATHS,
+        )
+    }))
 }
