@@ -838,8 +838,13 @@ pub fn value_error(e: &clap::Error) -> Option<String> {
             plain_number_reason(&value, &reason)
         }
         // An empty value where one is needed (`-o ""`: QA of issue #16, "give one of "
-        // with nothing after it): named by the flag's value name.
+        // with nothing after it): named by the flag's value name. clap reports a flag given
+        // no value at all (`render -o` at the end) the same way; that keeps clap's usage
+        // message (exit 2), told apart by whether an empty argument was typed.
         ErrorKind::InvalidValue if value.is_empty() => {
+            if !std::env::args_os().skip(1).any(|a| a.is_empty()) {
+                return None;
+            }
             let name = arg
                 .split_once('<')
                 .and_then(|(_, rest)| rest.split_once('>'))

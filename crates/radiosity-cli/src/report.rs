@@ -262,9 +262,6 @@ pub fn energy_note(
         escaped,
         escaped_meaning(escaped)
     );
-    if let Some(openings) = openings_text(scene) {
-        text.push_str(&format!("; {openings}"));
-    }
     if let SolutionReport::Progressive(_) = solution.report {
         text.push_str(" (the rest is still unshot)");
     } else if let SolutionReport::Matrix(_) = solution.report {
@@ -285,6 +282,9 @@ pub fn energy_note(
                 "; the two add up to {total:.2} %, not 100 %: {why}"
             ));
         }
+    }
+    if let Some(openings) = openings_text(scene) {
+        text.push_str(&format!("; {openings}"));
     }
     reporter.note(&text);
 }
@@ -359,7 +359,13 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
                 if one { "it lies" } else { "they lie" },
             ));
         }
-        if !scene.lights.is_empty() && emitters.is_empty() {
+        // Only luminaires that give light (QA of issue #16, review: a FLUX 0 luminaire,
+        // already warned of as emitting nothing, was said to be aimed away).
+        let lit = scene
+            .lights
+            .iter()
+            .any(|l| l.flux() > 0.0 && l.colour.0.iter().any(|&c| c > 0.0));
+        if lit && emitters.is_empty() {
             return Some(
                 "the point luminaires' light lands on no front of a surface: they are aimed \
                  away from the scene (AIM) or lie outside it, so pictures are black"

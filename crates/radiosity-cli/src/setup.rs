@@ -441,7 +441,7 @@ pub fn note_output(path: &Path, flag: &str, label: &str) {
 /// the scene named and was read with it: an OBJ's MTL, a glTF's buffer, a DXF's materials
 /// (QA of issue #16: `export scene.gltf -o copy.gltf`, its buffer `copy.bin` one the scene
 /// read, was refused only when written, after the solve; nothing was overwritten).
-fn refuse_outputs_read(scene: &Path) -> Result<()> {
+pub fn refuse_outputs_read(scene: &Path) -> Result<()> {
     let outputs = OUTPUTS.lock().map(|o| o.clone()).unwrap_or_default();
     for Output { path, flag, label } in outputs {
         if let Some(input) = radiosity::io::input_at(&path) {
@@ -557,27 +557,22 @@ pub fn load_scene(
 }
 
 /// Warnings for luminaires with a shaped distribution (COSINE, IES) aimed along the default
-/// AIM 0 0 -1 in a scene whose largest surface faces along y, where -z is horizontal: a
-/// downlight left at the default aim in a y-up room lights a wall (QA of issue #16: `check`
-/// said all its lumens land and nothing more). The default, straight down in a z-up scene,
-/// is the format's; an aim written as 0 0 -1 on purpose is warned of too, which AIM 0 0
-/// -1.0001 silences.
+/// AIM 0 0 -1 that hang in the top quarter of the scene's y extent and not of its z extent
+/// (a y-up scene, where -z is horizontal): a downlight left at the default aim in a y-up
+/// room lights a wall (QA of issue #16: `check` said all its lumens land and nothing more).
+/// The default, straight down in a z-up scene, is the format's; an aim written as 0 0 -1 on
+/// purpose is warned of too, which AIM 0 0 -1.0001 silences.
 pub fn sideways_lights(scene: &Scene) -> Vec<String> {
-    let largest_normal = scene
-        .surfaces
-        .iter()
-        .map(|s| {
-            (
-                radiosity::geometry::polygon_area(&s.vertices),
-                radiosity::geometry::polygon_normal(&s.vertices),
-            )
-        })
-        .max_by(|a, b| a.0.total_cmp(&b.0))
-        .and_then(|(_, n)| n);
-    let y_up = largest_normal.is_some_and(|n| n.y.abs() > 0.9);
-    if !y_up {
+    // Where the light hangs says which way is up (review of issue #16: the largest polygon,
+    // or the area facing each axis, took a z-up corridor's walls for floors).
+    if scene.surfaces.is_empty() {
         return Vec::new();
     }
+    let (lo, hi) = scene.bounds();
+    let near_top = |p: DVec3, axis: usize| {
+        let span = hi[axis] - lo[axis];
+        span > 0.0 && (p[axis] - lo[axis]) / span > 0.75
+    };
     scene
         .lights
         .iter()
@@ -586,12 +581,14 @@ pub fn sideways_lights(scene: &Scene) -> Vec<String> {
                 l.distribution,
                 radiosity::luminaire::Distribution::Isotropic
             ) && l.aim == radiosity::luminaire::DEFAULT_AIM
+                && near_top(l.position, 1)
+                && !near_top(l.position, 2)
         })
         .map(|l| {
             format!(
                 "light {:?} is aimed along AIM 0 0 -1 (the default: straight down in a z-up \
-                 scene), which is horizontal here, where the largest surface faces along y; \
-                 for a downlight in a y-up scene give AIM 0 -1 0",
+                 scene), which is horizontal here, where it hangs near the top of the y \
+                 extent (y up); for a downlight in a y-up scene give AIM 0 -1 0",
                 l.name
             )
         })

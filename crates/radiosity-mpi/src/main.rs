@@ -95,8 +95,17 @@ struct MpiArgs {
     #[arg(long, requires = "checkpoint")]
     resume: bool,
     /// Rows per block dealt to a rank (default: about eight blocks a rank, at most 256).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, value_name = "N", value_parser = parse_block_rows)]
     block_rows: Option<u64>,
+}
+
+/// `--block-rows`: a whole number of at least 1, in the words of `radiosity`'s own
+/// parsers (review of issue #16: `-1` was told "at least 0", 0 being refused too).
+fn parse_block_rows(text: &str) -> Result<u64, String> {
+    match text.trim().parse::<u64>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err("give a whole number of at least 1".to_string()),
+    }
 }
 
 fn main() -> ExitCode {

@@ -339,6 +339,8 @@ pub fn grid(
                 // To 12 significant digits: the decimals asked for, not 0.7 + 0.1 =
                 // 0.7999999999999999 (QA of issue #16).
                 let x = a[axis] + (b[axis] - a[axis]).signum() * k * spacing;
+                // A leftover near zero is zero (-0.7 + 7 x 0.1 = 1.1e-16).
+                let x = if x.abs() <= 1e-9 * spacing { 0.0 } else { x };
                 p[axis] = format!("{x:.11e}").parse().unwrap_or(x);
             }
             out.push(CalcPoint {

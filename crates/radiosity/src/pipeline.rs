@@ -678,7 +678,9 @@ fn solve_adaptive(
     let mut pairs_left = adapt.max_new_pairs;
     for round in 1..=adapt.rounds {
         let b = radiosity.as_arrays();
-        let mut steps_at_smallest = false;
+        // Where visible steps are left when nothing is split: on elements large enough to
+        // split (the budget stopped it), only on the smallest, or none.
+        let (mut steps_to_split, mut steps_at_smallest) = (false, false);
         let refined = run_stage(progress, Stage::Adapt, 0, || {
             let white = lit_radiosity_top_mean(scene, &mesh, b, AUTO_EXPOSURE_TOP_AREA)?;
             let luminance: Vec<f64> = radiosity.as_slice().iter().map(|b| b.luminance()).collect();
@@ -687,12 +689,17 @@ fn solve_adaptive(
             if split > 0 {
                 return Some((split, split_marked(&mesh, scene.surfaces.len(), &marks)));
             }
-            // Whether visible steps are left on elements already at the smallest size, for
-            // the note on why the rounds stop.
-            let unlimited = AdaptSettings {
-                min_area: 0.0,
+            // For the note on why the rounds stop: the steps without the budget, and then
+            // without the smallest size too.
+            let unbudgeted = AdaptSettings {
                 max_elements: usize::MAX,
                 ..*adapt
+            };
+            steps_to_split =
+                mark_steps(&mesh, &luminance, white, &unbudgeted, u64::MAX).contains(&true);
+            let unlimited = AdaptSettings {
+                min_area: 0.0,
+                ..unbudgeted
             };
             steps_at_smallest =
                 mark_steps(&mesh, &luminance, white, &unlimited, u64::MAX).contains(&true);
@@ -708,32 +715,35 @@ fn solve_adaptive(
                 "adaptive subdivision stopped before round {round} of {}",
                 adapt.rounds
             );
-            progress.message(&if adapt.max_elements.saturating_sub(n) < 3 {
-                format!(
-                    "{stopped}: the mesh has reached the most elements allowed, {} \
+            progress.message(
+                &if steps_to_split && adapt.max_elements.saturating_sub(n) < 3 {
+                    format!(
+                        "{stopped}: the mesh has reached the most elements allowed, {} \
                      (--adapt-max-elements N, or by default twice the first mesh's, at most {})",
-                    adapt.max_elements,
-                    crate::mesh::DEFAULT_MAX_ELEMENTS
-                )
-            } else if pairs_left / (4 * n.max(1) as u64) == 0 {
-                format!(
-                    "{stopped}: the new form-factor pairs allowed ({:.2e}, about twice the \
+                        adapt.max_elements,
+                        crate::mesh::DEFAULT_MAX_ELEMENTS
+                    )
+                } else if steps_to_split {
+                    // Not the elements: the pairs.
+                    format!(
+                        "{stopped}: the new form-factor pairs allowed ({:.2e}, about twice the \
                      first matrix's; --adapt-max-elements N lifts this limit) are spent",
-                    adapt.max_new_pairs as f64
-                )
-            } else if steps_at_smallest {
-                format!(
-                    "{stopped}: the visible steps left lie on elements already split to the \
+                        adapt.max_new_pairs as f64
+                    )
+                } else if steps_at_smallest {
+                    format!(
+                        "{stopped}: the visible steps left lie on elements already split to the \
                      smallest size, {} (MAX_PATCH_AREA / 64, three splits)",
-                    adapt.min_area
-                )
-            } else if round == 1 {
-                format!(
+                        adapt.min_area
+                    )
+                } else if round == 1 {
+                    format!(
                     "adaptive subdivision: no visible steps between the {n} elements; solved once"
                 )
-            } else {
-                format!("{stopped}: no visible steps left")
-            });
+                } else {
+                    format!("{stopped}: no visible steps left")
+                },
+            );
             break;
         };
         let kept: Vec<Option<u32>> = origin

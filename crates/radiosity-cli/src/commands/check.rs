@@ -95,6 +95,10 @@ pub fn run(args: CheckArgs) -> Result<()> {
             ..SolveRequest::new(solver)
         };
         let solution = pipeline::solve(&prepared, &request, &mut keep_going, &reporter)?;
+        // As solve_scene warns for the other commands (review of issue #16).
+        if let Some(warning) = crate::report::light_lost(&prepared.scene, &solution) {
+            errln!("warning: {warning}");
+        }
         let surface_of: Vec<u32> = solution.mesh.elements.iter().map(|e| e.surface).collect();
         let escaped = escaped_by_surface(
             &f,

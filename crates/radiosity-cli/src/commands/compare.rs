@@ -25,6 +25,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
         && args.solve.solver.0 == radiosity::solve::SolverKind::Auto
         && solver == Solver::DEFAULT_GAUSS_SEIDEL
         && args.solve.adapt_rounds.is_none_or(|r| r == 0)
+        && args.solve.form_factors.is_none()
     {
         errln!(
             "warning: auto chose Gauss-Seidel on the dense matrix, the reference's own \

@@ -241,6 +241,11 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         setup::refuse_overwriting_inputs(out, flag, &inputs)?;
         setup::output_directory(out, flag)?;
     }
+    // The scene was read before the outputs were known: the files it named itself (a
+    // glTF's textures and buffers, an OBJ's MTL) are checked now, before the tracing.
+    if let Some(path) = args.scene.scene.as_deref() {
+        setup::refuse_outputs_read(path)?;
+    }
 
     // The path-traced view: traced, or read back.
     let (view, settings) = match &args.reference {
@@ -282,7 +287,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
     report::path_traced(&view, &settings);
 
     let Some((prepared, _, solver)) = &prepared else {
-        // Alone: the view's own exposure unless one is given.
+        // Alone: render's rule estimated by paths unless an exposure is given.
         if format == ImageFormat::Exr {
             write_linear(view.film(), &camera, &output, &reporter)?;
             reporter.print_timings();
@@ -375,7 +380,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         &reporter,
     )?;
     // One line for the exposure (QA of issue #16: it was printed twice).
+    // The path tracer's own estimate is traced only for this note: not with -q.
     let whose = match args.tone.exposure {
+        Exposure::Auto if args.scene.quiet => " (auto, the radiosity solution's)".to_string(),
         Exposure::Auto => format!(
             " (auto, the radiosity solution's; the path tracer's own estimate of it would be \
              {})",

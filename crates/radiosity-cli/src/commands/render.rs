@@ -354,7 +354,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
         image.height()
     ));
     if !wireframe && picture_can_be_lit(&prepared, &solution) {
-        if let Some(warning) = black_picture(image.pixels().map(|p| p.0 == [0, 0, 0])) {
+        if let Some(warning) = black_picture(image.pixels().map(|p| p.0 == [0, 0, 0]))
+            .map(|w| with_exposure_hint(w, exposure))
+        {
             // Printed even with --quiet: the picture shows nothing.
             errln!("warning: {warning}");
         }
@@ -386,6 +388,18 @@ fn black_picture(dark: impl Iterator<Item = bool>) -> Option<String> {
             100.0 * share
         )
     })
+}
+
+/// The nothing-lit warning, with the other likely cause where the exposure was given
+/// (review of issue #16: a very low --exposure blackens the 8-bit picture too).
+fn with_exposure_hint(warning: String, exposure: radiosity::shade::Exposure) -> String {
+    match exposure {
+        radiosity::shade::Exposure::Fixed(s) => format!(
+            "{warning}, or raise --exposure {} (too low to show the light)",
+            crate::report::significant(s, 4)
+        ),
+        radiosity::shade::Exposure::Auto => warning,
+    }
 }
 
 /// Whether a black picture is the camera's doing: the scene's light reaches its surfaces

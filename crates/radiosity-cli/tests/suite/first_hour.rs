@@ -2553,6 +2553,29 @@ fn eighth_pass_findings_are_said() {
         err.contains("r.glb: error: not a binary glTF file"),
         "{err}"
     );
+    // A flag given no value at all keeps clap's usage message (exit 2); an empty value is
+    // named as empty (exit 1).
+    let (code, err) = run(&["render", "-o"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("a value is required for '--output <FILE>'"),
+        "{err}"
+    );
+    // A grid crossing zero writes 0 there, not a rounding leftover (-0.3 + 3 x 0.1).
+    let (code, err) = run(&[
+        "illuminance",
+        &crate::fixtures::example("room.scene"),
+        "--grid",
+        "-0.3,0.8,0.5:0.3,0.8,0.5:0.1",
+        "--normal",
+        "0,1,0",
+        "-o",
+        "z.csv",
+        "-q",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let csv = std::fs::read_to_string(dir.join("z.csv")).unwrap();
+    assert!(csv.contains("g3_0,0,0.8,0.5,"), "{csv}");
     // The camera note says which parts were given.
     let (_, err) = run(&[
         "render",

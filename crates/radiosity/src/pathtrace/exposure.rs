@@ -8,7 +8,8 @@
 //! first hit is the point itself, so its estimate is the point's radiosity). The brightest
 //! points are then estimated again with fresh paths: selecting the largest of noisy
 //! estimates favours those that came out high, and the second, independent estimate of the
-//! selected points has no such bias. Issue #11: the view's own statistic (the brightest 2 %
+//! selected points has no such upward bias (a smaller downward one remains: where noise
+//! swapped points across the cut, the set is not quite the true top 2 %). Issue #11: the view's own statistic (the brightest 2 %
 //! of its pixels) made the Cornell box's path-traced picture half as bright as its
 //! radiosity render, where the view sees little of the brightest area.
 

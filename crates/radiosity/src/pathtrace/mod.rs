@@ -36,7 +36,7 @@
 //!   ([`ErrorMap`]).
 //!
 //! ```
-//! use radiosity::pathtrace::{self, PathTraceSettings};
+//! use radiosity::pathtrace::{self, PathTraceSettings, PathTracer};
 //! use radiosity::progress::NoProgress;
 //! use radiosity::render::{tonemap, Camera};
 //!
@@ -44,7 +44,8 @@
 //! let camera = Camera::for_scene(&scene, 8, 8);
 //! let settings = PathTraceSettings::DEFAULT.with_samples(4);
 //! let view = pathtrace::path_trace(&scene, &camera, &settings, &NoProgress)?;
-//! let image = tonemap::to_image(view.film(), view.auto_exposure_scale(), 2.2);
+//! let exposure = PathTracer::new(&scene)?.area_exposure_scale(&scene, &settings, 256, 4);
+//! let image = tonemap::to_image(view.film(), exposure, 2.2);
 //! assert_eq!(image.dimensions(), (8, 8));
 //! assert!(view.noise().mean_standard_error > 0.0);
 //! # Ok::<(), radiosity::pathtrace::PathTraceError>(())
