@@ -289,6 +289,15 @@ pub fn energy_note(
     reporter.note(&text);
 }
 
+/// The first three of `names` and how many more: "a, b, c, 2 more".
+fn first_three(names: &[String]) -> String {
+    let mut shown: Vec<String> = names.iter().take(3).cloned().collect();
+    if names.len() > 3 {
+        shown.push(format!("{} more", names.len() - 3));
+    }
+    shown.join(", ")
+}
+
 /// Where a scene has `OPENING` surfaces, that what they take in counts as absorbed (QA of
 /// issue #16: the account said light escapes "through openings" while the light into an
 /// OPENING, reflectance 0, was in "absorbed").
@@ -302,15 +311,12 @@ fn openings_text(scene: &Scene) -> Option<String> {
     if openings.is_empty() {
         return None;
     }
-    let mut named: Vec<String> = openings.iter().take(3).map(|n| format!("{n:?}")).collect();
-    if openings.len() > 3 {
-        named.push(format!("{} more", openings.len() - 3));
-    }
+    let named: Vec<String> = openings.iter().map(|n| format!("{n:?}")).collect();
     Some(format!(
         "absorbed includes the light that leaves through the {} ({}): reflectance 0, \
          they take in all that reaches them",
         count(openings.len() as u64, "OPENING surface"),
-        named.join(", ")
+        first_three(&named)
     ))
 }
 
@@ -329,13 +335,7 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
         "" => format!("surface {s}"),
         n => format!("surface {s} {n:?}"),
     };
-    let names = |list: &[usize]| {
-        let mut named: Vec<String> = list.iter().take(3).map(|&s| name(s)).collect();
-        if list.len() > 3 {
-            named.push(format!("{} more", list.len() - 3));
-        }
-        named.join(", ")
-    };
+    let names = |list: &[usize]| first_three(&list.iter().map(|&s| name(s)).collect::<Vec<_>>());
     let b = &solution.balance;
     let Some(band) = energy_band(b) else {
         // Nothing reached the mesh: emitters dropped whole, or luminaires lighting nothing.
@@ -361,10 +361,7 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
         }
         // Only luminaires that give light (QA of issue #16, review: a FLUX 0 luminaire,
         // already warned of as emitting nothing, was said to be aimed away).
-        let lit = scene
-            .lights
-            .iter()
-            .any(|l| l.flux() > 0.0 && l.colour.0.iter().any(|&c| c > 0.0));
+        let lit = scene.lights.iter().any(|l| l.gives_light());
         if lit && emitters.is_empty() {
             return Some(
                 "the point luminaires' light lands on no front of a surface: they are aimed \

@@ -389,20 +389,36 @@ pub fn stem_of(scene: Option<&Path>) -> String {
 
 /// Refuses, before any work, to write `output` (given with `flag`) over one of the
 /// `inputs` (what it is, its path): the same file by device and inode, whatever the
-/// spelling (`./x.scene`, a link).
+/// spelling (`./x.scene`, a link). The output is noted for [`refuse_outputs_read`].
 pub fn refuse_overwriting_inputs(
     output: &Path,
     flag: &str,
     inputs: &[(&str, Option<&Path>)],
 ) -> Result<()> {
-    note_output(output, flag, &format!("{flag} {}", output.display()));
+    refuse_overwriting_inputs_as(
+        output,
+        flag,
+        &format!("{flag} {}", output.display()),
+        inputs,
+    )
+}
+
+/// [`refuse_overwriting_inputs`] for a file written beside the one `flag` names (a glTF's
+/// `.bin`, pathtrace's `-radiosity` picture), named in messages by `label`: "-o x.gltf (its
+/// buffer x.bin)" (QA of issue #16: the refusal named a file the user never typed).
+pub fn refuse_overwriting_inputs_as(
+    output: &Path,
+    flag: &str,
+    label: &str,
+    inputs: &[(&str, Option<&Path>)],
+) -> Result<()> {
+    note_output(output, flag, label);
     for &(what, input) in inputs {
         if let Some(input) = input {
             if radiosity::io::is_same_file(output, input) {
                 bail!(
-                    "{flag} {}: this is the {what} {}: writing it would destroy the input; \
+                    "{label}: this is the {what} {}: writing it would destroy the input; \
                      give {flag} another file name",
-                    output.display(),
                     input.display()
                 );
             }
@@ -603,10 +619,7 @@ pub fn no_emitter(scene: &Scene, format: Format) -> Option<String> {
         .surfaces
         .iter()
         .any(|s| s.emission.0.iter().any(|&e| e > 0.0))
-        || scene
-            .lights
-            .iter()
-            .any(|l| l.flux() > 0.0 && l.colour.0.iter().any(|&c| c > 0.0));
+        || scene.lights.iter().any(|l| l.gives_light());
     if emits || scene.surfaces.is_empty() {
         return None;
     }
@@ -1027,14 +1040,20 @@ pub fn output_directory(output: &Path, flag: &str) -> Result<()> {
             output.display()
         );
     }
-    let dir = match output.parent() {
+    parent_folder_exists(output, flag)
+}
+
+/// Refuses `path` (given with `flag`) whose folder does not exist: no output makes the
+/// folders above it (a file's, or a folder's that a command creates itself).
+pub fn parent_folder_exists(path: &Path, flag: &str) -> Result<()> {
+    let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => return Ok(()),
     };
     if !dir.is_dir() {
         bail!(
             "{flag} {}: the directory {} does not exist; create it first (mkdir -p {})",
-            output.display(),
+            path.display(),
             dir.display(),
             dir.display()
         );

@@ -204,6 +204,11 @@ impl Luminaire {
         self.colour * self.candela(d)
     }
 
+    /// Whether it gives any light: lumens above zero and a tint not black in every band.
+    pub fn gives_light(&self) -> bool {
+        self.flux() > 0.0 && self.colour.0.iter().any(|&c| c > 0.0)
+    }
+
     /// The lumens it emits in all directions (untinted): 4 pi I, pi I0, or the table's
     /// lumens times the scale.
     pub fn flux(&self) -> f64 {

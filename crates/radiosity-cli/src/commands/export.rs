@@ -63,15 +63,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
     };
     if let Some((what, path)) = beside {
         let label = format!("-o {} (its {what} {})", output.display(), path.display());
-        for &(input_is, input) in &inputs {
-            if input.is_some_and(|input| radiosity::io::is_same_file(&path, input)) {
-                bail!(
-                    "{label}: this is the {input_is}; writing it would destroy the input; \
-                     give -o another file name"
-                );
-            }
-        }
-        crate::setup::note_output(&path, "-o", &label);
+        crate::setup::refuse_overwriting_inputs_as(&path, "-o", &label, &inputs)?;
     }
     output_directory(output, "-o")?;
     // Printed even with --quiet: the file will not hold what the scene holds.

@@ -206,40 +206,27 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         ("reference", args.reference.as_deref()),
         ("form-factor file", args.solve.form_factors.as_deref()),
     ];
-    let mut outputs = vec![output.clone()];
-    if args.compare {
-        outputs.extend([
-            sibling(&output, "radiosity", format),
-            sibling(&output, "error", ImageFormat::Png),
-        ]);
-    }
+    setup::refuse_overwriting_inputs(&output, "-o", &inputs)?;
+    setup::output_directory(&output, "-o")?;
     // The pictures written beside -o are named as such (QA of issue #16: the refusal named
     // -o foo-radiosity.exr, which the user never typed).
-    for beside in outputs.iter().skip(1) {
-        let label = format!(
-            "-o {} (the picture written beside it, {})",
-            output.display(),
-            beside.display()
-        );
-        for &(what, input) in &inputs {
-            if input.is_some_and(|input| radiosity::io::is_same_file(beside, input)) {
-                bail!(
-                    "{label}: this is the {what}; writing it would destroy the input; give -o \
-                     another file name"
-                );
-            }
+    if args.compare {
+        for beside in [
+            sibling(&output, "radiosity", format),
+            sibling(&output, "error", ImageFormat::Png),
+        ] {
+            let label = format!(
+                "-o {} (the picture written beside it, {})",
+                output.display(),
+                beside.display()
+            );
+            setup::refuse_overwriting_inputs_as(&beside, "-o", &label, &inputs)?;
+            setup::output_directory(&beside, "-o")?;
         }
-        setup::note_output(beside, "-o", &label);
     }
-    outputs.extend(args.save_reference.clone());
-    for out in &outputs {
-        let flag = if args.save_reference.as_ref() == Some(out) {
-            "--save-reference"
-        } else {
-            "-o"
-        };
-        setup::refuse_overwriting_inputs(out, flag, &inputs)?;
-        setup::output_directory(out, flag)?;
+    if let Some(saved) = &args.save_reference {
+        setup::refuse_overwriting_inputs(saved, "--save-reference", &inputs)?;
+        setup::output_directory(saved, "--save-reference")?;
     }
     // The scene was read before the outputs were known: the files it named itself (a
     // glTF's textures and buffers, an OBJ's MTL) are checked now, before the tracing.

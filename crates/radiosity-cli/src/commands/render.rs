@@ -179,17 +179,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         let existed = dir.is_dir();
         if !existed {
-            if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
-                if !parent.is_dir() {
-                    bail!(
-                        "--snapshots {}: the directory {} does not exist; create it first \
-                         (mkdir -p {})",
-                        dir.display(),
-                        parent.display(),
-                        parent.display()
-                    );
-                }
-            }
+            crate::setup::parent_folder_exists(dir, "--snapshots")?;
             std::fs::create_dir(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         }
         let earlier = std::fs::read_dir(dir)

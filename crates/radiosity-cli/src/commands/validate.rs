@@ -37,16 +37,7 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
         }
         // As every other output: a missing folder's parent is not made (QA of issue #16:
         // `--write nowhere/deep/x` made three folders without a word).
-        if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
-            if !parent.is_dir() {
-                bail!(
-                    "--write {}: the directory {} does not exist; create it first (mkdir -p {})",
-                    dir.display(),
-                    parent.display(),
-                    parent.display()
-                );
-            }
-        }
+        crate::setup::parent_folder_exists(dir, "--write")?;
         let written = cie171::write_case_files(dir, &cases)
             .with_context(|| format!("cannot write the validation files into {}", dir.display()))?;
         if !args.quiet {
