@@ -154,10 +154,14 @@ pub struct MethodArgs {
     #[arg(long, value_enum)]
     pub method: Option<MethodArg>,
     /// Hemicube resolution: cells across the top face (--method hemicube only).
-    #[arg(long, default_value_t = MethodArgs::RESOLUTION, value_name = "CELLS")]
+    // Values are checked while parsing, whatever the method, as --steps is (QA of issue
+    // #16: `--resolution 0` was refused with the hemicube and only "ignored" without it).
+    #[arg(long, default_value_t = MethodArgs::RESOLUTION, value_name = "CELLS",
+          value_parser = parse_resolution)]
     pub resolution: u32,
     /// Monte Carlo rays per element (--method montecarlo only).
-    #[arg(long, default_value_t = MethodArgs::SAMPLES, value_name = "N")]
+    #[arg(long, default_value_t = MethodArgs::SAMPLES, value_name = "N",
+          value_parser = parse_samples)]
     pub samples: u32,
     /// Monte Carlo generator seed (the same seed gives the same numbers; --method
     /// montecarlo only).
@@ -657,9 +661,12 @@ pub struct BenchArgs {
     /// Image height in pixels, as for `render`: alone it sets both sides (default: --size).
     #[arg(long, value_parser = parse_at_least_1)]
     pub height: Option<u32>,
-    /// Rays per pixel along each axis, 1 to 16 (as `render --supersample`).
-    #[arg(long, default_value_t = 1, value_name = "N", value_parser = parse_supersample)]
-    pub supersample: u32,
+    /// The rays a pixel and the direct light, as for `render` and with its defaults, so that
+    /// the render column times what `render` draws (QA of issue #16: bench cast one ray a
+    /// pixel from the mesh alone; `--supersample 1 --direct-light mesh` is the paper's
+    /// rendering, which the tables against the paper use).
+    #[command(flatten)]
+    pub rays: RayArgs,
     /// Hierarchical: the BF refinement threshold (as for `render --epsilon`).
     #[arg(long, default_value_t = 0.05, value_name = "E")]
     pub epsilon: f64,
@@ -900,6 +907,19 @@ pub fn parse_steps(text: &str) -> Result<u32, String> {
     whole_number_at_least(text, 1).map_err(|_| {
         "give the points along each axis of an element, a whole number of at least 1".into()
     })
+}
+
+/// `--resolution`: the hemicube's cells along a side, 2 to 16,384.
+pub fn parse_resolution(text: &str) -> Result<u32, String> {
+    whole_number_in(text, 2, 16_384).map_err(|_| {
+        "give the hemicube's cells along a side, a whole number from 2 to 16384".into()
+    })
+}
+
+/// `--samples`: Monte Carlo rays per element, 1 or more.
+pub fn parse_samples(text: &str) -> Result<u32, String> {
+    whole_number_at_least(text, 1)
+        .map_err(|_| "give the Monte Carlo rays per element, a whole number of at least 1".into())
 }
 
 /// [`whole_number_at_least`] 1: image sizes.

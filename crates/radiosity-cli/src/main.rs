@@ -120,8 +120,45 @@ fn exit_with(e: clap::Error) -> ! {
             errln!("error: {line}");
             std::process::exit(1);
         }
+        None if e.use_stderr() => {
+            // clap's "Usage:" line after an error lists the flags typed as if they were
+            // required (QA of issue #16: `generate building --rooms 2` gave "Usage: ...
+            // --output <FILE.scene> --rooms-z <N>"); the command's own usage replaces it.
+            let text = e.render().to_string();
+            let usage = plain_usage(std::env::args_os().skip(1));
+            let text = match text.lines().find(|l| l.starts_with("Usage: ")) {
+                Some(line) if !usage.is_empty() => text.replacen(line, &usage, 1),
+                _ => text,
+            };
+            eprint!("{text}");
+            std::process::exit(e.exit_code());
+        }
         None => e.exit(),
     }
+}
+
+/// "Usage: radiosity generate building [OPTIONS] --output <FILE.scene>": the usage of the
+/// deepest subcommand that `args` name, as its `--help` gives it; empty when there is none.
+fn plain_usage(args: impl Iterator<Item = std::ffi::OsString>) -> String {
+    let mut cmd = command();
+    cmd.build();
+    let mut current = &mut cmd;
+    for arg in args {
+        let Some(arg) = arg.to_str() else { break };
+        if arg.starts_with('-') {
+            continue;
+        }
+        let Some(name) = current
+            .find_subcommand(arg)
+            .map(|sub| sub.get_name().to_string())
+        else {
+            break;
+        };
+        current = current
+            .find_subcommand_mut(&name)
+            .expect("found just above");
+    }
+    current.render_usage().to_string()
 }
 
 /// The command line with every flag that takes a value accepting a negative number

@@ -1149,7 +1149,7 @@ pub const BENCH_OTHER: &str = "contact refinement, the memory and work checks, t
 pub fn bench_header(
     repeat: usize,
     (width, height): (u32, u32),
-    supersample: u32,
+    rays: &radiosity::render::RenderSettings,
     solver: SolverKind,
     quiet: bool,
 ) {
@@ -1163,14 +1163,27 @@ pub fn bench_header(
         SolverKind::Progressive => "progressive (form factors computed within the solve)",
         SolverKind::Hierarchical => "hierarchical (links computed within the solve)",
     };
+    let n = rays.supersample.max(1);
+    // Adaptive antialiasing takes an even N above 2 (`setup::ray_settings`).
+    let pixel_rays = match rays.adaptive_contrast {
+        Some(_) if n > 2 && n % 2 == 0 => format!("4 to {} rays a pixel (adaptive)", n * n),
+        _ if n == 1 => "1 ray a pixel".to_string(),
+        _ => format!("{n}x{n} rays a pixel"),
+    };
+    let rays_text = match rays.direct_light {
+        true => format!("{pixel_rays}, direct light gathered per ray (as `render`)"),
+        false => format!("{pixel_rays}, shading from the mesh alone (the paper's)"),
+    };
     if !quiet {
         errln!(
-            "median of {0}; times in ms; render {1}x{2} at {3}x{3} supersampling; solver {solver_name}; \
+            "median of {0}; times in ms; render {1}x{2}, {rays_text}; solver {solver_name}; \
              other: end to end less the stages listed ({BENCH_OTHER}); rays/s: visibility rays \
              over the form-factor stage, or over the solve stage where the solver computes its \
              form factors within the solve, - where none is cast (the hemicube's depth \
              buffer)",
-            count(repeat as u64, "run"), width, height, supersample
+            count(repeat as u64, "run"),
+            width,
+            height
         );
     }
     outln!(

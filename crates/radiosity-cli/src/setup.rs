@@ -161,26 +161,14 @@ pub fn prepare_scene(args: &SceneArgs, reporter: &Reporter) -> Result<(Prepared,
         MethodArg::Area => FormFactorMethod::AreaIntegral { steps },
         MethodArg::Contour => FormFactorMethod::Contour { steps },
         MethodArg::Analytic => FormFactorMethod::Analytic { steps },
-        MethodArg::Hemicube => {
-            if m.resolution < 2 || m.resolution > 16_384 {
-                bail!(
-                    "--resolution {}: give the hemicube's cells along a side, 2 to 16384",
-                    m.resolution
-                );
-            }
-            FormFactorMethod::Hemicube {
-                resolution: m.resolution,
-            }
-        }
-        MethodArg::Montecarlo => {
-            if m.samples == 0 {
-                bail!("--samples 0: give the Monte Carlo rays per element, at least 1");
-            }
-            FormFactorMethod::MonteCarlo {
-                samples: m.samples,
-                seed: m.seed,
-            }
-        }
+        // --resolution (2 to 16384) and --samples (1 or more) are checked while parsing.
+        MethodArg::Hemicube => FormFactorMethod::Hemicube {
+            resolution: m.resolution,
+        },
+        MethodArg::Montecarlo => FormFactorMethod::MonteCarlo {
+            samples: m.samples,
+            seed: m.seed,
+        },
     };
     Ok((prepared, stem))
 }

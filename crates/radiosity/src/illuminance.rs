@@ -384,10 +384,30 @@ pub enum PointsError {
         /// What was found and what was expected.
         message: String,
     },
+    /// Several lines are not (QA of issue #16: one error at a time cost a run per line),
+    /// each displayed on its own line as [`PointsError::Invalid`] is.
+    #[error("{}", several_lines(.errors, *.more))]
+    Several {
+        /// The first [`MAX_POINTS_ERRORS`] errors, each an [`PointsError::Invalid`].
+        errors: Vec<PointsError>,
+        /// How many more lines were wrong.
+        more: usize,
+    },
+}
+
+/// The most wrong lines of a points file named one by one.
+pub const MAX_POINTS_ERRORS: usize = 10;
+
+fn several_lines(errors: &[PointsError], more: usize) -> String {
+    let mut text: Vec<String> = errors.iter().map(ToString::to_string).collect();
+    if more > 0 {
+        text.push(format!("... and {more} more lines like these"));
+    }
+    text.join("\n")
 }
 
 /// Reads a points CSV: the header `name,x,y,z,nx,ny,nz`, then one point a line (blank lines
-/// skipped); every number finite, the normal not zero.
+/// skipped); every name given and different, every number finite, the normal not zero.
 pub fn read_points(path: &std::path::Path) -> Result<Vec<CalcPoint>, PointsError> {
     let name = path.display().to_string();
     crate::io::note_input(path);
@@ -398,7 +418,8 @@ pub fn read_points(path: &std::path::Path) -> Result<Vec<CalcPoint>, PointsError
     parse_points(&text, &name)
 }
 
-/// [`read_points`] on text; `source_name` names it in errors.
+/// [`read_points`] on text; `source_name` names it in errors. Every wrong line is found,
+/// and the first [`MAX_POINTS_ERRORS`] are named.
 pub fn parse_points(text: &str, source_name: &str) -> Result<Vec<CalcPoint>, PointsError> {
     let bad = |line: usize, message: String| PointsError::Invalid {
         path: source_name.to_string(),
@@ -431,44 +452,26 @@ pub fn parse_points(text: &str, source_name: &str) -> Result<Vec<CalcPoint>, Poi
     }
     let header_line = i + 1;
     let mut out = Vec::new();
+    let mut errors = Vec::new();
+    // Each name's first line: the lux CSV's rows are told apart by name.
+    let mut first_line_of: std::collections::HashMap<String, usize> =
+        std::collections::HashMap::new();
     for (i, line) in lines {
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        if fields.len() != 7 {
-            return Err(bad(
-                i + 1,
-                format!(
-                    "expected 7 fields (name,x,y,z,nx,ny,nz), found {}",
-                    fields.len()
-                ),
-            ));
+        match point_of_line(line, i + 1, &mut first_line_of) {
+            Ok(p) => out.push(p),
+            Err(message) => errors.push(bad(i + 1, message)),
         }
-        let mut v = [0.0; 6];
-        for (k, f) in fields[1..].iter().enumerate() {
-            let what = ["x", "y", "z", "nx", "ny", "nz"][k];
-            v[k] = match f.parse::<f64>() {
-                Ok(x) if x.is_finite() => x,
-                _ => {
-                    return Err(bad(
-                        i + 1,
-                        format!("expected a finite number for {what}, found \"{f}\""),
-                    ))
-                }
-            };
+    }
+    match errors.len() {
+        0 => {}
+        1 => return Err(errors.remove(0)),
+        n => {
+            errors.truncate(MAX_POINTS_ERRORS);
+            return Err(PointsError::Several {
+                errors,
+                more: n.saturating_sub(MAX_POINTS_ERRORS),
+            });
         }
-        let normal = DVec3::new(v[3], v[4], v[5]);
-        if normal.length_squared() == 0.0 {
-            return Err(bad(
-                i + 1,
-                "the normal nx,ny,nz is 0,0,0; give the direction the meter faces (0,0,1 \
-                 for a horizontal work plane in a z-up scene)"
-                    .to_string(),
-            ));
-        }
-        out.push(CalcPoint {
-            name: fields[0].to_string(),
-            position: DVec3::new(v[0], v[1], v[2]),
-            normal,
-        });
     }
     if out.is_empty() {
         return Err(bad(
@@ -479,6 +482,62 @@ pub fn parse_points(text: &str, source_name: &str) -> Result<Vec<CalcPoint>, Poi
         ));
     }
     Ok(out)
+}
+
+/// One line of a points file (line number `line`), or what is wrong with it; its name is
+/// recorded in `first_line_of` and refused when it is already there.
+fn point_of_line(
+    line_text: &str,
+    line: usize,
+    first_line_of: &mut std::collections::HashMap<String, usize>,
+) -> Result<CalcPoint, String> {
+    let fields: Vec<&str> = line_text.split(',').map(str::trim).collect();
+    if fields.len() != 7 {
+        return Err(format!(
+            "expected 7 fields (name,x,y,z,nx,ny,nz), found {}",
+            fields.len()
+        ));
+    }
+    let mut v = [0.0; 6];
+    for (k, f) in fields[1..].iter().enumerate() {
+        let what = ["x", "y", "z", "nx", "ny", "nz"][k];
+        v[k] = match f.parse::<f64>() {
+            Ok(x) if x.is_finite() => x,
+            _ => {
+                return Err(format!(
+                    "expected a finite number for {what}, found \"{f}\""
+                ))
+            }
+        };
+    }
+    let normal = DVec3::new(v[3], v[4], v[5]);
+    if normal.length_squared() == 0.0 {
+        return Err(
+            "the normal nx,ny,nz is 0,0,0; give the direction the meter faces (0,0,1 \
+                    for a horizontal work plane in a z-up scene)"
+                .to_string(),
+        );
+    }
+    let name = fields[0];
+    if name.is_empty() {
+        return Err(
+            "the point has no name; give each point a name (the first field), \
+                    which labels its row of the lux CSV"
+                .to_string(),
+        );
+    }
+    if let Some(&first) = first_line_of.get(name) {
+        return Err(format!(
+            "the name \"{name}\" is already the point's on line {first}; give each point \
+             its own name, which labels its row of the lux CSV"
+        ));
+    }
+    first_line_of.insert(name.to_string(), line);
+    Ok(CalcPoint {
+        name: name.to_string(),
+        position: DVec3::new(v[0], v[1], v[2]),
+        normal,
+    })
 }
 
 /// Writes the illuminance CSV ([`LUX_HEADER`]), one row per point, numbers as Rust's

@@ -151,6 +151,27 @@ fn points_files_are_read_and_bad_lines_named() {
         err("name,x,y,z,nx,ny,nz\nA,1,q,3,0,0,1\n").contains("finite number for y, found \"q\"")
     );
     assert!(err("name,x,y,z,nx,ny,nz\nA,1,2,3,0,0,0\n").contains("the normal nx,ny,nz is 0,0,0"));
+    // A name given twice, or none: the lux CSV's rows are told apart by name.
+    assert_eq!(
+        err("name,x,y,z,nx,ny,nz\nA,1,2,3,0,0,1\nA,1,2,3,0,0,1\n"),
+        "p.csv:3: error: the name \"A\" is already the point's on line 2; give each point its \
+         own name, which labels its row of the lux CSV"
+    );
+    assert!(err("name,x,y,z,nx,ny,nz\n ,1,2,3,0,0,1\n").contains("the point has no name"));
+    // Every wrong line is found, the first ten named (QA of issue #16: one at a time).
+    let mut many = String::from("name,x,y,z,nx,ny,nz\nA,1,2,3,0,0,1\nB,1,2\n");
+    for k in 0..12 {
+        many += &format!("P{k},1,2,3,0,0,0\n");
+    }
+    let e = err(&many);
+    let lines: Vec<&str> = e.lines().collect();
+    assert_eq!(lines.len(), 11, "{e}");
+    assert!(
+        lines[0].starts_with("p.csv:3: error: expected 7 fields"),
+        "{e}"
+    );
+    assert!(lines[9].starts_with("p.csv:12: error: the normal"), "{e}");
+    assert_eq!(lines[10], "... and 3 more lines like these");
     // A header and nothing else is a mistake, not an empty table (QA of issue #16).
     assert!(
         err("name,x,y,z,nx,ny,nz\n\n").starts_with("p.csv:2: error: no points after the header")

@@ -38,13 +38,15 @@ pub fn run(args: BenchArgs) -> Result<()> {
     radiosity::budget::check_render_memory(
         width,
         height,
-        args.supersample,
+        args.rays.supersample,
         false,
         radiosity::form_factor::available_memory_bytes(),
     )?;
     if !args.no_work_limit {
-        radiosity::budget::check_render_work(width, height, args.supersample)?;
+        radiosity::budget::check_render_work(width, height, args.rays.supersample)?;
     }
+    // Said once here (its warnings too), not once per run.
+    let settings = crate::setup::ray_settings(&args.rays, crate::args::ShadingArg::Smooth);
     for &max_area in &areas {
         let (scene_args, options) = run_settings(&args, max_area);
         crate::setup::check_scene_flags(&scene_args)?;
@@ -63,13 +65,13 @@ pub fn run(args: BenchArgs) -> Result<()> {
     report::bench_header(
         args.repeat,
         image_size(&args),
-        args.supersample,
+        &settings,
         args.solver.0,
         args.quiet,
     );
     for max_area in areas {
         let runs = (0..args.repeat)
-            .map(|_| bench_run(&args, max_area))
+            .map(|_| bench_run(&args, max_area, settings))
             .collect::<Result<Vec<_>>>()?;
         let first = &runs[0];
         if !args.quiet && runs.iter().any(|r| r.rays != first.rays) {
@@ -156,12 +158,12 @@ fn run_settings(args: &BenchArgs, max_area: Option<f64>) -> (SceneArgs, SolveOpt
     (scene_args, options)
 }
 
-fn bench_run(args: &BenchArgs, max_area: Option<f64>) -> Result<BenchRun> {
+fn bench_run(
+    args: &BenchArgs,
+    max_area: Option<f64>,
+    settings: RenderSettings,
+) -> Result<BenchRun> {
     let (scene_args, options) = run_settings(args, max_area);
-    let settings = RenderSettings {
-        supersample: args.supersample,
-        ..RenderSettings::default()
-    };
     let reporter = Reporter::new(true);
     let start = std::time::Instant::now();
     let (prepared, _, solver) = prepare_solve(&scene_args, &options, &reporter)?;

@@ -142,8 +142,14 @@ pub fn solve_scene(
     }
     report::energy_note(&prepared.scene, &solution, prepared.method(), reporter);
     if let Some(warning) = report::light_lost(&prepared.scene, &solution) {
-        // Printed even with --quiet: every picture of this solution is black.
-        errln!("warning: {warning}");
+        // Printed even with --quiet: every picture of this solution is black. Once for the
+        // same words (QA of issue #16: bench printed it once per run).
+        static SAID: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+        let mut said = SAID.lock().unwrap_or_else(|e| e.into_inner());
+        if said.as_deref() != Some(warning.as_str()) {
+            errln!("warning: {warning}");
+            *said = Some(warning);
+        }
     }
     let stats = solution.form_factors;
     Ok((solution, stats))

@@ -164,6 +164,21 @@ fn bench_header_says_what_auto_picks_and_quiet_silences_it() {
     let err = stderr(&out);
     assert!(err.contains("else hierarchical)"), "{err}");
     assert!(!err.contains("progressive"), "{err}");
+    // It times what `render` draws by default, and says so (QA of issue #16: one ray a
+    // pixel from the mesh alone, unsaid).
+    assert!(
+        err.contains("render 8x8, 4 to 64 rays a pixel (adaptive), direct light gathered per ray (as `render`)"),
+        "{err}"
+    );
+    let mut paper = args.to_vec();
+    paper.extend(["--supersample", "1", "--direct-light", "mesh"]);
+    let out = radiosity(&paper, &dir);
+    assert!(
+        stderr(&out)
+            .contains("render 8x8, 1 ray a pixel, shading from the mesh alone (the paper's)"),
+        "{}",
+        stderr(&out)
+    );
     let table = crate::fixtures::stdout(&out);
     assert!(table.starts_with("| scene |"), "{table}");
     let mut quiet = args.to_vec();
@@ -1507,9 +1522,9 @@ fn bench_takes_width_and_height_as_render_does_and_keeps_size() {
     };
     let out = run(&["--size", "8", "--width", "12"]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stderr(&out).contains("render 12x8 at"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("render 12x8, "), "{}", stderr(&out));
     let out = run(&["--size", "8"]);
-    assert!(stderr(&out).contains("render 8x8 at"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("render 8x8, "), "{}", stderr(&out));
     for flag in ["--size", "--width", "--height"] {
         let out = run(&[flag, "0"]);
         let err = stderr(&out);
@@ -2451,7 +2466,7 @@ fn seventh_pass_findings_are_said() {
         0,
         "",
     );
-    assert!(err.contains("render 12x12 at"), "{err}");
+    assert!(err.contains("render 12x12, "), "{err}");
     // The analytic method's account, visibly not adding up, has its reason.
     let out = radiosity(
         &["check", "--max-area", "20000", "--method", "analytic"],
@@ -2590,6 +2605,34 @@ fn eighth_pass_findings_are_said() {
     ]);
     assert!(
         err.contains("--fov 50 (the camera flags given, the rest the scene's own;"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_usage_line_after_an_error_is_the_commands_own() {
+    // QA of issue #16: clap's usage line listed the flags typed as if they were required
+    // ("Usage: radiosity generate building --output <FILE.scene> --rooms-z <N>").
+    let dir = scratch_dir("usage-line");
+    let out = radiosity(&["generate", "building", "--rooms", "2"], &dir);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("a similar argument exists: '--rooms-z'"),
+        "{err}"
+    );
+    let usage: Vec<&str> = err.lines().filter(|l| l.starts_with("Usage: ")).collect();
+    assert_eq!(
+        usage,
+        ["Usage: radiosity generate building [OPTIONS] --output <FILE.scene>"],
+        "{err}"
+    );
+    let out = radiosity(&["illuminance", "--grid", "0,0,0:1,1,0:0.5"], &dir);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("Usage: radiosity illuminance [OPTIONS] --output <OUT.csv> [SCENE]\n"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).unwrap();

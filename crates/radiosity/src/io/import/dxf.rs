@@ -91,6 +91,7 @@ pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportErro
     let file = path.display().to_string();
     crate::io::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
+        what: "the scene file",
         file: file.clone(),
         message: e.to_string(),
     })?;
@@ -106,6 +107,7 @@ pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportErro
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
         Err(e) => {
             return Err(ImportError::Io {
+                what: "the materials file",
                 file: side_name,
                 message: e.to_string(),
             })
@@ -153,9 +155,12 @@ pub fn parse(
     let table = materials
         .map(|t| MaterialsFile::parse(materials_file, t))
         .transpose()?;
+    let mut warnings = drawing.warnings(file);
+    if let Some(table) = &table {
+        warnings.extend(table.unused_layers(materials_file, file, &builder.layers));
+    }
     let soup = builder.soup(materials_file, table.as_ref())?;
     let (scene, mut more) = soup.to_scene(options.scale)?;
-    let mut warnings = drawing.warnings(file);
     warnings.append(&mut more);
     let settings = options.settings.unwrap_or_else(|| default_settings(&scene));
     let unit = match drawing.insunits {
@@ -1023,6 +1028,20 @@ impl Builder<'_> {
                 (Some(m), _) => (m, table.line_of(&format!("[layers.{name}]"))),
                 (None, Some(d)) => (d, table.line_of("[default]")),
                 (None, None) => {
+                    // A table that names no layer is most likely this one misspelt.
+                    let unused: Vec<String> = table
+                        .layers
+                        .keys()
+                        .filter(|l| !self.layers.contains(l))
+                        .map(|l| format!("[layers.\"{l}\"]"))
+                        .collect();
+                    let unused = match unused.is_empty() {
+                        true => String::new(),
+                        false => format!(
+                            "; tables here that name no layer with faces: {}",
+                            unused.join(", ")
+                        ),
+                    };
                     return Err(ImportError::BadMaterial {
                         file: materials_file.to_string(),
                         line: 0,
@@ -1030,11 +1049,11 @@ impl Builder<'_> {
                         message: format!(
                             "the layer \"{name}\" of {} has faces but no [layers.\"{name}\"] \
                              table here, and there is no [default] table; the drawing's \
-                             layers with faces: {}",
+                             layers with faces: {}{unused}",
                             self.file,
                             layers_found()
                         ),
-                    })
+                    });
                 }
             };
             material_of_layer.push(soup.materials.len() as u32);
@@ -1108,6 +1127,44 @@ impl MaterialsFile {
             default: parsed.default,
             text: text.to_string(),
         })
+    }
+
+    /// A warning for each `[layers.NAME]` table that names no layer of the drawing with
+    /// faces (`layers`): a misspelt or stale name, whose layer takes `[default]` or is
+    /// refused (QA of issue #16: it was passed over without a word).
+    fn unused_layers(
+        &self,
+        materials_file: &str,
+        drawing: &str,
+        layers: &[String],
+    ) -> Vec<ImportWarning> {
+        let listed = || {
+            layers
+                .iter()
+                .map(|l| format!("\"{l}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        self.layers
+            .keys()
+            .filter(|name| !layers.contains(name))
+            .map(|name| {
+                let near = layers
+                    .iter()
+                    .find(|l| l.eq_ignore_ascii_case(name))
+                    .map(|l| format!(" (layer names are case sensitive: \"{l}\"?)"))
+                    .unwrap_or_default();
+                ImportWarning {
+                    file: materials_file.to_string(),
+                    line: self.line_of(&format!("[layers.{name}]")),
+                    message: format!(
+                        "[layers.\"{name}\"] names no layer of {drawing} with faces, so it \
+                         is not used{near}; the layers with faces: {}",
+                        listed()
+                    ),
+                }
+            })
+            .collect()
     }
 
     /// The line of a table header (for messages about its colours); 0 when it is written

@@ -385,6 +385,33 @@ fn a_missing_layer_or_materials_file_lists_the_layers_found() {
 }
 
 #[test]
+fn a_table_that_names_no_layer_is_pointed_out() {
+    let text = dxf("", &(square("Floor", 0.0, 0.0) + &square("Wall", 2.0, 0.0)));
+    // Misspelt beside a [default]: read, with a warning at the table's line.
+    let materials = "[layers.floor]\nreflectance = [0.1, 0.2, 0.3]\n\n[default]\nreflectance = [0.4, 0.4, 0.4]\n";
+    let imported = read(&text, Some(materials)).unwrap();
+    let warnings: Vec<String> = imported.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        warnings,
+        [
+            "t.materials.toml:1: warning: [layers.\"floor\"] names no layer of t.dxf with faces, \
+          so it is not used (layer names are case sensitive: \"Floor\"?); the layers with \
+          faces: \"Floor\", \"Wall\""
+        ]
+    );
+    assert_eq!(imported.file.scene.surfaces[0].reflectance, Rgb([0.4; 3]));
+    // Without a [default]: the refusal names the table too.
+    let e = err(
+        &text,
+        Some("[layers.Flor]\nreflectance = [0.5, 0.5, 0.5]\n[layers.Wall]\nreflectance = [0.5, 0.5, 0.5]\n"),
+    );
+    assert!(
+        e.ends_with("tables here that name no layer with faces: [layers.\"Flor\"]"),
+        "{e}"
+    );
+}
+
+#[test]
 fn block_cycles_and_missing_blocks_are_refused() {
     let blocks = block("A", DVec3::ZERO, &insert_of("B", "0", DVec3::ZERO, &[]))
         + &block(

@@ -94,6 +94,7 @@ pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportErro
     let file = path.display().to_string();
     crate::io::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
+        what: "the scene file",
         file: file.clone(),
         message: e.to_string(),
     })?;
@@ -559,6 +560,7 @@ impl Reader<'_> {
         let path = dir.join(percent_decode(uri));
         crate::io::note_input(&path);
         let opened = std::fs::File::open(&path).map_err(|e| ImportError::Io {
+            what: "the file",
             file: path.display().to_string(),
             message: format!("{e} ({what} of {})", self.file),
         })?;
@@ -567,6 +569,7 @@ impl Reader<'_> {
             .take(limit as u64)
             .read_to_end(&mut data)
             .map_err(|e| ImportError::Io {
+                what: "the file",
                 file: path.display().to_string(),
                 message: format!("{e} ({what} of {})", self.file),
             })?;

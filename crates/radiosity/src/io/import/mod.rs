@@ -204,10 +204,13 @@ pub enum ImportError {
     #[error(transparent)]
     Scene(#[from] SceneError),
     /// The file cannot be read.
-    #[error("{file}: error: cannot read the file: {message}")]
+    #[error("{file}: error: cannot read {what}: {message}")]
     Io {
         /// The file.
         file: String,
+        /// What the file is ("the scene file", "the materials file", "the buffer"), as the
+        /// `.scene` reader's "cannot read the scene file" says (QA of issue #16).
+        what: &'static str,
         /// The system's reason.
         message: String,
     },

@@ -75,6 +75,7 @@ pub fn read(path: &Path, options: &ImportOptions) -> Result<Imported, ImportErro
     let file = path.display().to_string();
     crate::io::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
+        what: "the scene file",
         file: file.clone(),
         message: e.to_string(),
     })?;

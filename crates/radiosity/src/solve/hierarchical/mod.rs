@@ -406,7 +406,7 @@ pub fn solve_hierarchical(
             // mean emission over 1 - the mean reflectance (area weighted, largest band).
             let b_ref = max3(solver.b[solver.top as usize]) / (1.0 - mean_rho).max(1e-3);
             let top = solver.top;
-            solver.refine(vec![(top, top)], b_ref)?;
+            solver.refine(vec![(top, top)], b_ref, progress)?;
             let initial_links = solver.nodes.iter().map(|n| n.links.len()).sum();
             let (mut iterations, mut rounds, mut residual) = (0, 0, 0.0);
             if max3(emitted) == 0.0 {
@@ -421,7 +421,7 @@ pub fn solve_hierarchical(
                 iterations += sweeps;
                 residual = r;
                 let b_ref = max3(solver.b[solver.top as usize]);
-                let refined = solver.refine_all(b_ref)?;
+                let refined = solver.refine_all(b_ref, progress)?;
                 progress.advance(1);
                 progress.message(&format!(
                     "hierarchical round {rounds}: {} nodes, {} links, {refined} refined",

@@ -2,11 +2,18 @@
 //! pairs into links (estimates in parallel, splits in order), and a pass over all links
 //! with the current radiosity.
 
+use std::time::{Duration, Instant};
+
 use rayon::prelude::*;
 
 use super::link::Estimate;
 use super::solver::Solver;
+use crate::progress::Progress;
 use crate::solve::SolveError;
+
+/// How often a long refinement says how far it has got (QA of issue #16: a tiny `--epsilon`
+/// refined for minutes with nothing but a spinner).
+const HEARTBEAT: Duration = Duration::from_secs(10);
 
 impl Solver<'_> {
     /// Which of p and q to split for a refined link: Some(true) for p, Some(false) for q,
@@ -27,14 +34,30 @@ impl Solver<'_> {
 
     /// Refines the candidate pairs (p, q) breadth first until the oracle is satisfied,
     /// storing the resulting links (estimates in parallel, splits in order); returns whether
-    /// anything was split.
+    /// anything was split. Every [`HEARTBEAT`] it tells `progress` the nodes, links and
+    /// memory so far: how long refinement takes is not known before it ends, but the
+    /// memory limit bounds it.
     pub(super) fn refine(
         &mut self,
         mut frontier: Vec<(u32, u32)>,
         b_ref: f64,
+        progress: &dyn Progress,
     ) -> Result<bool, SolveError> {
         let mut split = false;
+        let mut last_said = Instant::now();
         while !frontier.is_empty() {
+            if last_said.elapsed() >= HEARTBEAT {
+                last_said = Instant::now();
+                progress.message(&format!(
+                    "hierarchical refinement: {} nodes, {} links, {} pairs to judge next; \
+                     {} MiB of the {} MiB limit",
+                    self.nodes.len(),
+                    self.link_count,
+                    frontier.len(),
+                    self.memory_bytes() >> 20,
+                    self.memory_limit >> 20
+                ));
+            }
             // What is held, and the frontier about to be expanded and estimated (checked
             // before it is allocated).
             let expanded: u64 = frontier
@@ -136,7 +159,11 @@ impl Solver<'_> {
     }
 
     /// One refinement pass over all links with the current B; returns the links refined.
-    pub(super) fn refine_all(&mut self, b_ref: f64) -> Result<usize, SolveError> {
+    pub(super) fn refine_all(
+        &mut self,
+        b_ref: f64,
+        progress: &dyn Progress,
+    ) -> Result<usize, SolveError> {
         let mut pairs = Vec::new();
         for p in 0..self.nodes.len() {
             let links = std::mem::take(&mut self.nodes[p].links);
@@ -157,7 +184,7 @@ impl Solver<'_> {
         if refined > 0 {
             // The pairs are estimated again (cheap next to their children) so that `refine`
             // handles them like any candidate.
-            self.refine(pairs, b_ref)?;
+            self.refine(pairs, b_ref, progress)?;
         }
         Ok(refined)
     }
