@@ -216,6 +216,17 @@ struct Reflecting {
 /// disagree: a shadow edge's error is then that of a band 1/64 of an element wide.
 pub const FIRST_BOUNCE_MAX_DEPTH: u32 = 6;
 
+/// A first-bounce piece that a point light sees wider than this (sr) is halved, down to
+/// [`FIRST_BOUNCE_MAX_SOLID_DEPTH`] times: over a cone of 0.1 sr (10 degrees across) a
+/// COSINE light's intensity is near linear, so taking it at the centroid is second-order
+/// accurate (well under 1 %), and a light's whole sphere holds at most about 130 such
+/// pieces of one element.
+pub const FIRST_BOUNCE_MAX_SOLID_ANGLE: f64 = 0.1;
+
+/// How many times a wide piece may be halved (4^9 pieces of a fan triangle at most), so that
+/// an element through a light cannot split without end.
+pub const FIRST_BOUNCE_MAX_SOLID_DEPTH: u32 = 9;
+
 /// Every sub-triangle is halved at least this many times (4 per fan triangle), so that the
 /// illuminance's variation across a lit, seen element is integrated, not taken at one point.
 const FIRST_BOUNCE_MIN_DEPTH: u32 = 1;
@@ -257,11 +268,26 @@ impl FirstBounce<'_> {
         (sum.1 > 0.0).then(|| sum.0 * (1.0 / sum.1))
     }
 
+    /// The solid angle (sr) the triangle `t` (counter-clockwise from its front) subtends
+    /// seen from the light at `light`; 0 when the light is behind it.
+    fn solid_angle_from(light: DVec3, t: &[DVec3; 3]) -> f64 {
+        (-crate::luminaire::triangle_solid_angle(t[0] - light, t[1] - light, t[2] - light)).max(0.0)
+    }
+
     fn triangle(&self, t: [DVec3; 3], s: [u64; 3], depth: u32, sum: &mut (Rgb, f64)) {
         let centre = (t[0] + t[1] + t[2]) / 3.0;
         let sm = self.state(centre);
         let uniform = s.iter().all(|&x| x == sm);
-        if depth < FIRST_BOUNCE_MIN_DEPTH || (!uniform && depth < FIRST_BOUNCE_MAX_DEPTH) {
+        // A piece that a light sees wide is split too: over it the light's intensity
+        // changes with direction (QA of issue #16: a COSINE light 5 cm below a ceiling
+        // gave half the indirect lux, its first bounce taken at a few points of a spike).
+        let wide = depth < FIRST_BOUNCE_MAX_SOLID_DEPTH
+            && self
+                .lights
+                .iter()
+                .take(63)
+                .any(|l| Self::solid_angle_from(l.position, &t) > FIRST_BOUNCE_MAX_SOLID_ANGLE);
+        if depth < FIRST_BOUNCE_MIN_DEPTH || (!uniform && depth < FIRST_BOUNCE_MAX_DEPTH) || wide {
             let m = [
                 0.5 * (t[0] + t[1]),
                 0.5 * (t[1] + t[2]),
@@ -286,14 +312,20 @@ impl FirstBounce<'_> {
         if sm & 1 == 1 {
             return;
         }
+        // The light's power onto the piece, I towards its centre times the solid angle it
+        // subtends (exact for an isotropic light however close: the irradiance at the
+        // centre times the area is not, near a light), times the kernel per unit area.
+        let kernel = cx * cy / (r2 * r2);
         for (i, l) in self.lights.iter().enumerate() {
             let blocked = if i < 63 {
                 sm >> (i + 1) & 1 == 1
             } else {
                 self.occluders.segment_blocked(l.position, centre)
             };
-            if !blocked {
-                sum.0 += l.irradiance_unoccluded(centre, self.normal) * kw;
+            let omega = Self::solid_angle_from(l.position, &t);
+            if !blocked && omega > 0.0 {
+                let d = (centre - l.position).normalize_or_zero();
+                sum.0 += l.intensity(d) * (omega * kernel);
             }
         }
     }
