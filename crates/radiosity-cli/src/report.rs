@@ -381,18 +381,68 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
     {
         return None;
     }
+    // What the pictures show: nothing, or the little that lands, which the automatic
+    // exposure brightens (QA of issue #16: "so pictures are black" over a lit picture).
+    let pictures = if absorbed > 0.0 {
+        format!(
+            "pictures show only the {} % that lands, brightened by the automatic exposure",
+            significant(100.0 * absorbed, 2)
+        )
+    } else {
+        "so pictures are black".to_string()
+    };
+    // Blame the emitters' orientation only where it is to blame: an emitter with no other
+    // surface in front of it (QA of issue #16: a lamp facing a ground 20 m below, and the
+    // lamp inside a box whose faces point out, were told to reverse their corners).
+    let facing_nothing: Vec<usize> = emitters
+        .iter()
+        .copied()
+        .filter(|&s| faces_nothing(scene, s))
+        .collect();
+    if !facing_nothing.is_empty() {
+        return Some(format!(
+            "{:.2} % of the emitted light reaches no surface ({pictures}): {} {} out of the \
+             scene, with no surface in front of {} (corners listed clockwise, seen from the \
+             side to light, face the other way: reverse their order)",
+            100.0 * (1.0 - absorbed),
+            names(&facing_nothing),
+            if facing_nothing.len() == 1 {
+                "faces"
+            } else {
+                "face"
+            },
+            if facing_nothing.len() == 1 {
+                "it"
+            } else {
+                "them"
+            },
+        ));
+    }
     Some(format!(
-        "{:.2} % of the emitted light reaches no surface, so pictures are black: {}{} faces \
-         out of the scene or lies behind another face (corners listed clockwise, seen from \
-         the side to light, face the other way: reverse their order)",
+        "{:.2} % of the emitted light reaches no surface ({pictures}): it leaves an open \
+         scene, or lands on the backs of faces (an emitter behind a wall, above a ceiling or \
+         inside furniture, or a room whose faces point out: `check` lists where it goes)",
         100.0 * (1.0 - absorbed),
-        if emitters.len() == 1 {
-            ""
-        } else {
-            "one or more of "
-        },
-        names(&emitters),
     ))
+}
+
+/// Whether no corner of any other surface of `scene` lies in front of surface `s`'s plane
+/// (by more than 1e-9 of the scene's size): its light can only leave the scene.
+fn faces_nothing(scene: &Scene, s: usize) -> bool {
+    let vertices = &scene.surfaces[s].vertices;
+    let Some(normal) = radiosity::geometry::polygon_normal(vertices) else {
+        return false;
+    };
+    let centre = radiosity::geometry::polygon_centroid(vertices);
+    let (lo, hi) = scene.bounds();
+    let eps = 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE);
+    !scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != s)
+        .flat_map(|(_, other)| other.vertices.iter())
+        .any(|&v| normal.dot(v - centre) > eps)
 }
 
 /// What an escaped share (percent of the emitted power) means, for the energy notes.

@@ -400,7 +400,7 @@ pub fn refuse_overwriting_inputs_as(
     label: &str,
     inputs: &[(&str, Option<&Path>)],
 ) -> Result<()> {
-    note_output(output, flag, label);
+    note_output(output, flag, label)?;
     for &(what, input) in inputs {
         if let Some(input) = input {
             if radiosity::io::is_same_file(output, input) {
@@ -430,15 +430,30 @@ struct Output {
 /// files a scene names itself once it is read ([`refuse_outputs_read`]).
 static OUTPUTS: std::sync::Mutex<Vec<Output>> = std::sync::Mutex::new(Vec::new());
 
-/// Notes `path` as an output of this run, named by `flag`, described as `label`.
-pub fn note_output(path: &Path, flag: &str, label: &str) {
-    if let Ok(mut outputs) = OUTPUTS.lock() {
-        outputs.push(Output {
-            path: path.to_path_buf(),
-            flag: flag.to_string(),
-            label: label.to_string(),
-        });
+/// Notes `path` as an output of this run, named by `flag`, described as `label`; refuses
+/// it when an output noted before is the same file, which one write would destroy (QA of
+/// issue #16: `pathtrace --save-reference r.exr -o r.exr` wrote its picture over the
+/// reference it had just saved).
+pub fn note_output(path: &Path, flag: &str, label: &str) -> Result<()> {
+    let Ok(mut outputs) = OUTPUTS.lock() else {
+        return Ok(());
+    };
+    if let Some(earlier) = outputs
+        .iter()
+        .find(|o| o.path == path || radiosity::io::is_same_file(&o.path, path))
+    {
+        bail!(
+            "{label} is {} too: one output would overwrite the other; give {flag} another \
+             file name",
+            earlier.label
+        );
     }
+    outputs.push(Output {
+        path: path.to_path_buf(),
+        flag: flag.to_string(),
+        label: label.to_string(),
+    });
+    Ok(())
 }
 
 /// Refuses, right after the scene is read and before any work, an output that is a file

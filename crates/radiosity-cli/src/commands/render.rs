@@ -344,8 +344,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
         image.height()
     ));
     if !wireframe && picture_can_be_lit(&prepared, &solution) {
-        if let Some(warning) = black_picture(image.pixels().map(|p| p.0 == [0, 0, 0]))
-            .map(|w| with_exposure_hint(w, exposure))
+        if let Some(warning) = black_picture(
+            image.pixels().map(|p| p.0 == [0, 0, 0]),
+            fronts_in_view(&prepared, &camera),
+        )
+        .map(|w| with_exposure_hint(w, exposure))
         {
             // Printed even with --quiet: the picture shows nothing.
             errln!("warning: {warning}");
@@ -363,7 +366,11 @@ const BLACK_PICTURE_SHARE: f64 = 0.95;
 /// seeing the backs of its faces, or inside a closed piece of furniture (QA of issue #16:
 /// a camera outside a closed room wrote a black picture without a word; `illuminance`
 /// warns of points that see only backs).
-fn black_picture(dark: impl Iterator<Item = bool>) -> Option<String> {
+/// `fronts` is the share of the view whose camera rays meet the front of a surface
+/// ([`fronts_in_view`]): where most do, the camera is not to blame, what it sees gets no
+/// light or reflects none (QA of issue #16: a camera inside a room facing a wall of
+/// reflectance 0 was told to move into the scene).
+fn black_picture(dark: impl Iterator<Item = bool>, fronts: f64) -> Option<String> {
     let (mut pixels, mut black) = (0u64, 0u64);
     for is_dark in dark {
         pixels += 1;
@@ -371,13 +378,47 @@ fn black_picture(dark: impl Iterator<Item = bool>) -> Option<String> {
     }
     let share = black as f64 / pixels.max(1) as f64;
     (share > BLACK_PICTURE_SHARE).then(|| {
-        format!(
-            "{:.1} % of the picture shows nothing lit: the camera sees the backs of faces \
-             (outside a closed room, or inside furniture or a wall) or nothing; move --eye \
-             into the scene",
-            100.0 * share
-        )
+        if fronts >= 0.5 {
+            format!(
+                "{:.1} % of the picture shows nothing lit: the surfaces in view face the \
+                 camera, but no light reaches them or they reflect none (reflectance 0)",
+                100.0 * share
+            )
+        } else {
+            format!(
+                "{:.1} % of the picture shows nothing lit: the camera sees the backs of faces \
+                 (outside a closed room, or inside furniture or a wall) or nothing; move \
+                 --eye into the scene",
+                100.0 * share
+            )
+        }
     })
+}
+
+/// The share of a 32 x 32 grid of the camera's rays whose first hit, among the scene's
+/// surfaces, is a front face.
+fn fronts_in_view(
+    prepared: &radiosity::pipeline::Prepared,
+    camera: &radiosity::render::Camera,
+) -> f64 {
+    const GRID: u32 = 32;
+    let surfaces = &prepared.scene.surfaces;
+    let (lo, hi) = prepared.scene.bounds();
+    let near = 1e-9 * (hi - lo).length();
+    let fronts = (0..GRID * GRID)
+        .filter(|k| {
+            let x = (f64::from(k % GRID) + 0.5) / f64::from(GRID) * f64::from(camera.width);
+            let y = (f64::from(k / GRID) + 0.5) / f64::from(GRID) * f64::from(camera.height);
+            let dir = camera.ray_direction(x, y);
+            prepared
+                .occluders
+                .closest_hit(camera.eye, dir, near, f64::INFINITY)
+                .and_then(|hit| surfaces.get(hit.id as usize))
+                .and_then(|s| radiosity::geometry::polygon_normal(&s.vertices))
+                .is_some_and(|n| n.dot(dir) < 0.0)
+        })
+        .count();
+    fronts as f64 / f64::from(GRID * GRID)
 }
 
 /// The nothing-lit warning, with the other likely cause where the exposure was given
@@ -487,7 +528,7 @@ fn false_colour(
             .iter()
             .zip(&coverage)
             .map(|(&lux, &c)| c <= 0.0 || lux <= 0.0);
-        if let Some(warning) = black_picture(nothing) {
+        if let Some(warning) = black_picture(nothing, fronts_in_view(prepared, camera)) {
             errln!("warning: {warning}");
         }
     }

@@ -3,7 +3,7 @@
 use crate::progress_bar::run_file_stage;
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use radiosity::progress::Stage;
 
 use super::solve_as_asked;
@@ -37,13 +37,7 @@ pub fn outputs(args: &SolveArgs) -> Result<PathBuf> {
             "the per-surface report is a CSV table",
             &["csv"],
             &inputs,
-        )?;
-        if radiosity::io::is_same_file(report, &output) || report == &output {
-            bail!(
-                "--report {} is the solution's output too; give the report another name",
-                report.display()
-            );
-        }
+        )?; // also refused when it is -o's file (`setup::note_output`)
     }
     check_scene_flags(&args.scene)?;
     check_solve_flags(&args.solve)?;

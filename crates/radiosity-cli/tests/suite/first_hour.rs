@@ -2127,8 +2127,8 @@ fn a_light_that_reaches_no_surface_is_warned_of() {
         (
             "up.scene",
             "VERTEX0 2.5 3 1.5\nVERTEX1 1.5 3 1.5\nVERTEX2 1.5 3 2.5\nVERTEX3 2.5 3 2.5\n",
-            "100.00 % of the emitted light reaches no surface, so pictures are black: \
-             surface 6 \"Light\" faces out of the scene",
+            "100.00 % of the emitted light reaches no surface (so pictures are black): \
+             surface 6 \"Light\" faces out of the scene, with no surface in front of it",
         ),
         (
             "above.scene",
@@ -2153,6 +2153,27 @@ fn a_light_that_reaches_no_surface_is_warned_of() {
             assert!(err.contains(&format!("warning: {needle}")), "{name}: {err}");
         }
     }
+    // QA of issue #16 (ninth pass): a lamp facing a ground 20 m below it lights the ground
+    // (a picture of it is not black) and is not turned the wrong way; the scene is open.
+    std::fs::write(
+        dir.join("far.scene"),
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 2\nSCENEBEGIN\n\
+         PATCHBEGIN\n#Ground\nVERTICES 4\nEr 0\nEg 0\nEb 0\nRr 0.5\nRg 0.5\nRb 0.5\n\
+         VERTEX0 0 0 0\nVERTEX1 0 0 2\nVERTEX2 2 0 2\nVERTEX3 2 0 0\nPATCHEND\n\
+         PATCHBEGIN\n#Lamp\nVERTICES 4\nEr 100\nEg 100\nEb 100\nRr 0\nRg 0\nRb 0\n\
+         VERTEX0 0.9 20 0.9\nVERTEX1 1.1 20 0.9\nVERTEX2 1.1 20 1.1\nVERTEX3 0.9 20 1.1\n\
+         PATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    let out = radiosity(&["solve", "far.scene", "-o", "b.csv", "-q"], &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("% of the emitted light reaches no surface (pictures show only the 0.")
+            && err.contains("it leaves an open scene, or lands on the backs of faces")
+            && !err.contains("reverse"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -2635,5 +2656,71 @@ fn a_usage_line_after_an_error_is_the_commands_own() {
         err.contains("Usage: radiosity illuminance [OPTIONS] --output <OUT.csv> [SCENE]\n"),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn ninth_pass_findings_are_said() {
+    let dir = scratch_dir("ninth-pass");
+    // Two outputs of one run naming the same file: refused before the trace.
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--width",
+            "8",
+            "--paths",
+            "2",
+            "--save-reference",
+            "r.exr",
+            "-o",
+            "r.exr",
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains(
+            "error: --save-reference r.exr is -o r.exr too: one output would overwrite the other"
+        ),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!dir.join("r.exr").exists());
+    // A camera inside a closed room facing a wall of reflectance 0, the light behind it:
+    // the picture is black, and the camera is not blamed.
+    std::fs::write(
+        dir.join("black.scene"),
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 2\nSCENEBEGIN\nBOXBEGIN\n#Room\nFACING IN\n\
+         Er 0\nEg 0\nEb 0\nRr 0\nRg 0\nRb 0\nORIGIN 0 0 0\nSIZE 4 3 4\nBOXEND\n\
+         PATCHBEGIN\n#Light\nVERTICES 4\nEr 15\nEg 15\nEb 15\nRr 0.7\nRg 0.7\nRb 0.7\n\
+         VERTEX0 2.5 2.95 1.5\nVERTEX1 2.5 2.95 2.5\nVERTEX2 1.5 2.95 2.5\nVERTEX3 1.5 2.95 1.5\n\
+         PATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    let out = radiosity(
+        &[
+            "render",
+            "black.scene",
+            "--eye",
+            "2,1.5,1",
+            "--look-at",
+            "2,1.5,4",
+            "--width",
+            "16",
+            "-o",
+            "b.png",
+            "-q",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains(
+            "the surfaces in view face the camera, but no light reaches them or they reflect none"
+        ),
+        "{err}"
+    );
+    assert!(!err.contains("move --eye"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -236,7 +236,10 @@ fn solve_report_has_one_row_per_surface_at_the_closed_form() {
     // The report may not replace an input or the solution.
     for (report, needle) in [
         ("furnace.scene", "would destroy the input"),
-        ("elements.csv", "another name"),
+        (
+            "elements.csv",
+            "is -o elements.csv too: one output would overwrite the other",
+        ),
     ] {
         let out = radiosity(
             &[

@@ -62,6 +62,8 @@ pub struct PathTracer {
     /// Rays start this far beyond the point they leave (1e-9 of the scene's diagonal, the
     /// BVH's own edge tolerance), so they do not hit their own surface again.
     epsilon: f64,
+    /// The emitting surfaces' corners and unit normals, for the emitter mask of a view.
+    pub(super) emitters: Vec<(Vec<DVec3>, DVec3)>,
 }
 
 /// What one path from a ray found.
@@ -101,7 +103,15 @@ impl PathTracer {
         } else {
             scene.bounds()
         };
+        let emitters = scene
+            .surfaces
+            .iter()
+            .zip(&surfaces)
+            .filter(|(_, t)| t.emission.max_band() > 0.0)
+            .map(|(s, t)| (s.vertices.clone(), t.normal))
+            .collect();
         Ok(PathTracer {
+            emitters,
             epsilon: 1e-9 * bvh.scale(),
             lights: Lights::new(scene),
             points: scene.lights.clone(),
@@ -126,6 +136,16 @@ impl PathTracer {
         self.epsilon
     }
 
+    /// Whether the ray `origin + t dir` (t past 1e-9 of the scene) first meets the front
+    /// of an emitting surface.
+    pub(super) fn first_hit_emits(&self, origin: DVec3, dir: DVec3) -> bool {
+        let t_max = (origin - self.centre).length() + self.bvh.scale() + 1.0;
+        self.bvh
+            .closest_hit(origin, dir, self.epsilon, t_max)
+            .map(|hit| &self.surfaces[hit.id as usize])
+            .is_some_and(|s| s.normal.dot(dir) < 0.0 && s.emission.max_band() > 0.0)
+    }
+
     /// One path from `origin` along the unit direction `dir`: an unbiased estimate of the
     /// radiosity B = pi L that the ray sees (see the module documentation), drawing its
     /// random numbers from `rng`.
@@ -148,7 +168,9 @@ impl PathTracer {
         let nee = settings.next_event_estimation && !self.lights.is_empty();
         let mut radiosity = Rgb::BLACK;
         let mut throughput = Rgb::splat(1.0);
-        let (mut origin, mut dir, mut t_min) = (origin, dir, 0.0);
+        // The first segment too starts past 1e-9 of the scene: a camera exactly on a wall sees
+        // the room in front of it, not the wall's back at t = 0 (QA of issue #16).
+        let (mut origin, mut dir, mut t_min) = (origin, dir, self.epsilon);
         let mut sees_emitter = false;
         let mut bounces = 0;
         // The cosine-weighted density (per solid angle) of the bounce that made `dir`.

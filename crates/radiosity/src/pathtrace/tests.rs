@@ -342,6 +342,35 @@ fn a_seed_gives_the_same_image_on_any_number_of_threads() {
 }
 
 #[test]
+fn the_emitter_pixels_depend_on_the_view_alone() {
+    // QA of issue #16: the pixels left out as showing an emitter changed with --paths and
+    // --max-bounces (a path's first hit decided). Now a fixed grid of rays decides.
+    let s = crate::scene::cornell_box().scene;
+    let cam = Camera::for_scene(&s, 32, 32);
+    let mask = |settings: &PathTraceSettings| {
+        path_trace(&s, &cam, settings, &NoProgress)
+            .unwrap()
+            .emitter_mask()
+            .to_vec()
+    };
+    let base = mask(&PathTraceSettings::DEFAULT.with_samples(2));
+    assert!(
+        base.iter().any(|&e| e),
+        "the Cornell box's light is in view"
+    );
+    for settings in [
+        PathTraceSettings::DEFAULT.with_samples(64),
+        PathTraceSettings::DEFAULT.with_samples(16).with_seed(7),
+        PathTraceSettings {
+            max_bounces: 0,
+            ..PathTraceSettings::DEFAULT.with_samples(16)
+        },
+    ] {
+        assert_eq!(mask(&settings), base);
+    }
+}
+
+#[test]
 fn progress_is_one_unit_a_row() {
     use crate::progress::Stage;
     use std::sync::atomic::{AtomicU64, Ordering};

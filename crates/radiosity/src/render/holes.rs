@@ -77,14 +77,15 @@ impl Holes {
         &self,
         eye: DVec3,
         dir: DVec3,
+        t_min: f64,
         t_element: Option<f64>,
         t_max: f64,
     ) -> Option<Uncovered> {
         let limit = t_element.map_or(t_max, |t| t - self.depth);
-        if limit <= 0.0 {
+        if limit <= t_min {
             return None;
         }
-        let hit = self.surfaces.closest_hit(eye, dir, 0.0, limit)?;
+        let hit = self.surfaces.closest_hit(eye, dir, t_min, limit)?;
         if self.normals[hit.id as usize].dot(dir) >= 0.0 {
             return Some(Uncovered::Back);
         }

@@ -37,6 +37,9 @@ use crate::progress::{run_stage, Progress, Stage};
 use crate::scene::Scene;
 use crate::visibility::PolygonBvh;
 
+/// The camera's near distance, relative to the scene's bounding-box diagonal.
+const CAMERA_NEAR: f64 = 1e-9;
+
 /// How the hit element is coloured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Shading {
@@ -375,9 +378,13 @@ impl<'m> Renderer<'m> {
         }
         let (lo, hi) = self.bounds;
         let t_max = (eye - 0.5 * (lo + hi)).length() + (hi - lo).length() + 1.0;
-        let hit = self.bvh.closest_hit(eye, dir, 0.0, t_max);
+        // Hits nearer than 1e-9 of the scene are not seen: an eye exactly on a wall sees
+        // the room in front of it, not the wall's back at t = 0 (QA of issue #16: 94 % of
+        // such a picture was black, with no warning).
+        let t_min = CAMERA_NEAR * (hi - lo).length();
+        let hit = self.bvh.closest_hit(eye, dir, t_min, t_max);
         if let Some(holes) = &self.holes {
-            match holes.uncovered(eye, dir, hit.map(|h| h.t), t_max) {
+            match holes.uncovered(eye, dir, t_min, hit.map(|h| h.t), t_max) {
                 None => {}
                 Some(Uncovered::Back) => return Seen::NOTHING,
                 Some(Uncovered::Front { surface, x }) => {

@@ -35,6 +35,46 @@ fn front_side_is_open(scene: &Scene, lo: DVec3, hi: DVec3) -> bool {
     escaped > 12
 }
 
+/// Whether the scene's lights say that +z is up rather than +y: more emitting power in
+/// surfaces facing down along z (normal z below -0.7) than along y; without such surfaces,
+/// more point lights in the top quarter of the z extent (and not of the y extent) than the
+/// other way round. +y (the paper's convention, and glTF's) otherwise.
+pub fn z_is_up(scene: &Scene) -> bool {
+    let (mut down_y, mut down_z) = (0.0, 0.0);
+    for s in scene
+        .surfaces
+        .iter()
+        .filter(|s| s.emission.max_band() > 0.0)
+    {
+        let Some(n) = crate::geometry::polygon_normal(&s.vertices) else {
+            continue;
+        };
+        let power = crate::geometry::polygon_area(&s.vertices) * s.emission.max_band();
+        if n.y < -0.7 {
+            down_y += power;
+        } else if n.z < -0.7 {
+            down_z += power;
+        }
+    }
+    if down_y > 0.0 || down_z > 0.0 {
+        return down_z > down_y;
+    }
+    let (lo, hi) = scene.bounds();
+    let near_top = |p: DVec3, axis: usize| {
+        let span = hi[axis] - lo[axis];
+        span > 0.0 && (p[axis] - lo[axis]) / span > 0.75
+    };
+    let (mut top_y, mut top_z) = (0, 0);
+    for l in scene.lights.iter().filter(|l| l.gives_light()) {
+        match (near_top(l.position, 1), near_top(l.position, 2)) {
+            (true, false) => top_y += 1,
+            (false, true) => top_z += 1,
+            _ => {}
+        }
+    }
+    top_z > top_y
+}
+
 /// The field of view of the cameras [`Camera::framing`] and [`Camera::for_scene`] make.
 pub const DEFAULT_FOV_Y_DEGREES: f64 = 60.0;
 
@@ -149,10 +189,41 @@ impl Camera {
     /// * for several rooms (more than one emitter facing down, like a generated building):
     ///   in the room of the most powerful one (see `under_brightest_light`);
     /// * otherwise (objects): [`Camera::outside`].
+    ///
+    /// A scene whose lights say that +z is up ([`z_is_up`]) is framed the same way with z
+    /// for y (QA of issue #16: a z-up room, as `validate cie171 --write` and DXF plans make,
+    /// was looked at from 9 cm above its floor, sideways).
     pub fn for_scene(scene: &Scene, width: u32, height: u32) -> Camera {
         if let Some(hint) = &scene.camera {
             return Camera::from_hint(hint, width, height);
         }
+        if z_is_up(scene) {
+            // (x, y, z) -> (x, z, -y) turns +z into +y (a rotation: windings are kept).
+            let to_y_up = |v: DVec3| DVec3::new(v.x, v.z, -v.y);
+            let back = |v: DVec3| DVec3::new(v.x, 0.0 - v.z, v.y);
+            let mut turned = Scene {
+                surfaces: scene.surfaces.clone(),
+                camera: None,
+                lights: Vec::new(),
+            };
+            for s in &mut turned.surfaces {
+                for v in &mut s.vertices {
+                    *v = to_y_up(*v);
+                }
+            }
+            let c = Camera::for_y_up_scene(&turned, width, height);
+            return Camera {
+                eye: back(c.eye),
+                look_at: back(c.look_at),
+                up: back(c.up),
+                ..c
+            };
+        }
+        Camera::for_y_up_scene(scene, width, height)
+    }
+
+    /// [`Camera::for_scene`] for a scene without a camera of its own, +y up.
+    fn for_y_up_scene(scene: &Scene, width: u32, height: u32) -> Camera {
         // Several rooms (more than one light facing down): any eye chosen from the bounding
         // box alone may stand inside a wall or outside every room, seeing only backs.
         let ceiling_lights = scene
@@ -365,6 +436,57 @@ mod tests {
             );
             write_png(&img, &dir.join("room-cornell-camera.png")).unwrap();
         }
+    }
+
+    #[test]
+    fn a_z_up_room_is_framed_with_z_up_and_an_eye_on_a_wall_sees_the_room() {
+        // QA of issue #16: a z-up room was looked at from 9 cm above its floor, sideways.
+        // The room above turned so that +y goes to +z ((x, y, z) -> (x, -z, y), a rotation).
+        let mut s = room();
+        for surf in &mut s.surfaces {
+            for v in &mut surf.vertices {
+                *v = dvec3(v.x, -v.z, v.y);
+            }
+        }
+        assert!(z_is_up(&s) && !z_is_up(&room()));
+        let cam = Camera::for_scene(&s, 96, 72);
+        let y_up = Camera::for_scene(&room(), 96, 72);
+        let turn = |v: DVec3| dvec3(v.x, -v.z, v.y);
+        // The y-up room's camera, turned the same way.
+        assert!((cam.up - DVec3::Z).length() < 1e-12, "{cam:?}");
+        assert!(
+            (cam.eye - turn(y_up.eye)).length() < 1e-9,
+            "{cam:?} {y_up:?}"
+        );
+        assert!((cam.look_at - turn(y_up.look_at)).length() < 1e-9);
+        // An eye exactly on the front wall's plane (z = 0 in the y-up room) sees the room
+        // in front of it, not the wall's back at t = 0: no pixel black.
+        let s = room();
+        let mesh = mesh_scene(&s, 1500.0).unwrap();
+        let eb = made_up_b(&s, &mesh);
+        let vb = vertex_radiosity(&mesh, &eb);
+        let cam = Camera {
+            eye: dvec3(278.0, 273.0, 0.0),
+            look_at: dvec3(278.0, 273.0, 559.0),
+            up: DVec3::Y,
+            fov_y_degrees: 60.0,
+            width: 24,
+            height: 24,
+        };
+        let settings = RenderSettings {
+            exposure_scale: crate::render::tonemap::Exposure::Auto.scale(&s, &mesh, &eb),
+            ..RenderSettings::default()
+        };
+        let img = render(
+            &Renderer::new(&mesh),
+            &cam,
+            &eb,
+            &vb,
+            &settings,
+            &NoProgress,
+        );
+        let black = img.pixels().filter(|p| p.0 == [0; 3]).count();
+        assert_eq!(black, 0);
     }
 
     #[test]
