@@ -237,7 +237,8 @@ pub struct SolveOptions {
     /// time grows with this: at the default, the million-element building gathers at
     /// 236,916 points in about 110 s of CPU (BENCHMARKS.md), the Cornell box at --max-area
     /// 10 at its 176,191 leaves in about 8 s (README, two idle cores).
-    #[arg(long, value_name = "N", default_value_t = radiosity::solve::GATHER_POINTS_DEFAULT)]
+    #[arg(long, value_name = "N", default_value_t = radiosity::solve::GATHER_POINTS_DEFAULT,
+          value_parser = parse_gather_points)]
     pub gather_points: usize,
     /// Dense solvers: rounds of adaptive subdivision after the first solve (each splits
     /// the elements whose luminance steps against a neighbour's, then solves again; 2 is a
@@ -754,7 +755,8 @@ pub struct ViewArgs {
     /// `--bench-triangles`) and edit-to-picture time at `--bench-elements`, print Markdown.
     #[arg(long)]
     pub bench: bool,
-    /// Triangles of the large frame-time scene (0 skips it).
+    /// Triangles of the large frame-time scene, rounded up to whole copies of a Cornell box
+    /// of about 10,000 elements (some 19,000 triangles each; at least one copy); 0 skips it.
     #[arg(long, default_value_t = 1_000_000, value_name = "N")]
     pub bench_triangles: usize,
     /// Element counts for edit-to-picture timing (comma-separated): the Cornell box is
@@ -884,7 +886,24 @@ pub fn value_error(e: &clap::Error) -> Option<String> {
 fn whole_number_at_least(text: &str, min: u32) -> Result<u32, String> {
     match text.trim().parse::<u32>() {
         Ok(n) if n >= min => Ok(n),
-        _ => Err(format!("give a whole number of at least {min}")),
+        _ => Err(format!(
+            "give {}",
+            at_least_words(text, min.into(), u32::MAX.into())
+        )),
+    }
+}
+
+/// "a whole number of at least MIN", or "from MIN to MAX" for a whole number past `max`
+/// (QA of issue #16: `--width 4294967297` was told to be "at least 1").
+fn at_least_words(text: &str, min: u64, max: u64) -> String {
+    let digits = text.trim();
+    let too_large = !digits.is_empty()
+        && digits.chars().all(|c| c.is_ascii_digit())
+        && digits.parse::<u64>().map_or(true, |n| n > max);
+    if too_large {
+        format!("a whole number from {min} to {max}")
+    } else {
+        format!("a whole number of at least {min}")
     }
 }
 
@@ -905,7 +924,10 @@ pub fn parse_supersample(text: &str) -> Result<u32, String> {
 /// `--steps`: the points along each axis of an element, 1 or more.
 pub fn parse_steps(text: &str) -> Result<u32, String> {
     whole_number_at_least(text, 1).map_err(|_| {
-        "give the points along each axis of an element, a whole number of at least 1".into()
+        format!(
+            "give the points along each axis of an element, {}",
+            at_least_words(text, 1, u32::MAX.into())
+        )
     })
 }
 
@@ -918,8 +940,24 @@ pub fn parse_resolution(text: &str) -> Result<u32, String> {
 
 /// `--samples`: Monte Carlo rays per element, 1 or more.
 pub fn parse_samples(text: &str) -> Result<u32, String> {
-    whole_number_at_least(text, 1)
-        .map_err(|_| "give the Monte Carlo rays per element, a whole number of at least 1".into())
+    whole_number_at_least(text, 1).map_err(|_| {
+        format!(
+            "give the Monte Carlo rays per element, {}",
+            at_least_words(text, 1, u32::MAX.into())
+        )
+    })
+}
+
+/// `--gather-points`: the most points the final gather gathers at, 1 or more.
+pub fn parse_gather_points(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "give the most points the final gather gathers at, {} (--no-final-gather leaves \
+             the gather out)",
+            at_least_words(text, 1, usize::MAX as u64)
+        )),
+    }
 }
 
 /// [`whole_number_at_least`] 1: image sizes.
@@ -935,13 +973,16 @@ pub fn parse_at_least_2(text: &str) -> Result<u32, String> {
 /// `--eye`, `--look-at`, `--up`: three finite numbers "x,y,z".
 pub fn parse_vec3(text: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f64> = parts
-        .iter()
-        .filter_map(|p| p.parse::<f64>().ok())
-        .filter(|v| v.is_finite())
-        .collect();
+    let values: Vec<f64> = parts.iter().filter_map(|p| p.parse::<f64>().ok()).collect();
     if parts.len() != 3 || values.len() != 3 {
         return Err("give three numbers \"x,y,z\"".into());
+    }
+    // QA of issue #16: "1e400" reads as a number, past the largest a double holds.
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        return Err(format!(
+            "give three numbers \"x,y,z\" ({} is not a finite number)",
+            parts[k]
+        ));
     }
     Ok(DVec3::new(values[0], values[1], values[2]))
 }

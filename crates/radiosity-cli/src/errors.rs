@@ -71,6 +71,27 @@ pub fn plain_io_words(text: &str) -> String {
         .fold(out, |text, (os, ours)| text.replace(os, ours))
 }
 
+/// For an LU matrix past the memory, how long LU takes at the size that would fit (QA of
+/// issue #16: the refusal offered 43,004 elements, half an hour of LU or more): its time
+/// grows as the cube of the elements, 2.45 s measured at 4,584 elements on two cores
+/// (`radiosity solve --solver lu --max-area 500`, December 2026).
+fn lu_time(m: &radiosity::form_factor::OutOfMemory) -> String {
+    if !m.what.contains("LU") {
+        return String::new();
+    }
+    let seconds = 2.45 * (m.fits as f64 / 4584.0).powi(3);
+    let time = if seconds < 120.0 {
+        format!("{seconds:.0} s")
+    } else {
+        format!("{:.0} minutes", seconds / 60.0)
+    };
+    format!(
+        "; LU's time grows as the cube of the elements: about {time} on two cores at {} \
+         elements (Gauss-Seidel's, --solver gauss-seidel, as the square)",
+        m.fits
+    )
+}
+
 /// What to run instead, in this program's commands and flags, for a library error that can
 /// be fixed by other settings: text to append to its message. The library's messages state
 /// what is wrong with the numbers; only the command line knows its flags.
@@ -80,8 +101,8 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
     const RECOMPUTE: &str = "; recompute it with `radiosity formfactors`";
     if let Some(e) = err.downcast_ref::<PipelineError>() {
         return match e {
-            PipelineError::OutOfMemory(_) | PipelineError::Solve(SolveError::OutOfMemory(_)) => {
-                Some(MEMORY.into())
+            PipelineError::OutOfMemory(m) | PipelineError::Solve(SolveError::OutOfMemory(m)) => {
+                Some(format!("{MEMORY}{}", lu_time(m)))
             }
             PipelineError::TooManyIntegrationPoints { .. } => {
                 Some("; use fewer steps (--steps) or larger elements (--max-area)".into())

@@ -233,8 +233,8 @@ pub fn energy_band(b: &EnergyBalance) -> Option<usize> {
 const BAND_NAMES: [&str; 3] = ["R", "G", "B"];
 
 /// Notes where the emitted power went (in the band that emits most, as `check` gives it):
-/// absorbed, and escaped (light that reached no element: through openings, into gaps and
-/// the backs of faces, or counted twice where negative), so every solve says how far its
+/// absorbed, and escaped (light that reached no element: out of the scene where it is
+/// open, into gaps and the backs of faces, or counted twice where negative), so every solve says how far its
 /// light can be trusted. `check` prints the same account in full and, for a matrix solve,
 /// says through which surfaces the escaped part goes.
 pub fn energy_note(
@@ -456,7 +456,10 @@ fn escaped_meaning(percent: f64) -> String {
 
 /// Where light that reaches no element goes: one wording for the energy note, `check`'s
 /// energy line and its list of surfaces (QA of issue #16: they said it three ways).
-const ESCAPED: &str = "through openings, into gaps and contacts or onto the backs of faces";
+// "out of the scene where it is open", not "through openings" (QA of issue #16: light
+// into OPENING surfaces is counted as absorbed, and the word read as those).
+const ESCAPED: &str =
+    "out of the scene where it is open, into gaps and contacts or onto the backs of faces";
 
 /// Why a solve with reciprocal form factors loses part of the account: the relative
 /// residual is the largest single element's, over the brightest emission, so thousands

@@ -294,9 +294,7 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
             bail!("--min-area {a}: give the smallest element area (scene units squared), a number above 0");
         }
     }
-    if options.gather_points == 0 {
-        bail!("--gather-points 0: give the most points the final gather gathers at, at least 1 (--no-final-gather leaves the gather out)");
-    }
+    // --gather-points 0 is refused while parsing (args::parse_gather_points).
     if options.max_shots == 0 {
         bail!("--max-shots 0: give the most shots progressive radiosity takes, at least 1");
     }
@@ -326,7 +324,7 @@ fn max_area_origin(args: &SceneArgs) -> String {
     };
     if Format::of_path(path) != Some(Format::Scene) {
         return format!(
-            "{}: the MAX_PATCH_AREA given to an imported scene (its total area / 1000)",
+            "{}: error: the MAX_PATCH_AREA given to an imported scene (its total area / 1000)",
             path.display()
         );
     }
@@ -345,8 +343,10 @@ fn max_area_origin(args: &SceneArgs) -> String {
             .then(|| (i + 1, words.next().unwrap_or("").to_string()))
     });
     match line {
-        Some((n, value)) => format!("{}:{n}: MAX_PATCH_AREA {value}", path.display()),
-        None => format!("{}: MAX_PATCH_AREA", path.display()),
+        // In the compiler's form of the reader's errors ("file:line: error: ..."; QA of
+        // issue #16: "error: m.scene:1: MAX_PATCH_AREA" stood beside "m.scene:1:16: error:").
+        Some((n, value)) => format!("{}:{n}: error: MAX_PATCH_AREA {value}", path.display()),
+        None => format!("{}: error: MAX_PATCH_AREA", path.display()),
     }
 }
 

@@ -332,7 +332,8 @@ pub fn run_all(
     ));
     if big_triangles > 0 {
         log(&format!(
-            "frame time: about {big_triangles} triangles of tiled Cornell boxes, {frames} frames"
+            "frame time: {big_triangles} triangles asked for, rounded up to whole tiled \
+             Cornell boxes, {frames} frames"
         ));
         let (_, fine, fb, fscale) = solved_cornell(cornell_max_area_for(10_000))?;
         let per_copy = geometry_vertices(&fine, &[]).len() / 3;

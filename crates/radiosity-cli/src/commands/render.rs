@@ -217,6 +217,43 @@ pub fn run(args: RenderArgs) -> Result<()> {
             camera.height
         ));
     }
+    // A wireframe of a mesh that the solve does not change (dense or progressive, no
+    // adaptive subdivision) needs no light: no form factors and no solve (QA of issue #16:
+    // it computed both, minutes on a large scene, for white lines on black).
+    let adapt = crate::setup::adapt(&args.solve, &prepared, &solver)?;
+    if wireframe
+        && args.snapshots.is_none()
+        && adapt.is_none()
+        && !matches!(solver, radiosity::solve::Solver::Hierarchical(_))
+    {
+        reporter.note(
+            "wireframe of the mesh: no form factors or solve (the lines are the same \
+             whatever the light; hierarchical radiosity and --adapt-rounds solve first, as \
+             they make their own elements)",
+        );
+        let black = vec![[0.0; 3]; prepared.mesh.len()];
+        let image = shade_and_render(
+            &prepared,
+            &prepared.mesh,
+            &black,
+            &camera,
+            settings,
+            1.0,
+            &reporter,
+        )?;
+        run_file_stage(&reporter, Stage::Write, &output, || {
+            render::write_png(&image, &output)
+        })
+        .with_context(|| format!("cannot write {}", output.display()))?;
+        reporter.note(&format!(
+            "wrote {} ({} x {})",
+            output.display(),
+            image.width(),
+            image.height()
+        ));
+        reporter.print_timings();
+        return Ok(());
+    }
     // Snapshots render the display radiosity (B plus the ambient term) with a quiet
     // reporter, so that their shading and rendering do not count in the stage times.
     let mut snapshot_error = None;
@@ -259,7 +296,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let (solution, _) = solve_scene(
         &prepared,
         solver,
-        crate::setup::adapt(&args.solve, &prepared, &solver)?,
+        adapt,
         args.solve.form_factors.as_deref(),
         &mut observer,
         &reporter,

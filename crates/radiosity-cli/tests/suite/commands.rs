@@ -819,7 +819,7 @@ fn hostile_scene_geometry_is_refused_with_file_and_line() {
             "1e-300",
             "0 0 0",
             "1 1 1",
-            "error: h.scene:1: MAX_PATCH_AREA 1e-300: meshing",
+            "h.scene:1: error: MAX_PATCH_AREA 1e-300: meshing",
         ),
     ];
     for (max_area, origin, size, expected) in cases {

@@ -600,7 +600,7 @@ fn check_gives_the_reason_for_a_non_reciprocal_energy_account() {
     let escaped = text
         .lines()
         .filter(|l| {
-            l.contains("through openings, into gaps and contacts or onto the backs of faces")
+            l.contains("out of the scene where it is open, into gaps and contacts or onto the backs of faces")
         })
         .count();
     assert_eq!(escaped, 2, "{text}");
@@ -2722,5 +2722,41 @@ fn ninth_pass_findings_are_said() {
         "{err}"
     );
     assert!(!err.contains("move --eye"), "{err}");
+    // A wireframe of the dense mesh draws its lines without form factors or a solve.
+    let out = radiosity(
+        &[
+            "render",
+            "--shading",
+            "wireframe",
+            "--width",
+            "16",
+            "-o",
+            "w.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("wireframe of the mesh: no form factors or solve"),
+        "{err}"
+    );
+    let timings = err
+        .lines()
+        .find(|l| l.starts_with("timings:"))
+        .unwrap_or("");
+    assert!(
+        timings.contains("render")
+            && !timings.contains("form factors")
+            && !timings.contains("solve"),
+        "{err}"
+    );
+    // A number past the largest a flag takes is told its range, not "at least 1".
+    let out = radiosity(&["render", "--width", "4294967297"], &dir);
+    assert!(
+        stderr(&out).contains("--width 4294967297: give a whole number from 1 to 4294967295"),
+        "{}",
+        stderr(&out)
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -152,6 +152,29 @@ pub fn parse(
     for e in &drawing.entities {
         builder.entity(e, &DMat4::IDENTITY, None)?;
     }
+    // No face at all: said before the materials file is asked for (QA of issue #16: a
+    // drawing of lines asked for a materials file for its layers with faces, of which it
+    // had none).
+    if builder.faces.is_empty() {
+        let left_out: Vec<String> = drawing
+            .ignored
+            .iter()
+            .map(|(k, n)| format!("{n} {k}"))
+            .collect();
+        return Err(syntax(
+            0,
+            format!(
+                "no usable faces: the drawing has no 3DFACE, polyface mesh or MESH{}",
+                match left_out.is_empty() {
+                    true => String::new(),
+                    false => format!(
+                        " (its entities, which give no faces: {})",
+                        left_out.join(", ")
+                    ),
+                }
+            ),
+        ));
+    }
     let table = materials
         .map(|t| MaterialsFile::parse(materials_file, t))
         .transpose()?;

@@ -385,6 +385,22 @@ fn a_missing_layer_or_materials_file_lists_the_layers_found() {
 }
 
 #[test]
+fn a_drawing_without_faces_says_so_before_asking_for_materials() {
+    // QA of issue #16: a drawing of lines asked for a materials file naming its layers
+    // with faces, of which it had none.
+    let line = "0\nLINE\n8\nWalls\n10\n0\n20\n0\n30\n0\n11\n1\n21\n0\n31\n0\n";
+    assert_eq!(
+        err(&dxf("", line), None),
+        "t.dxf: error: no usable faces: the drawing has no 3DFACE, polyface mesh or MESH (its \
+         entities, which give no faces: 1 LINE)"
+    );
+    assert_eq!(
+        err(&dxf("", ""), None),
+        "t.dxf: error: no usable faces: the drawing has no 3DFACE, polyface mesh or MESH"
+    );
+}
+
+#[test]
 fn a_table_that_names_no_layer_is_pointed_out() {
     let text = dxf("", &(square("Floor", 0.0, 0.0) + &square("Wall", 2.0, 0.0)));
     // Misspelt beside a [default]: read, with a warning at the table's line.

@@ -448,10 +448,16 @@ impl FaceSoup {
             }
             drop[upper] = true;
             if named.len() < NAMED_IN_WARNING {
-                named.push(format!(
-                    "\"{}\" (the same as \"{}\")",
-                    surfaces[upper].name, surfaces[lower].name
-                ));
+                // One name for both (a shape placed twice): said once (QA of issue #16:
+                // "\"Lamp.0\" (the same as \"Lamp.0\")").
+                named.push(if surfaces[upper].name == surfaces[lower].name {
+                    format!("\"{}\" (twice)", surfaces[upper].name)
+                } else {
+                    format!(
+                        "\"{}\" (the same as \"{}\")",
+                        surfaces[upper].name, surfaces[lower].name
+                    )
+                });
             }
         }
         let count = drop.iter().filter(|&&d| d).count();

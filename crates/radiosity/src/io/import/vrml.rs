@@ -758,13 +758,16 @@ impl Builder<'_> {
             });
         }
         if let Some(&line) = self.bright.first() {
+            // Counted by where they are written: a Material used again (USE) is one
+            // (QA of issue #16: "2 Materials" for one used twice).
+            let written: std::collections::BTreeSet<usize> = self.bright.iter().copied().collect();
             out.push(ImportWarning {
                 file: self.file.clone(),
                 line,
                 message: format!(
                     "{} Material{} with a diffuseColor of 1 or more taken as reflectance {MAX_REFLECTANCE} (a surface cannot reflect all the light it receives)",
-                    self.bright.len(),
-                    if self.bright.len() == 1 { "" } else { "s" }
+                    written.len(),
+                    if written.len() == 1 { "" } else { "s" }
                 ),
             });
         }
