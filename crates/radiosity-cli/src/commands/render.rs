@@ -523,7 +523,24 @@ fn false_colour(
             .map(|p| p.expect("a wireframe is refused above"))
     };
     let pixels = linear(&values, reporter)?;
-    let coverage = linear(&ones, &Reporter::new(true))?;
+    // The share of each pixel's rays that met a front, a hole's front (a dropped buried
+    // piece seen through a gap) counted whole, so that its open share darkens the lux
+    // rather than turning it into background.
+    let coverage = {
+        let renderer =
+            radiosity::render::Renderer::for_settings(&solution.mesh, &prepared.scene, &settings)
+                .counting_coverage();
+        let vertex_ones = radiosity::shade::vertex_radiosity(&solution.mesh, &ones);
+        radiosity::render::render_linear(
+            &renderer,
+            camera,
+            &ones,
+            &vertex_ones,
+            &settings,
+            &Reporter::new(true),
+        )?
+        .expect("a wireframe is refused above")
+    };
     let (pixel_lux, coverage): (Vec<f64>, Vec<f64>) = pixels
         .iter()
         .zip(&coverage)

@@ -2751,6 +2751,37 @@ fn ninth_pass_findings_are_said() {
             && !timings.contains("solve"),
         "{err}"
     );
+    // --false-colour through the 5 cm gap above a luminaire housing: the ceiling there
+    // (dropped as buried) is dark, not the white of the background.
+    let scene = crate::fixtures::example("room_downlights.scene");
+    let out = radiosity(
+        &[
+            "render",
+            &scene,
+            "--eye",
+            "2.6,2.45,1.5",
+            "--look-at",
+            "1.8,2.68,1.5",
+            "--fov",
+            "30",
+            "--width",
+            "48",
+            "--false-colour",
+            "-o",
+            "fc.png",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(dir.join("fc.png")).unwrap().to_rgb8();
+    // Whitish: every channel above 200 (no colour of the scale is; the background mixed
+    // with blue at the strip's edges is).
+    let whitish = (0..48)
+        .flat_map(|x| (0..48).map(move |y| (x, y)))
+        .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&c| c > 200))
+        .count();
+    assert_eq!(whitish, 0, "background in the view of a closed room");
     // A number past the largest a flag takes is told its range, not "at least 1".
     let out = radiosity(&["render", "--width", "4294967297"], &dir);
     assert!(

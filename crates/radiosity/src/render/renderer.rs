@@ -70,6 +70,9 @@ pub struct Renderer<'m> {
     /// The scene's surfaces, where rays meet the holes that dropped buried pieces leave
     /// ([`Renderer::with_holes_covered`]).
     holes: Option<Holes>,
+    /// A ray that meets a hole's front counts whole, not times its open share
+    /// ([`Renderer::counting_coverage`]).
+    coverage: bool,
 }
 
 impl<'m> Renderer<'m> {
@@ -125,7 +128,17 @@ impl<'m> Renderer<'m> {
             direct: None,
             adaptive: None,
             holes: None,
+            coverage: false,
         }
+    }
+
+    /// For a render of ones that says which share of each pixel's rays met a front: a ray
+    /// that meets a hole's front (a dropped buried piece seen through a gap) counts 1, not
+    /// its open share (QA of issue #16: `--false-colour` divides the illuminance by this
+    /// share, and the gap above a light panel, open share 0, came out as background white).
+    pub fn counting_coverage(mut self) -> Renderer<'m> {
+        self.coverage = true;
+        self
     }
 
     /// The renderer of `mesh` (cut from `scene`) that `settings` ask for: with the direct
@@ -396,7 +409,11 @@ impl<'m> Renderer<'m> {
                         Shading::Smooth => interpolation(self.mesh, e, at).of(vertex_b),
                         Shading::Wireframe => [0.0; 3],
                     };
-                    let open = holes.open_share(surface, x);
+                    let open = if self.coverage {
+                        1.0
+                    } else {
+                        holes.open_share(surface, x)
+                    };
                     let value = near.map(|b| b * open);
                     return Seen {
                         value,
