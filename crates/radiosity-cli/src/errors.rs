@@ -150,6 +150,15 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
         return match e {
             SolveError::OutOfMemory(_) => Some(MEMORY.into()),
             SolveError::HierarchicalTooBig { .. } => Some(": raise --epsilon or --min-area".into()),
+            // QA of issue #16: a closed box of reflectance 0.97 stopped with "rows summing
+            // far above 1?", and the CIE 5.8 cube of 0.95 ran 100,000 sweeps.
+            SolveError::HierarchicalGrowing { .. }
+            | SolveError::HierarchicalNotConverged { .. } => Some(
+                "; --solver gauss-seidel (the dense matrix, its rows summing to 1 within \
+                     0.2 % in a closed room) or --solver progressive solves it, or a smaller \
+                     --epsilon makes the links' estimates finer"
+                    .into(),
+            ),
             SolveError::NotConverged { .. } => {
                 Some(" (--tolerance loosens it; --solver lu solves directly)".into())
             }

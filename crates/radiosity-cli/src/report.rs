@@ -290,7 +290,7 @@ pub fn energy_note(
 }
 
 /// The first three of `names` and how many more: "a, b, c, 2 more".
-fn first_three(names: &[String]) -> String {
+pub fn first_three(names: &[String]) -> String {
     let mut shown: Vec<String> = names.iter().take(3).cloned().collect();
     if names.len() > 3 {
         shown.push(format!("{} more", names.len() - 3));

@@ -438,6 +438,14 @@ pub fn note_output(path: &Path, flag: &str, label: &str) -> Result<()> {
     let Ok(mut outputs) = OUTPUTS.lock() else {
         return Ok(());
     };
+    // The same output noted again (a command checked twice, or run again in one process,
+    // as `radiosity-mpi` and the tests do) is no clash.
+    if outputs
+        .iter()
+        .any(|o| o.path == path && o.flag == flag && o.label == label)
+    {
+        return Ok(());
+    }
     if let Some(earlier) = outputs
         .iter()
         .find(|o| o.path == path || radiosity::io::is_same_file(&o.path, path))
@@ -570,9 +578,45 @@ pub fn load_scene(
             for w in sideways_lights(&imported.file.scene) {
                 errln!("{}: warning: {w}", path.display());
             }
+            if let Some(w) = unnamed_surfaces(&imported.file.scene) {
+                errln!("{}: warning: {w}", path.display());
+            }
             Ok((imported.file, stem_of(Some(path))))
         }
     }
+}
+
+/// A warning for surfaces whose name is empty (a bare `#` line): the reports' rows and an
+/// export name them otherwise (QA of issue #16: the `--report` CSV row began with an empty
+/// field, and `export` called the surface "surface6").
+pub fn unnamed_surfaces(scene: &Scene) -> Option<String> {
+    let unnamed: Vec<String> = scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.name.is_empty())
+        .map(|(i, _)| i.to_string())
+        .collect();
+    if unnamed.is_empty() {
+        return None;
+    }
+    Some(format!(
+        "{} no name (an empty # line): {} {}; reports show an empty name for {} and exports \
+         call {} \"surfaceN\"; give each a name after its #",
+        if unnamed.len() == 1 {
+            "a surface has"
+        } else {
+            "surfaces have"
+        },
+        if unnamed.len() == 1 {
+            "surface"
+        } else {
+            "surfaces"
+        },
+        crate::report::first_three(&unnamed),
+        if unnamed.len() == 1 { "it" } else { "them" },
+        if unnamed.len() == 1 { "it" } else { "them" },
+    ))
 }
 
 /// Warnings for luminaires with a shaped distribution (COSINE, IES) aimed along the default

@@ -59,6 +59,29 @@ pub enum SolveError {
         /// Sweeps made.
         sweeps: usize,
     },
+    /// Hierarchical radiosity's light grew sweep after sweep: its links' form factors,
+    /// estimates, sum a little above 1 for some elements, and with reflectances near 1 that
+    /// is enough to make the light grow without end (QA of issue #16: a closed box of
+    /// reflectance 0.97 "diverged" with "rows summing far above 1?").
+    #[error(
+        "hierarchical radiosity's light grows without settling: the power a sweep changes \
+         rose for {rising} sweeps in a row, to {change:.3} of the emitted power after sweep \
+         {sweep}; its links estimate form factors, which can sum a little above 1, and with \
+         reflectance up to {rho_max} (light kept {kept:.0} times over) that is enough to make \
+         the light grow"
+    )]
+    HierarchicalGrowing {
+        /// Consecutive sweeps whose change rose.
+        rising: usize,
+        /// The last sweep's change, a fraction of the emitted power.
+        change: f64,
+        /// The sweep.
+        sweep: usize,
+        /// The largest reflectance.
+        rho_max: f64,
+        /// 1 / (1 - rho_max): how often light is passed on before it is spent.
+        kept: f64,
+    },
     /// A solver produced a radiosity that is not a finite number (NaN or infinity). It is
     /// never treated as converged: NaN compares false with every tolerance.
     #[error(

@@ -35,11 +35,24 @@ fn front_side_is_open(scene: &Scene, lo: DVec3, hi: DVec3) -> bool {
     escaped > 12
 }
 
-/// Whether the scene's lights say that +z is up rather than +y: more emitting power in
-/// surfaces facing down along z (normal z below -0.7) than along y; without such surfaces,
-/// more point lights in the top quarter of the z extent (and not of the y extent) than the
-/// other way round. +y (the paper's convention, and glTF's) otherwise.
+/// Whether the scene's lights say that +z is up rather than +y, and its shape allows it.
+///
+/// The lights: the emitting power in surfaces facing down along an axis (normal below
+/// -0.7) less that facing up along it, for y and for z; a ceiling light faces down, and
+/// windows in opposite walls cancel (QA of issue #16: a generated building's windows facing
+/// -z outweighed its ceiling light and turned the camera on its side). Without emitting
+/// surfaces facing either way, more point lights in the top quarter of the z extent (and
+/// not of the y extent) than the other way round. The shape: a z-up verdict also needs the
+/// z extent no larger than the y extent (rooms and buildings are wider than they are tall,
+/// so a y-up room lit through one window facing -z stays y-up). +y (the paper's
+/// convention, and glTF's) otherwise.
 pub fn z_is_up(scene: &Scene) -> bool {
+    let (lo, hi) = scene.bounds();
+    let size = hi - lo;
+    if !(size.z <= size.y) {
+        return false;
+    }
+    // Down-facing less up-facing emitting power, along y and along z.
     let (mut down_y, mut down_z) = (0.0, 0.0);
     for s in scene
         .surfaces
@@ -50,16 +63,26 @@ pub fn z_is_up(scene: &Scene) -> bool {
             continue;
         };
         let power = crate::geometry::polygon_area(&s.vertices) * s.emission.max_band();
-        if n.y < -0.7 {
-            down_y += power;
-        } else if n.z < -0.7 {
-            down_z += power;
+        if n.y.abs() > 0.7 {
+            down_y -= power * n.y.signum();
+        } else if n.z.abs() > 0.7 {
+            down_z -= power * n.z.signum();
         }
     }
+    // Power balances within rounding count as none.
+    let total: f64 = scene
+        .surfaces
+        .iter()
+        .map(|s| crate::geometry::polygon_area(&s.vertices) * s.emission.max_band())
+        .sum();
+    let tiny = 1e-9 * total;
+    let (down_y, down_z) = (
+        if down_y.abs() <= tiny { 0.0 } else { down_y },
+        if down_z.abs() <= tiny { 0.0 } else { down_z },
+    );
     if down_y > 0.0 || down_z > 0.0 {
         return down_z > down_y;
     }
-    let (lo, hi) = scene.bounds();
     let near_top = |p: DVec3, axis: usize| {
         let span = hi[axis] - lo[axis];
         span > 0.0 && (p[axis] - lo[axis]) / span > 0.75
@@ -449,6 +472,27 @@ mod tests {
             }
         }
         assert!(z_is_up(&s) && !z_is_up(&room()));
+        // A y-up room lit by two strong windows in opposite walls (facing -z and +z) and a
+        // weaker ceiling light stays y-up (QA of issue #16: a generated building's windows
+        // turned its camera on its side).
+        let mut windows = room();
+        let window = |z: f64, facing_minus_z: bool| {
+            let mut v = vec![
+                dvec3(200., 100., z),
+                dvec3(350., 100., z),
+                dvec3(350., 300., z),
+                dvec3(200., 300., z),
+            ];
+            if facing_minus_z {
+                v.reverse();
+            }
+            surface("window", 50.0, v)
+        };
+        windows.surfaces.push(window(558.0, true));
+        windows.surfaces.push(window(1.0, false));
+        let n = crate::geometry::polygon_normal(&windows.surfaces[7].vertices).unwrap();
+        assert!(n.z < -0.7, "{n}");
+        assert!(!z_is_up(&windows));
         let cam = Camera::for_scene(&s, 96, 72);
         let y_up = Camera::for_scene(&room(), 96, 72);
         let turn = |v: DVec3| dvec3(v.x, -v.z, v.y);

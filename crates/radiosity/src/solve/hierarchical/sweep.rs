@@ -13,6 +13,11 @@ use crate::solve::SolveError;
 /// Give up after this many sweeps in one solve.
 const MAX_SWEEPS: usize = 100_000;
 
+/// Sweeps in a row whose changed power rises before the light is said to grow without end:
+/// a converging solve's change falls every sweep (after the first few, where the light
+/// still spreads), so twenty rises in a row is growth, not a wobble.
+const RISING_SWEEPS: usize = 20;
+
 impl Solver<'_> {
     /// Pushes irradiance down and pulls radiosity (and power bins) up from node `n`;
     /// `down` is the irradiance from above as bins (clusters) or reduced to n's normal
@@ -196,6 +201,8 @@ impl Solver<'_> {
         emitted: [f64; 3],
         tolerance: f64,
     ) -> Result<(usize, f64), SolveError> {
+        let rho_max = self.rho.iter().flatten().fold(0.0, |m: f64, &r| m.max(r));
+        let (mut previous, mut rising) = (f64::INFINITY, 0);
         for sweep in 1..=MAX_SWEEPS {
             let this = &*self;
             let gathered: Vec<[f64; 3]> = this
@@ -241,10 +248,23 @@ impl Solver<'_> {
                     after: format!("sweep {sweep}"),
                 });
             }
+            // A converging sweep changes less than the one before it (by rho times the
+            // form factors' sum, below 1); a change that rises sweep after sweep is light
+            // growing, whatever bound it has yet to reach.
+            rising = if residual > previous { rising + 1 } else { 0 };
+            previous = residual;
+            if rising >= RISING_SWEEPS {
+                return Err(SolveError::HierarchicalGrowing {
+                    rising,
+                    change: residual,
+                    sweep,
+                    rho_max,
+                    kept: 1.0 / (1.0 - rho_max).max(1e-12),
+                });
+            }
             // The power a sweep changes is at most the power in the scene, which valid
             // links keep below emitted / (1 - rho_max); twice that leaves room for the
             // links' own error.
-            let rho_max = self.rho.iter().flatten().fold(0.0, |m: f64, &r| m.max(r));
             let limit = 2.0 / (1.0 - rho_max).max(1e-12);
             if residual > limit {
                 return Err(SolveError::Diverged {
