@@ -96,13 +96,13 @@ fn lu_time(m: &radiosity::form_factor::OutOfMemory) -> String {
 /// be fixed by other settings: text to append to its message. The library's messages state
 /// what is wrong with the numbers; only the command line knows its flags.
 pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
-    const MEMORY: &str = " (raise MAX_PATCH_AREA with --max-area, or use --solver hierarchical \
-                          or --solver progressive, which keep no matrix)";
+    let memory = memory_hint();
+    let memory = memory.as_str();
     const RECOMPUTE: &str = "; recompute it with `radiosity formfactors`";
     if let Some(e) = err.downcast_ref::<PipelineError>() {
         return match e {
             PipelineError::OutOfMemory(m) | PipelineError::Solve(SolveError::OutOfMemory(m)) => {
-                Some(format!("{MEMORY}{}", lu_time(m)))
+                Some(format!("{}{memory}{}", fits_area(m), lu_time(m)))
             }
             PipelineError::TooManyIntegrationPoints { .. } => {
                 Some("; use fewer steps (--steps) or larger elements (--max-area)".into())
@@ -142,13 +142,15 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
                 method_flags(expected),
                 method_flags(found)
             )),
-            FormFactorFileError::OutOfMemory { .. } => Some(MEMORY.into()),
+            FormFactorFileError::OutOfMemory { source, .. } => {
+                Some(format!("{}{memory}", fits_area(source)))
+            }
             _ => Some(RECOMPUTE.into()),
         };
     }
     if let Some(e) = err.downcast_ref::<SolveError>() {
         return match e {
-            SolveError::OutOfMemory(_) => Some(MEMORY.into()),
+            SolveError::OutOfMemory(m) => Some(format!("{}{memory}", fits_area(m))),
             SolveError::HierarchicalTooBig { .. } => Some(": raise --epsilon or --min-area".into()),
             // QA of issue #16: a closed box of reflectance 0.97 stopped with "rows summing
             // far above 1?", and the CIE 5.8 cube of 0.95 ran 100,000 sweeps.
@@ -186,7 +188,38 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
             _ => None,
         };
     }
-    err.downcast_ref::<OutOfMemory>().map(|_| MEMORY.into())
+    err.downcast_ref::<OutOfMemory>()
+        .map(|m| format!("{}{memory}", fits_area(m)))
+}
+
+/// The command being run ("formfactors"), for hints that depend on it; set by `main`.
+pub static COMMAND: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
+/// What to change when a dense matrix does not fit: a larger MAX_PATCH_AREA, or (where the
+/// command solves) a solver that keeps no matrix (QA of issue #16: `formfactors`, whose
+/// output is the matrix, was offered `--solver`, a flag it does not have).
+fn memory_hint() -> String {
+    match COMMAND.get().map(String::as_str) {
+        Some("formfactors") => " (raise MAX_PATCH_AREA with --max-area: the matrix is what \
+                                `formfactors` writes, so it must fit)"
+            .to_string(),
+        _ => " (raise MAX_PATCH_AREA with --max-area, or use --solver hierarchical or \
+              --solver progressive, which keep no matrix)"
+            .to_string(),
+    }
+}
+
+/// "; about 2.7 times the MAX_PATCH_AREA": the elements go as one over the area, so the
+/// area that fits is the one used times n / fits (QA of issue #16: the refusal gave an
+/// element count, where the flag takes an area).
+fn fits_area(m: &OutOfMemory) -> String {
+    if m.fits == 0 || m.n <= m.fits {
+        return String::new();
+    }
+    format!(
+        ", at about {} times the MAX_PATCH_AREA",
+        crate::report::significant(m.n as f64 / m.fits as f64, 2)
+    )
 }
 
 /// The flags that give `camera`: `--eye x,y,z --look-at x,y,z --up x,y,z --fov F`.
@@ -238,7 +271,8 @@ mod tests {
     #[test]
     fn memory_errors_get_the_flags_that_help() {
         let want = "error: the form-factor matrix (f32) for 100000 elements needs 41962 MiB, but \
-                    only 1024 MiB of memory is available; at most 15621 elements would fit (raise \
+                    only 1024 MiB of memory is available; at most 15621 elements would fit, at \
+                    about 6.4 times the MAX_PATCH_AREA (raise \
                     MAX_PATCH_AREA with --max-area, or use --solver hierarchical or --solver \
                     progressive, which keep no matrix)";
         // However it reaches the command line.

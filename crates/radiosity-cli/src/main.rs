@@ -99,6 +99,7 @@ fn main() -> ExitCode {
         .try_get_matches()
         .and_then(|m| Cli::from_arg_matches(&m))
         .unwrap_or_else(|e| exit_with(e));
+    let _ = errors::COMMAND.set(command_name(&cli.command).to_string());
     // No output of this run may replace a file it read (an OBJ's MTL as much as the scene).
     radiosity::io::protect_inputs();
     match run(cli) {
@@ -134,6 +135,24 @@ fn exit_with(e: clap::Error) -> ! {
             std::process::exit(e.exit_code());
         }
         None => e.exit(),
+    }
+}
+
+/// The name of `command` as typed ("formfactors").
+fn command_name(command: &Command) -> &'static str {
+    match command {
+        Command::Render(_) => "render",
+        Command::Formfactors(_) => "formfactors",
+        Command::Solve(_) => "solve",
+        Command::Illuminance(_) => "illuminance",
+        Command::Check(_) => "check",
+        Command::Bench(_) => "bench",
+        Command::Compare(_) => "compare",
+        Command::Pathtrace(_) => "pathtrace",
+        Command::Export(_) => "export",
+        Command::View(_) => "view",
+        Command::Generate { .. } => "generate",
+        Command::Validate { .. } => "validate",
     }
 }
 

@@ -122,14 +122,18 @@ pub fn not_reciprocal(method: FormFactorMethod) -> Option<&'static str> {
     }
 }
 
-/// The name of element `e` for a note: `element 12 of surface 3 "Floor"`.
+/// The name of element `e` for a note: `element 12 of surface 3 "Floor"`, numbered within
+/// its surface from 0 as the solution CSV's `element` column is (QA of issue #16: notes
+/// named the mesh's running index, a different, lit element of the CSV).
 fn element_name(scene: &Scene, mesh: &Mesh, e: usize) -> String {
     match mesh.elements.get(e) {
         Some(el) => {
             let s = el.surface as usize;
+            let first = mesh.surface_elements.get(s).map_or(0, |r| r.start);
+            let k = e.saturating_sub(first as usize);
             match scene.surfaces.get(s).map(|x| x.name.as_str()) {
-                Some(name) if !name.is_empty() => format!("element {e} of surface {s} {name:?}"),
-                _ => format!("element {e} of surface {s}"),
+                Some(name) if !name.is_empty() => format!("element {k} of surface {s} {name:?}"),
+                _ => format!("element {k} of surface {s}"),
             }
         }
         None => format!("element {e}"),
@@ -149,12 +153,29 @@ fn zero_rows_text(scene: &Scene, mesh: &Mesh, rows: &RowSums) -> Option<String> 
             count(rows.zero as u64, "element") + if rows.zero == 1 { " sees" } else { " see" },
         ));
     }
+    // Nothing in front of the first one's surface: it faces open space (QA of issue #16: a
+    // triangle facing up over a floor was said to be pressed against another surface).
+    if let Some(el) = mesh.elements.get(rows.min_row) {
+        if faces_nothing(scene, el.surface as usize) && !faced_in_plane(scene, el.surface as usize)
+        {
+            return Some(format!(
+                "row sums: {} {} no other element (row sum 0; the first is {}): no surface \
+                 lies in front of {}, so what they send leaves the scene and nothing \
+                 sends light back",
+                count(rows.zero as u64, "element"),
+                if rows.zero == 1 { "sees" } else { "see" },
+                element_name(scene, mesh, rows.min_row),
+                if rows.zero == 1 { "it" } else { "the first" },
+            ));
+        }
+    }
     Some(format!(
-        "row sums: {} {} no other element (row sum 0; the first is {}): faces \
-         pressed against another surface, such as the base of furniture standing on the floor \
-         or a side against a wall, or elements whose sample points lie under such furniture; \
-         no light reaches them, so they keep only their own emission, and they are hidden \
-         (or partly hidden) by what touches them",
+        "row sums: {} {} no other element (row sum 0; the first is {}): they see no \
+         other element's front, most often as faces pressed against another surface (the \
+         base of furniture standing on the floor, a side against a wall, or sample points \
+         under such furniture, hidden by what touches them), else where only the backs of \
+         faces or open space lie in front of them; no light reaches them, so they keep only \
+         their own emission",
         count(rows.zero as u64, "element"),
         if rows.zero == 1 { "sees" } else { "see" },
         element_name(scene, mesh, rows.min_row),
@@ -362,6 +383,21 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
         // Only luminaires that give light (QA of issue #16, review: a FLUX 0 luminaire,
         // already warned of as emitting nothing, was said to be aimed away).
         let lit = scene.lights.iter().any(|l| l.gives_light());
+        // Black surfaces take the luminaires' light where it lands and pass none on (QA of
+        // issue #16: a room of reflectance 0 was told its lights were aimed away).
+        let all_black = scene
+            .surfaces
+            .iter()
+            .all(|s| s.reflectance.max_band() <= 0.0);
+        if lit && emitters.is_empty() && all_black {
+            return Some(
+                "every surface has reflectance 0: the point luminaires' light is absorbed \
+                 where it lands and none is reflected, so the solution holds no light and \
+                 pictures are black (`illuminance` takes the direct light at each point, and \
+                 reads it)"
+                    .to_string(),
+            );
+        }
         if lit && emitters.is_empty() {
             return Some(
                 "the point luminaires' light lands on no front of a surface: they are aimed \
@@ -424,6 +460,32 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
          inside furniture, or a room whose faces point out: `check` lists where it goes)",
         100.0 * (1.0 - absorbed),
     ))
+}
+
+/// Whether another surface of `scene` lies in surface `s`'s plane facing it (a box's base
+/// on the floor): all its corners within 1e-9 of the scene's size of the plane, its normal
+/// opposite.
+fn faced_in_plane(scene: &Scene, s: usize) -> bool {
+    let vertices = &scene.surfaces[s].vertices;
+    let Some(normal) = radiosity::geometry::polygon_normal(vertices) else {
+        return false;
+    };
+    let centre = radiosity::geometry::polygon_centroid(vertices);
+    let (lo, hi) = scene.bounds();
+    let eps = 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE);
+    scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != s)
+        .any(|(_, other)| {
+            radiosity::geometry::polygon_normal(&other.vertices)
+                .is_some_and(|m| m.dot(normal) < -0.99)
+                && other
+                    .vertices
+                    .iter()
+                    .all(|&v| normal.dot(v - centre).abs() <= eps)
+        })
 }
 
 /// Whether no corner of any other surface of `scene` lies in front of surface `s`'s plane
@@ -544,10 +606,24 @@ fn lights(prepared: &Prepared) {
             100.0 * share
         );
         if flux > 0.0 && share < LIGHT_LANDING_WARN {
+            // A shaped light at the default aim may simply point the wrong way (QA of issue
+            // #16: a COSINE light added to the y-up Cornell box pointed out of its open
+            // front, and the warning asked only whether it was inside furniture).
+            let aim = if !matches!(
+                l.distribution,
+                radiosity::luminaire::Distribution::Isotropic
+            ) && l.aim == radiosity::luminaire::DEFAULT_AIM
+            {
+                " or points the wrong way (it has the default AIM 0 0 -1, straight down in a \
+                 z-up scene but horizontal in a y-up one: give AIM 0 -1 0 for a downlight \
+                 there)"
+            } else {
+                ""
+            };
             errln!(
                 "warning: point luminaire {} at ({}, {}, {}): only {:.1} % of its {:.1} lm lands \
                  on the front of a surface; the rest falls on the backs of faces (is it inside \
-                 furniture or behind a wall?) or leaves the scene (is it outside the room?), \
+                 furniture or behind a wall?) or leaves the scene (is it outside the room{aim}?), \
                  and no solution holds it",
                 l.name,
                 p.x,
@@ -1319,7 +1395,7 @@ pub fn building(output: &Path, params: &BuildingParams, built: &Scene, elements:
     let size = hi - lo;
     let rooms = params.floors * params.rooms_x * params.rooms_z;
     outln!(
-        "{}: {} room{}, {} surfaces, {:.0} m^2, {:.1} x {:.1} x {:.1} m; MAX_PATCH_AREA {}: {}",
+        "{}: {} room{}, {} surfaces of {:.0} m^2 in all, {:.1} x {:.1} x {:.1} m across; MAX_PATCH_AREA {}: {}",
         output.display(),
         rooms,
         if rooms == 1 { "" } else { "s" },
@@ -1371,7 +1447,11 @@ pub fn path_traced(view: &PathTraced, settings: &PathTraceSettings) {
             if settings.max_bounces == 0 {
                 "--max-bounces 0 shows the emitters only"
             } else {
-                "no light reaches what the view shows: does anything in the scene emit?"
+                // QA of issue #16: asked whether anything emits of a scene whose lamp lay
+                // outside the room.
+                "no light reaches what the view shows: nothing in the scene emits, or its \
+                 light does not reach what the camera sees (a lamp outside the room or \
+                 facing away; `check` says how much of each light lands)"
             }
         );
     }

@@ -281,6 +281,12 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
             let t = crate::report::typed(t);
             bail!("--tolerance {t}: give the unshot share of the emitted power at which progressive refinement stops, a number above 0 and below 1 (0.01 is 1 %)");
         }
+        // A relative residual of 1 or more stops Gauss-Seidel after one sweep (QA of issue
+        // #16: `--tolerance 5` left 36 % of the light unsolved); `auto` may take either.
+        if matches!(options.solver.0, SolverKind::GaussSeidel | SolverKind::Auto) && t >= 1.0 {
+            let t = crate::report::typed(t);
+            bail!("--tolerance {t}: give where the solver stops, a number above 0 and below 1 (Gauss-Seidel's relative residual, 1e-9 by default; hierarchical radiosity's changing power, 1e-6)");
+        }
     }
     if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
         bail!(
@@ -581,6 +587,12 @@ pub fn load_scene(
             if let Some(w) = unnamed_surfaces(&imported.file.scene) {
                 errln!("{}: warning: {w}", path.display());
             }
+            // The importers number their faces' names; a scene file's are the user's own.
+            if imported.format == Format::Scene {
+                if let Some(w) = shared_names(&imported.file.scene) {
+                    errln!("{}: warning: {w}", path.display());
+                }
+            }
             Ok((imported.file, stem_of(Some(path))))
         }
     }
@@ -616,6 +628,37 @@ pub fn unnamed_surfaces(scene: &Scene) -> Option<String> {
         crate::report::first_three(&unnamed),
         if unnamed.len() == 1 { "it" } else { "them" },
         if unnamed.len() == 1 { "it" } else { "them" },
+    ))
+}
+
+/// A warning for surfaces that share a name (QA of issue #16: two patches named `#A` gave
+/// two report rows called "A", and `view --select A` could pick either).
+pub fn shared_names(scene: &Scene) -> Option<String> {
+    let mut first: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    let mut shared = Vec::new();
+    for (i, s) in scene.surfaces.iter().enumerate() {
+        if s.name.is_empty() {
+            continue;
+        }
+        match first.get(s.name.as_str()) {
+            Some(&j) => shared.push(format!("{:?} (surfaces {j} and {i})", s.name)),
+            None => {
+                first.insert(&s.name, i);
+            }
+        }
+    }
+    if shared.is_empty() {
+        return None;
+    }
+    Some(format!(
+        "{} a name with an earlier surface: {}; reports show them as rows of one name and \
+         `view --select` picks the first; give each its own name",
+        if shared.len() == 1 {
+            "a surface shares"
+        } else {
+            "surfaces share"
+        },
+        crate::report::first_three(&shared)
     ))
 }
 

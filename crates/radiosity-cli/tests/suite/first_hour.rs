@@ -205,7 +205,7 @@ fn check_gives_the_reason_beside_odd_row_sums_and_the_escaped_share() {
     let text = crate::fixtures::stdout(&out);
     assert!(
         text.contains("see no other element (row sum 0; the first is element")
-            && text.contains(".base\"): faces pressed against another surface"),
+            && text.contains(".base\"): they see no other element's front, most often as faces pressed against another surface"),
         "{text}"
     );
     // Explained, but not a warning: 44 of 906 rows, the largest 1.07, count 0.19 % of the
@@ -2782,6 +2782,23 @@ fn ninth_pass_findings_are_said() {
         .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&c| c > 200))
         .count();
     assert_eq!(whitish, 0, "background in the view of a closed room");
+    // Row sums of 0 where nothing lies in front (two squares facing away from each other)
+    // are not blamed on furniture (QA of issue #16, tenth pass).
+    std::fs::write(
+        dir.join("apart.scene"),
+        "MAX_PATCH_AREA 0.25\nINTEGRAL_STEPS 2\nSCENEBEGIN\n\
+         PATCHBEGIN\n#Down\nVERTICES 4\nEr 1\nEg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\n\
+         VERTEX0 0 0 0\nVERTEX1 1 0 0\nVERTEX2 1 0 1\nVERTEX3 0 0 1\nPATCHEND\n\
+         PATCHBEGIN\n#Up\nVERTICES 4\nEr 1\nEg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\n\
+         VERTEX0 0 1 0\nVERTEX1 0 1 1\nVERTEX2 1 1 1\nVERTEX3 1 1 0\nPATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    let out = radiosity(&["check", "apart.scene"], &dir);
+    let text = crate::fixtures::stdout(&out);
+    assert!(
+        text.contains("no surface lies in front of the first, so what they send leaves the scene"),
+        "{text}"
+    );
     // A number past the largest a flag takes is told its range, not "at least 1".
     let out = radiosity(&["render", "--width", "4294967297"], &dir);
     assert!(
