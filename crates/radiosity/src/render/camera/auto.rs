@@ -95,7 +95,36 @@ pub fn z_is_up(scene: &Scene) -> bool {
             _ => {}
         }
     }
-    top_z > top_y
+    if top_z != top_y {
+        return top_z > top_y;
+    }
+    // No word from the lights: a closed room lower along z than it is deep along y stands
+    // on z (QA of issue #16: a z-up room lit by a lamp in its middle was looked at from
+    // 9 cm above its floor).
+    size.z < size.y && encloses_its_centre(scene, lo, hi)
+}
+
+/// Whether rays from the bounding box's centre along the six axis directions all meet the
+/// front of a surface: a closed room seen from inside.
+fn encloses_its_centre(scene: &Scene, lo: DVec3, hi: DVec3) -> bool {
+    let bvh = PolygonBvh::over_surfaces(scene);
+    let centre = 0.5 * (lo + hi);
+    let scale = bvh.scale();
+    [
+        DVec3::X,
+        -DVec3::X,
+        DVec3::Y,
+        -DVec3::Y,
+        DVec3::Z,
+        -DVec3::Z,
+    ]
+    .iter()
+    .all(|&d| {
+        bvh.closest_hit(centre, d, 0.0, 2.0 * scale + 1.0)
+            .and_then(|h| scene.surfaces.get(h.id as usize))
+            .and_then(|s| crate::geometry::polygon_normal(&s.vertices))
+            .is_some_and(|n| n.dot(d) < 0.0)
+    })
 }
 
 /// The field of view of the cameras [`Camera::framing`] and [`Camera::for_scene`] make.
@@ -493,6 +522,12 @@ mod tests {
         let n = crate::geometry::polygon_normal(&windows.surfaces[7].vertices).unwrap();
         assert!(n.z < -0.7, "{n}");
         assert!(!z_is_up(&windows));
+        // No light to go by: a closed room lower along z than deep along y stands on z.
+        let mut dark = s.clone();
+        dark.surfaces.retain(|x| x.name != "light");
+        let mut dark_y_up = room();
+        dark_y_up.surfaces.retain(|x| x.name != "light");
+        assert!(z_is_up(&dark) && !z_is_up(&dark_y_up));
         let cam = Camera::for_scene(&s, 96, 72);
         let y_up = Camera::for_scene(&room(), 96, 72);
         let turn = |v: DVec3| dvec3(v.x, -v.z, v.y);
