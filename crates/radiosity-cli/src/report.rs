@@ -614,17 +614,17 @@ fn lights(prepared: &Prepared) {
                 radiosity::luminaire::Distribution::Isotropic
             ) && l.aim == radiosity::luminaire::DEFAULT_AIM
             {
-                " or points the wrong way (it has the default AIM 0 0 -1, straight down in a \
-                 z-up scene but horizontal in a y-up one: give AIM 0 -1 0 for a downlight \
-                 there)"
+                "; or the light points the wrong way: it has the default AIM 0 0 -1, straight \
+                 down in a z-up scene but horizontal in a y-up one, where a downlight takes \
+                 AIM 0 -1 0"
             } else {
                 ""
             };
             errln!(
                 "warning: point luminaire {} at ({}, {}, {}): only {:.1} % of its {:.1} lm lands \
                  on the front of a surface; the rest falls on the backs of faces (is it inside \
-                 furniture or behind a wall?) or leaves the scene (is it outside the room{aim}?), \
-                 and no solution holds it",
+                 furniture or behind a wall?) or leaves the scene (is it outside the room?){aim}; \
+                 no solution holds it",
                 l.name,
                 p.x,
                 p.y,

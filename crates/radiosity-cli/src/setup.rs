@@ -446,16 +446,17 @@ pub fn note_output(path: &Path, flag: &str, label: &str) -> Result<()> {
     };
     // The same output noted again (a command checked twice, or run again in one process,
     // as `radiosity-mpi` and the tests do) is no clash.
+    let same = |o: &Output| {
+        lexical_absolute(&o.path) == lexical_absolute(path)
+            || radiosity::io::is_same_file(&o.path, path)
+    };
     if outputs
         .iter()
-        .any(|o| o.path == path && o.flag == flag && o.label == label)
+        .any(|o| same(o) && o.flag == flag && o.label == label)
     {
         return Ok(());
     }
-    if let Some(earlier) = outputs
-        .iter()
-        .find(|o| o.path == path || radiosity::io::is_same_file(&o.path, path))
-    {
+    if let Some(earlier) = outputs.iter().find(|o| same(o)) {
         bail!(
             "{label} is {} too: one output would overwrite the other; give {flag} another \
              file name",
@@ -468,6 +469,25 @@ pub fn note_output(path: &Path, flag: &str, label: &str) -> Result<()> {
         label: label.to_string(),
     });
     Ok(())
+}
+
+/// `path` made absolute (against the working folder) with its `.` and `..` taken out by
+/// name, so that `r.exr` and `./r.exr` compare equal before either exists (review of issue
+/// #16: `is_same_file` needs both files to exist, and a first run's outputs do not).
+fn lexical_absolute(path: &Path) -> std::path::PathBuf {
+    use std::path::Component;
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut out = std::path::PathBuf::new();
+    for part in absolute.components() {
+        match part {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
 }
 
 /// Refuses, right after the scene is read and before any work, an output that is a file
@@ -674,11 +694,8 @@ pub fn sideways_lights(scene: &Scene) -> Vec<String> {
     if scene.surfaces.is_empty() {
         return Vec::new();
     }
-    let (lo, hi) = scene.bounds();
-    let near_top = |p: DVec3, axis: usize| {
-        let span = hi[axis] - lo[axis];
-        span > 0.0 && (p[axis] - lo[axis]) / span > 0.75
-    };
+    let bounds = scene.bounds();
+    let near_top = |p: DVec3, axis: usize| radiosity::render::in_top_quarter(bounds, p, axis);
     scene
         .lights
         .iter()

@@ -325,7 +325,8 @@ pub const MAX_PIECE_SOLID_ANGLE: f64 = 0.01;
 pub const MAX_PIECE_DEPTH: u32 = 7;
 
 /// The sub-triangles per fan triangle edge used for elements' first bounce
-/// ([`power_onto`]): 4 x 4 = 16 shadow rays per triangle.
+/// ([`power_onto`]): 4 x 4 = 16 shadow rays per triangle at least (more where a light
+/// sees a piece wider than [`MAX_PIECE_SOLID_ANGLE`]).
 pub const ELEMENT_SUBDIVISION: u32 = 4;
 
 /// Each element's average illuminance from the point lights of `scene` (per band,

@@ -224,6 +224,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if wireframe
         && args.snapshots.is_none()
         && adapt.is_none()
+        && args.solve.form_factors.is_none()
         && !matches!(solver, radiosity::solve::Solver::Hierarchical(_))
     {
         reporter.note(
@@ -384,6 +385,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         if let Some(warning) = black_picture(
             image.pixels().map(|p| p.0 == [0, 0, 0]),
             fronts_in_view(&prepared, &camera),
+            false,
         )
         .map(|w| with_exposure_hint(w, exposure))
         {
@@ -405,9 +407,9 @@ const BLACK_PICTURE_SHARE: f64 = 0.95;
 /// warns of points that see only backs).
 /// `fronts` is the share of the view whose camera rays meet the front of a surface
 /// ([`fronts_in_view`]): where most do, the camera is not to blame, what it sees gets no
-/// light or reflects none (QA of issue #16: a camera inside a room facing a wall of
+/// light or (unless the picture shows `lux`) reflects none (QA of issue #16: a camera inside a room facing a wall of
 /// reflectance 0 was told to move into the scene).
-fn black_picture(dark: impl Iterator<Item = bool>, fronts: f64) -> Option<String> {
+fn black_picture(dark: impl Iterator<Item = bool>, fronts: f64, lux: bool) -> Option<String> {
     let (mut pixels, mut black) = (0u64, 0u64);
     for is_dark in dark {
         pixels += 1;
@@ -416,10 +418,16 @@ fn black_picture(dark: impl Iterator<Item = bool>, fronts: f64) -> Option<String
     let share = black as f64 / pixels.max(1) as f64;
     (share > BLACK_PICTURE_SHARE).then(|| {
         if fronts >= 0.5 {
+            // Reflectance does not matter to lux, which is the light arriving.
             format!(
                 "{:.1} % of the picture shows nothing lit: the surfaces in view face the \
-                 camera, but no light reaches them or they reflect none (reflectance 0)",
-                100.0 * share
+                 camera, but no light reaches them{}",
+                100.0 * share,
+                if lux {
+                    ""
+                } else {
+                    " or they reflect none (reflectance 0)"
+                }
             )
         } else {
             format!(
@@ -582,7 +590,7 @@ fn false_colour(
             .iter()
             .zip(&coverage)
             .map(|(&lux, &c)| c <= 0.0 || lux <= 0.0);
-        if let Some(warning) = black_picture(nothing, fronts_in_view(prepared, camera)) {
+        if let Some(warning) = black_picture(nothing, fronts_in_view(prepared, camera), true) {
             errln!("warning: {warning}");
         }
     }

@@ -358,6 +358,34 @@ fn the_emitter_pixels_depend_on_the_view_alone() {
         base.iter().any(|&e| e),
         "the Cornell box's light is in view"
     );
+    // An emitter behind the eye, facing it, changes nothing it cannot be seen from
+    // (review of issue #16: its outline, not in front of the eye, marked every pixel beside
+    // the light's).
+    let mut behind = s.clone();
+    let z = cam.eye.z - 100.0;
+    behind.surfaces.push(surface(
+        "behind",
+        Rgb::splat(5.0),
+        Rgb::splat(0.0),
+        vec![
+            DVec3::new(0.0, 0.0, z),
+            DVec3::new(556.0, 0.0, z),
+            DVec3::new(556.0, 548.0, z),
+            DVec3::new(0.0, 548.0, z),
+        ],
+    ));
+    let n = crate::geometry::polygon_normal(&behind.surfaces.last().unwrap().vertices).unwrap();
+    assert!(n.z > 0.5, "faces the eye's back: {n}");
+    let behind_mask = path_trace(
+        &behind,
+        &cam,
+        &PathTraceSettings::DEFAULT.with_samples(2),
+        &NoProgress,
+    )
+    .unwrap()
+    .emitter_mask()
+    .to_vec();
+    assert_eq!(behind_mask, base);
     for settings in [
         PathTraceSettings::DEFAULT.with_samples(64),
         PathTraceSettings::DEFAULT.with_samples(16).with_seed(7),

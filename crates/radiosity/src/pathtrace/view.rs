@@ -2,6 +2,7 @@
 //! points of the pixel (a box filter, as the radiosity renderer's supersampling grid),
 //! rows in parallel.
 
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::estimate::{Accumulator, PathTraced, PixelEstimate};
@@ -91,13 +92,22 @@ impl PathTracer {
                 })
             })
             .collect();
-        // Each emitting front's outline in the image: None where a corner is not in front
-        // of the eye (then every pixel beside a found one counts as overlapped).
-        let outlines: Vec<Option<Vec<(f64, f64)>>> = self
+        // Each emitting front's outline in the image, clipped to the part in front of the
+        // eye (review of issue #16: an emitter with a corner behind the eye counted as
+        // overlapping every pixel beside a found one).
+        let (forward, _, _) = camera.basis();
+        let near = self.epsilon();
+        let outlines: Vec<Vec<(f64, f64)>> = self
             .emitters
             .iter()
             .filter(|(v, n)| n.dot(camera.eye - v[0]) > 0.0)
-            .map(|(v, _)| v.iter().map(|&c| camera.project(c)).collect())
+            .filter_map(|(v, _)| {
+                let depth = |c: DVec3| (c - camera.eye).dot(forward) - near;
+                let front = clip_to_front(v, depth);
+                let outline: Option<Vec<(f64, f64)>> =
+                    front.iter().map(|&c| camera.project(c)).collect();
+                outline.filter(|o| o.len() >= 3)
+            })
             .collect();
         (0..w * h)
             .into_par_iter()
@@ -109,10 +119,9 @@ impl PathTracer {
                 let beside = (y.saturating_sub(1)..(y + 2).min(h))
                     .any(|j| (x.saturating_sub(1)..(x + 2).min(w)).any(|i| coarse[j * w + i]));
                 beside
-                    && outlines.iter().any(|o| match o {
-                        None => true,
-                        Some(o) => overlaps_pixel(o, x as f64, y as f64),
-                    })
+                    && outlines
+                        .iter()
+                        .any(|o| overlaps_pixel(o, x as f64, y as f64))
             })
             .collect()
     }
@@ -120,6 +129,23 @@ impl PathTracer {
 
 /// Rays a pixel along each side for [`PathTracer::emitter_mask`]'s first look.
 pub const EMITTER_GRID: u32 = 4;
+
+/// The part of the convex polygon `corners` where `depth` (linear along the polygon) is
+/// above 0: one Sutherland-Hodgman step against the camera's near plane.
+fn clip_to_front(corners: &[DVec3], depth: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity(corners.len() + 1);
+    for i in 0..corners.len() {
+        let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+        let (da, db) = (depth(a), depth(b));
+        if da > 0.0 {
+            out.push(a);
+        }
+        if (da > 0.0) != (db > 0.0) {
+            out.push(a + (b - a) * (da / (da - db)));
+        }
+    }
+    out
+}
 
 /// Whether the convex polygon `outline` (image coordinates, either winding) overlaps the
 /// open pixel square [x, x + 1] x [y, y + 1]: no separating axis among the square's two and
@@ -141,10 +167,14 @@ fn overlaps_pixel(outline: &[(f64, f64)], x: f64, y: f64) -> bool {
     if k < 3 {
         return false;
     }
-    let edges = (0..k).map(|i| {
-        let (a, b) = (outline[i], outline[(i + 1) % k]);
-        (b.1 - a.1, a.0 - b.0)
-    });
+    // A corner repeated, or an edge seen end on, gives no axis (review of issue #16: the
+    // zero axis "separated" everything).
+    let edges = (0..k)
+        .map(|i| {
+            let (a, b) = (outline[i], outline[(i + 1) % k]);
+            (b.1 - a.1, a.0 - b.0)
+        })
+        .filter(|&(u, v)| u * u + v * v > 1e-24);
     ![(1.0, 0.0), (0.0, 1.0)]
         .into_iter()
         .chain(edges)

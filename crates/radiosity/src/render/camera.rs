@@ -10,7 +10,7 @@ use crate::scene::CameraHint;
 
 mod auto;
 
-pub use auto::DEFAULT_FOV_Y_DEGREES;
+pub use auto::{in_top_quarter, z_is_up, DEFAULT_FOV_Y_DEGREES};
 
 /// A pinhole camera (right-handed): `forward = normalize(look_at - eye)`,
 /// `right = normalize(forward x up)`, `true_up = right x forward`. Image pixel (x, y) has

@@ -36,7 +36,7 @@ mod renderer;
 mod test_support;
 pub mod tonemap;
 
-pub use camera::{Camera, DEFAULT_FOV_Y_DEGREES};
+pub use camera::{in_top_quarter, z_is_up, Camera, DEFAULT_FOV_Y_DEGREES};
 pub use direct::{DirectCorrection, DirectLight, COARSE_RAYS};
 pub use film::{sample_offset, Film, FilmContent};
 pub use hole_cover::HoleCover;

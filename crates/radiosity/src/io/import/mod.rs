@@ -208,7 +208,8 @@ pub enum ImportError {
     Io {
         /// The file.
         file: String,
-        /// What the file is ("the scene file", "the materials file", "the buffer"), as the
+        /// What the file is ("the scene file", "the materials file", "the file" for a
+        /// glTF's buffer or image, named in the message), as the
         /// `.scene` reader's "cannot read the scene file" says (QA of issue #16).
         what: &'static str,
         /// The system's reason.

@@ -45,7 +45,9 @@ fn front_side_is_open(scene: &Scene, lo: DVec3, hi: DVec3) -> bool {
 /// not of the y extent) than the other way round. The shape: a z-up verdict also needs the
 /// z extent no larger than the y extent (rooms and buildings are wider than they are tall,
 /// so a y-up room lit through one window facing -z stays y-up). +y (the paper's
-/// convention, and glTF's) otherwise.
+/// convention, and glTF's) otherwise; and for a scene where nothing emits, a closed room
+/// lower along z than along y is taken as z-up. A box lit only by one emitter in one wall
+/// is ambiguous (a window, or a ceiling light of a room on its side): `--up` settles it.
 pub fn z_is_up(scene: &Scene) -> bool {
     let (lo, hi) = scene.bounds();
     let size = hi - lo;
@@ -83,10 +85,7 @@ pub fn z_is_up(scene: &Scene) -> bool {
     if down_y > 0.0 || down_z > 0.0 {
         return down_z > down_y;
     }
-    let near_top = |p: DVec3, axis: usize| {
-        let span = hi[axis] - lo[axis];
-        span > 0.0 && (p[axis] - lo[axis]) / span > 0.75
-    };
+    let near_top = |p: DVec3, axis: usize| in_top_quarter((lo, hi), p, axis);
     let (mut top_y, mut top_z) = (0, 0);
     for l in scene.lights.iter().filter(|l| l.gives_light()) {
         match (near_top(l.position, 1), near_top(l.position, 2)) {
@@ -98,10 +97,19 @@ pub fn z_is_up(scene: &Scene) -> bool {
     if top_z != top_y {
         return top_z > top_y;
     }
-    // No word from the lights: a closed room lower along z than it is deep along y stands
-    // on z (QA of issue #16: a z-up room lit by a lamp in its middle was looked at from
-    // 9 cm above its floor).
-    size.z < size.y && encloses_its_centre(scene, lo, hi)
+    // Nothing emits at all: a closed room lower along z than it is deep along y stands on
+    // z. Not where lights gave no word (review of issue #16: a y-up corridor, shallower
+    // along z than tall, with a lamp at mid-height was turned on its side).
+    let lit = scene.lights.iter().any(|l| l.gives_light())
+        || scene.surfaces.iter().any(|s| s.emission.max_band() > 0.0);
+    !lit && size.z < size.y && encloses_its_centre(scene, lo, hi)
+}
+
+/// Whether `p` lies in the top quarter of the box `bounds` along `axis` (0, 1, 2 for x, y,
+/// z): where a ceiling light hangs when that axis is up.
+pub fn in_top_quarter((lo, hi): (DVec3, DVec3), p: DVec3, axis: usize) -> bool {
+    let span = hi[axis] - lo[axis];
+    span > 0.0 && (p[axis] - lo[axis]) / span > 0.75
 }
 
 /// Whether rays from the bounding box's centre along the six axis directions all meet the
@@ -242,8 +250,8 @@ impl Camera {
     ///   in the room of the most powerful one (see `under_brightest_light`);
     /// * otherwise (objects): [`Camera::outside`].
     ///
-    /// A scene whose lights say that +z is up ([`z_is_up`]) is framed the same way with z
-    /// for y (QA of issue #16: a z-up room, as `validate cie171 --write` and DXF plans make,
+    /// A scene that [`z_is_up`] takes as z-up (its lights and its shape) is framed the same
+    /// way with z for y (QA of issue #16: a z-up room, as `validate cie171 --write` and DXF plans make,
     /// was looked at from 9 cm above its floor, sideways).
     pub fn for_scene(scene: &Scene, width: u32, height: u32) -> Camera {
         if let Some(hint) = &scene.camera {
@@ -503,8 +511,14 @@ mod tests {
         assert!(z_is_up(&s) && !z_is_up(&room()));
         // A y-up room lit by two strong windows in opposite walls (facing -z and +z) and a
         // weaker ceiling light stays y-up (QA of issue #16: a generated building's windows
-        // turned its camera on its side).
+        // turned its camera on its side). Squashed along z to 0.9 so that its z extent is
+        // below its y extent and the lights, not the shape, decide.
         let mut windows = room();
+        for surf in &mut windows.surfaces {
+            for v in &mut surf.vertices {
+                v.z *= 0.9;
+            }
+        }
         let window = |z: f64, facing_minus_z: bool| {
             let mut v = vec![
                 dvec3(200., 100., z),
@@ -517,12 +531,18 @@ mod tests {
             }
             surface("window", 50.0, v)
         };
-        windows.surfaces.push(window(558.0, true));
+        windows.surfaces.push(window(502.0, true));
         windows.surfaces.push(window(1.0, false));
         let n = crate::geometry::polygon_normal(&windows.surfaces[7].vertices).unwrap();
         assert!(n.z < -0.7, "{n}");
+        let (lo, hi) = windows.bounds();
+        assert!(hi.z - lo.z < hi.y - lo.y);
         assert!(!z_is_up(&windows));
-        // No light to go by: a closed room lower along z than deep along y stands on z.
+        // Without the window facing +z the one facing -z outweighs the ceiling light: the
+        // ambiguous case the documentation names (a room on its side), taken as z-up.
+        windows.surfaces.pop();
+        assert!(z_is_up(&windows));
+        // Nothing emits: a closed room lower along z than deep along y stands on z.
         let mut dark = s.clone();
         dark.surfaces.retain(|x| x.name != "light");
         let mut dark_y_up = room();

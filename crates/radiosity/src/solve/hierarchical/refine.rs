@@ -34,9 +34,10 @@ impl Solver<'_> {
 
     /// Refines the candidate pairs (p, q) breadth first until the oracle is satisfied,
     /// storing the resulting links (estimates in parallel, splits in order); returns whether
-    /// anything was split. Every [`HEARTBEAT`] it tells `progress` the nodes, links and
-    /// memory so far: how long refinement takes is not known before it ends, but the
-    /// memory limit bounds it.
+    /// anything was split. Between breadth-first levels, at most once every [`HEARTBEAT`]
+    /// (a level itself can take longer), it tells `progress` the nodes, links and memory so
+    /// far: how long refinement takes is not known before it ends, but the memory limit
+    /// bounds it.
     pub(super) fn refine(
         &mut self,
         mut frontier: Vec<(u32, u32)>,
