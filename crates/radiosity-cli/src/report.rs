@@ -462,48 +462,54 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
     ))
 }
 
-/// Whether another surface of `scene` lies in surface `s`'s plane facing it (a box's base
-/// on the floor): all its corners within 1e-9 of the scene's size of the plane, its normal
-/// opposite.
-fn faced_in_plane(scene: &Scene, s: usize) -> bool {
+/// Surface `s`'s unit normal, a point of its plane, and 1e-9 of the scene's size (how far
+/// off the plane a corner may lie and still count as in it); `None` for a degenerate one.
+fn plane_of(scene: &Scene, s: usize) -> Option<(glam::DVec3, glam::DVec3, f64)> {
     let vertices = &scene.surfaces[s].vertices;
-    let Some(normal) = radiosity::geometry::polygon_normal(vertices) else {
-        return false;
-    };
+    let normal = radiosity::geometry::polygon_normal(vertices)?;
     let centre = radiosity::geometry::polygon_centroid(vertices);
     let (lo, hi) = scene.bounds();
-    let eps = 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE);
+    Some((
+        normal,
+        centre,
+        1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE),
+    ))
+}
+
+/// The surfaces of `scene` other than `s`.
+fn others(scene: &Scene, s: usize) -> impl Iterator<Item = &radiosity::scene::Surface> {
     scene
         .surfaces
         .iter()
         .enumerate()
-        .filter(|&(k, _)| k != s)
-        .any(|(_, other)| {
-            radiosity::geometry::polygon_normal(&other.vertices)
-                .is_some_and(|m| m.dot(normal) < -0.99)
-                && other
-                    .vertices
-                    .iter()
-                    .all(|&v| normal.dot(v - centre).abs() <= eps)
-        })
+        .filter(move |&(k, _)| k != s)
+        .map(|(_, other)| other)
+}
+
+/// Whether another surface of `scene` lies in surface `s`'s plane facing it (a box's base
+/// on the floor): all its corners within 1e-9 of the scene's size of the plane, its normal
+/// opposite.
+fn faced_in_plane(scene: &Scene, s: usize) -> bool {
+    let Some((normal, centre, eps)) = plane_of(scene, s) else {
+        return false;
+    };
+    others(scene, s).any(|other| {
+        radiosity::geometry::polygon_normal(&other.vertices).is_some_and(|m| m.dot(normal) < -0.99)
+            && other
+                .vertices
+                .iter()
+                .all(|&v| normal.dot(v - centre).abs() <= eps)
+    })
 }
 
 /// Whether no corner of any other surface of `scene` lies in front of surface `s`'s plane
 /// (by more than 1e-9 of the scene's size): its light can only leave the scene.
 fn faces_nothing(scene: &Scene, s: usize) -> bool {
-    let vertices = &scene.surfaces[s].vertices;
-    let Some(normal) = radiosity::geometry::polygon_normal(vertices) else {
+    let Some((normal, centre, eps)) = plane_of(scene, s) else {
         return false;
     };
-    let centre = radiosity::geometry::polygon_centroid(vertices);
-    let (lo, hi) = scene.bounds();
-    let eps = 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE);
-    !scene
-        .surfaces
-        .iter()
-        .enumerate()
-        .filter(|&(k, _)| k != s)
-        .flat_map(|(_, other)| other.vertices.iter())
+    !others(scene, s)
+        .flat_map(|other| other.vertices.iter())
         .any(|&v| normal.dot(v - centre) > eps)
 }
 
