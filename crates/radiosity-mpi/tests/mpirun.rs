@@ -245,8 +245,10 @@ fn a_rank_killed_midway_then_resumed_gives_the_same_file() {
     let reference = dir.path().join("single.ff");
     let out = dir.path().join("mpi.ff");
     let checkpoint = dir.path().join("checkpoint");
-    // A finer mesh (about 400 elements), blocks of 2 rows: long enough to be killed midway.
-    let mesh = ["--max-area", "0.1", "--steps", "1"];
+    // A finer mesh (about 2,200 elements), blocks of 2 rows: long enough to be killed
+    // midway. At --max-area 0.1 (882 elements) the job took 0.49 s on an idle machine and
+    // once finished before rank 1 could be found and killed.
+    let mesh = ["--max-area", "0.04", "--steps", "1"];
     let mut args = vec![
         "formfactors",
         scene,
