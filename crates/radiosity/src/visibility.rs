@@ -268,8 +268,23 @@ impl PolygonBvh {
     /// with the segment test below this gives shaft-style culling: the segments between two
     /// elements stay inside the box around both, so only these polygons can block them.
     pub fn overlapping(&self, lo: DVec3, hi: DVec3, out: &mut Vec<u32>) {
+        self.overlapping_where(lo, hi, usize::MAX, |_| true, out);
+    }
+
+    /// [`PolygonBvh::overlapping`], keeping only the polygons for which `keep` (given the
+    /// index) is true, and stopping once more than `limit` are kept: false then (`out`
+    /// holds `limit + 1` of them), true when all are in `out`. A caller that scans a short
+    /// list and traverses the hierarchy for a long one need not find the whole long one.
+    pub fn overlapping_where(
+        &self,
+        lo: DVec3,
+        hi: DVec3,
+        limit: usize,
+        mut keep: impl FnMut(u32) -> bool,
+        out: &mut Vec<u32>,
+    ) -> bool {
         if self.polygons.is_empty() {
-            return;
+            return true;
         }
         let pad = 1e-6 * self.scale;
         let query = Aabb::new(
@@ -285,6 +300,7 @@ impl PolygonBvh {
         // scale (QA of issue #16: the ceiling over a light panel was contact-refined at
         // `--scale 1` and not at 7.7).
         let (lo, hi) = (lo - DVec3::splat(pad), hi + DVec3::splat(pad));
+        let mut found = 0usize;
         obvhs::traverse!(
             bvh,
             node,
@@ -292,11 +308,20 @@ impl PolygonBvh {
             node.intersect_aabb(&query, state.oct_inv4),
             {
                 let poly = &self.polygons[state.primitive_id as usize];
-                if poly.lo.cmple(hi).all() && poly.hi.cmpge(lo).all() {
+                if poly.lo.cmple(hi).all() && poly.hi.cmpge(lo).all() && keep(state.primitive_id) {
                     out.push(state.primitive_id);
+                    found += 1;
+                    if found > limit {
+                        // Ends the traversal: nothing left in this leaf, this node or the
+                        // stack.
+                        state.primitive_group = UVec2::ZERO;
+                        state.current_group = UVec2::ZERO;
+                        while state.stack.pop().is_some() {}
+                    }
                 }
             }
         );
+        found <= limit
     }
 
     /// The bounding box (min, max) of polygon `index` (an index from

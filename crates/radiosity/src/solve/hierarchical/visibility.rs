@@ -81,6 +81,10 @@ fn spread_stride(n: usize) -> usize {
     s
 }
 
+/// The most candidate occluders a patch <- patch link tests its rays against one by one;
+/// with more it traverses the whole hierarchy.
+const MAX_CANDIDATES: usize = 32;
+
 /// The 16 point pairs of a patch <- patch link: 4 x 4 stratified points on each node,
 /// paired by a fixed permutation, each weighed by what it stands for of the exchange.
 struct PatchPairs<'a> {
@@ -153,13 +157,31 @@ impl Solver<'_> {
                 hi = hi.max(v);
             }
             let (sp, sq) = (np.surface, nq.surface);
+            let (mp, mq) = (self.normal[sp as usize], self.normal[sq as usize]);
+            let (op, oq) = (np.polygon()[0], nq.polygon()[0]);
+            let tol = 1e-9 * occ.scale();
             scratch.clear();
-            occ.overlapping(lo, hi, scratch);
-            scratch.retain(|&k| occ.id_of(k) != sp && occ.id_of(k) != sq);
+            // Occluders of the two surfaces themselves, or wholly behind either plane, cannot
+            // cross a segment between facing points (it runs in front of both planes); a
+            // pair that does not face counts only where none faces.
+            let short = occ.overlapping_where(
+                lo,
+                hi,
+                MAX_CANDIDATES,
+                |k| {
+                    let id = occ.id_of(k);
+                    let corners = occ.corners_of(k);
+                    id != sp
+                        && id != sq
+                        && corners.iter().any(|c| mp.dot(*c - op) > tol)
+                        && corners.iter().any(|c| mq.dot(*c - oq) > tol)
+                },
+                scratch,
+            );
             if scratch.is_empty() {
                 return (1.0, 0, 16);
             }
-            use_candidates = scratch.len() <= 32;
+            use_candidates = short;
             // The same points for the link p <- q as for q <- p.
             let seed = crate::splitmix::splitmix64((p.min(q) as u64) << 32 | p.max(q) as u64);
             let (seed_p, seed_q) = if p < q { (seed, !seed) } else { (!seed, seed) };
