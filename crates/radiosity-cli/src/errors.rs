@@ -151,6 +151,13 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
     if let Some(e) = err.downcast_ref::<SolveError>() {
         return match e {
             SolveError::OutOfMemory(m) => Some(format!("{}{memory}", fits_area(m))),
+            // QA of issue #16: under `ulimit -v` the limit can be nothing at all, which no
+            // epsilon cures.
+            SolveError::HierarchicalTooBig { limit_mib, .. } if *limit_mib < 64 => Some(format!(
+                "; but only {limit_mib} MiB is left to it (the machine's free memory, or what \
+                 `ulimit -v` leaves after the program's own mapped memory and its threads' \
+                 malloc arenas of 64 MiB each): raise the limit or free memory"
+            )),
             SolveError::HierarchicalTooBig { .. } => Some(": raise --epsilon or --min-area".into()),
             // QA of issue #16: a closed box of reflectance 0.97 stopped with "rows summing
             // far above 1?", and the CIE 5.8 cube of 0.95 ran 100,000 sweeps.

@@ -10,6 +10,12 @@ use radiosity_cli::{args, commands, errors};
 
 use std::process::ExitCode;
 
+mod out_of_memory;
+
+/// A failed allocation stops the program with an error, not an abort (see the module).
+#[global_allocator]
+static ALLOCATOR: out_of_memory::CleanOutOfMemory = out_of_memory::CleanOutOfMemory;
+
 use anyhow::Result;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 

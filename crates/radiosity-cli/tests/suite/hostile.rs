@@ -309,6 +309,30 @@ fn memory_budget_honours_ulimit_v() {
 }
 
 #[test]
+fn a_failed_allocation_is_an_error_not_an_abort() {
+    // QA of issue #16: under tight `ulimit -v` limits the hierarchical solve aborted
+    // ("memory allocation of 2048 bytes failed", a backtrace, status 134). Whatever limit
+    // is met first, the run ends with status 1 and a message that names the limit.
+    let dir = scratch_dir("ulimit-oom");
+    let bin = env!("CARGO_BIN_EXE_radiosity");
+    for kib in [60_000, 250_000, 400_000] {
+        let out = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v {kib} && exec '{bin}' solve --max-area 30 -o x.csv"
+            ))
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "ulimit -v {kib}: {err}");
+        assert!(err.contains("ulimit -v"), "ulimit -v {kib}: {err}");
+        assert!(!err.contains("backtrace"), "ulimit -v {kib}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_scene_far_from_the_origin_is_warned_about() {
     // A 1 x 1 x 1 closed box of six quads shifted by 3e9 along x and z: 2e9 times its size
     // out, where such scenes were measured to render wrong; the same box at the origin
