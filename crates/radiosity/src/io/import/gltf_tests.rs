@@ -1417,3 +1417,31 @@ fn an_orthographic_camera_is_warned_about_and_not_used() {
     let w = imported.warnings[0].to_string();
     assert!(w.contains("orthographic camera of node"), "{w}");
 }
+
+/// QA of issue #16: room.scene exported to glTF came back with a table leg's corner
+/// 3.6999999999999997 read as 3.7 (serde_json's default float parsing can be an ulp off),
+/// and its solve differed by up to 0.13 %. An export's numbers, as `exported_polygon`
+/// reads them (through a `serde_json::Value`), are the written ones to the last bit.
+#[test]
+fn json_numbers_read_back_to_the_last_bit() {
+    // The doubles beside a positive x.
+    let beside = |x: f64| {
+        [
+            f64::from_bits(x.to_bits() - 1),
+            f64::from_bits(x.to_bits() + 1),
+        ]
+    };
+    let mut values = vec![beside(3.7)[0], 0.1 + 0.2, 1e-300, 5e-324, 1.0 / 3.0];
+    // A spread of awkward doubles: consecutive ones near decimal round numbers.
+    for k in 1..2000u64 {
+        let x = k as f64 * 0.0370001;
+        values.push(x);
+        values.extend(beside(x));
+    }
+    for x in values {
+        let text = serde_json::to_string(&serde_json::json!([x, -x])).unwrap();
+        let back: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let got = [back[0].as_f64().unwrap(), back[1].as_f64().unwrap()];
+        assert_eq!(got.map(f64::to_bits), [x, -x].map(f64::to_bits), "{text}");
+    }
+}
