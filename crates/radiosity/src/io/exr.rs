@@ -19,7 +19,7 @@
 //! software.
 
 use std::collections::HashMap;
-use std::io;
+use std::io::{self, Write};
 use std::path::Path;
 
 use exr::prelude::{
@@ -37,17 +37,76 @@ pub const UNIT: &str = "the scene's emission unit per steradian: cd/m^2 where E 
                         (photometric scenes), W/(m^2 sr) where E is in W/m^2";
 
 /// Writes `image` (a layer with its attributes) to `path`, atomically (see
-/// [`crate::io::write_atomically`]); the `exr` crate's errors become I/O errors.
+/// [`crate::io::write_atomically`]), its header's attributes in the order of their names
+/// ([`sort_header_attributes`]); the `exr` crate's errors become I/O errors.
 pub(crate) fn write_image(
     path: &Path,
     image: Image<Layer<AnyChannels<FlatSamples>>>,
 ) -> io::Result<()> {
-    crate::io::write_atomically(path, |out| {
-        image.write().to_buffered(out).map_err(|e| match e {
-            exr::error::Error::Io(e) => e,
-            other => io::Error::other(other.to_string()),
-        })
-    })
+    let mut bytes = io::Cursor::new(Vec::new());
+    image.write().to_buffered(&mut bytes).map_err(|e| match e {
+        exr::error::Error::Io(e) => e,
+        other => io::Error::other(other.to_string()),
+    })?;
+    let mut bytes = bytes.into_inner();
+    sort_header_attributes(&mut bytes);
+    crate::io::write_atomically(path, |out| out.write_all(&bytes))
+}
+
+/// Puts the attributes of a single-part OpenEXR file's header in the order of their names,
+/// in place. The `exr` crate writes a layer's own attributes from a `HashMap` whose order
+/// changes from run to run, so the same image made different files (QA of issue #16);
+/// sorted, the same image is the same bytes. The header keeps its length, so the offsets
+/// that follow it stay right. A header that does not parse as one (or a multi-part file)
+/// is left as it is.
+///
+/// The layout (OpenEXR file layout, "Header"): the magic number and version field (8
+/// bytes), then attributes, each a name and a type name ended by 0 bytes, a 4-byte
+/// little-endian size and that many bytes of value, and a 0 byte that ends the header.
+fn sort_header_attributes(bytes: &mut [u8]) {
+    const MULTIPART: u8 = 0x10; // bit 12 of the version field, in its second byte
+    if bytes.len() < 8 || bytes[..4] != [0x76, 0x2f, 0x31, 0x01] || bytes[5] & MULTIPART != 0 {
+        return;
+    }
+    let zero_after = |from: usize| {
+        bytes
+            .get(from..)?
+            .iter()
+            .position(|&b| b == 0)
+            .map(|k| from + k)
+    };
+    let mut spans: Vec<(usize, usize, usize)> = Vec::new(); // (start, name end, end)
+    let mut at = 8;
+    loop {
+        match bytes.get(at) {
+            None => return,
+            Some(0) => break,
+            Some(_) => {}
+        }
+        let Some(name_end) = zero_after(at) else {
+            return;
+        };
+        let Some(type_end) = zero_after(name_end + 1) else {
+            return;
+        };
+        let Some(size) = bytes.get(type_end + 1..type_end + 5) else {
+            return;
+        };
+        let size = u32::from_le_bytes([size[0], size[1], size[2], size[3]]) as usize;
+        let end = type_end + 5 + size;
+        if end > bytes.len() {
+            return;
+        }
+        spans.push((at, name_end, end));
+        at = end;
+    }
+    let mut sorted = spans.clone();
+    sorted.sort_by(|a, b| bytes[a.0..a.1].cmp(&bytes[b.0..b.1]));
+    let header: Vec<u8> = sorted
+        .iter()
+        .flat_map(|&(start, _, end)| bytes[start..end].iter().copied())
+        .collect();
+    bytes[8..at].copy_from_slice(&header);
 }
 
 /// Writes a `width` x `height` linear image whose pixels (row by row from the top left)
@@ -195,5 +254,48 @@ mod tests {
         let err = write_radiance(&other, 2, 2, &film, &camera, "test", "metres").unwrap_err();
         assert_eq!(err.kind(), io::ErrorKind::InvalidInput);
         assert!(!other.exists());
+    }
+
+    /// QA of issue #16: the same image written twice made two files (the header's
+    /// attributes came in a `HashMap`'s order). Written again and again, it is the same
+    /// bytes, its attributes in the order of their names, and it reads back.
+    #[test]
+    fn the_same_image_is_the_same_bytes() {
+        let film = vec![[1.0, 2.0, 3.0]; 4];
+        let camera = Camera {
+            eye: DVec3::new(0.0, 0.0, -3.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+            width: 2,
+            height: 2,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let files: Vec<Vec<u8>> = (0..8)
+            .map(|k| {
+                let path = dir.path().join(format!("{k}.exr"));
+                write_radiance(&path, 2, 2, &film, &camera, "test", "metres").unwrap();
+                assert_eq!(text_attributes(&path).unwrap()["radiosity.unit"], UNIT);
+                assert_eq!(read_rgb(&path).unwrap().2.len(), 4);
+                std::fs::read(&path).unwrap()
+            })
+            .collect();
+        for f in &files[1..] {
+            assert!(f == &files[0], "two writes of one image differ");
+        }
+        // The names in the header, in order.
+        let mut names = Vec::new();
+        let mut at = 8;
+        let bytes = &files[0];
+        while bytes[at] != 0 {
+            let name_end = at + bytes[at..].iter().position(|&b| b == 0).unwrap();
+            let type_end =
+                name_end + 1 + bytes[name_end + 1..].iter().position(|&b| b == 0).unwrap();
+            let size = u32::from_le_bytes(bytes[type_end + 1..type_end + 5].try_into().unwrap());
+            names.push(bytes[at..name_end].to_vec());
+            at = type_end + 5 + size as usize;
+        }
+        assert!(names.len() > 10, "{} attributes", names.len());
+        assert!(names.windows(2).all(|w| w[0] < w[1]), "not in order");
     }
 }
