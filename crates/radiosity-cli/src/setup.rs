@@ -447,8 +447,7 @@ pub fn note_output(path: &Path, flag: &str, label: &str) -> Result<()> {
     // The same output noted again (a command checked twice, or run again in one process,
     // as `radiosity-mpi` and the tests do) is no clash.
     let same = |o: &Output| {
-        lexical_absolute(&o.path) == lexical_absolute(path)
-            || radiosity::io::is_same_file(&o.path, path)
+        resolved(&o.path) == resolved(path) || radiosity::io::is_same_file(&o.path, path)
     };
     if outputs
         .iter()
@@ -469,6 +468,25 @@ pub fn note_output(path: &Path, flag: &str, label: &str) -> Result<()> {
         label: label.to_string(),
     });
     Ok(())
+}
+
+/// Where writing `path` would write: [`lexical_absolute`], through the links that the
+/// name and its folders are (QA of issue #16: `--report link.csv`, a link to the `-o`
+/// file not yet written, wrote over it), whether or not the file itself exists yet.
+fn resolved(path: &Path) -> std::path::PathBuf {
+    let mut at = lexical_absolute(path);
+    // A link's target, relative to its folder; a cycle ends after 40, as the system's.
+    for _ in 0..40 {
+        let Ok(target) = std::fs::read_link(&at) else {
+            break;
+        };
+        let folder = at.parent().map(Path::to_path_buf).unwrap_or_default();
+        at = lexical_absolute(&folder.join(target));
+    }
+    match (at.parent().map(std::fs::canonicalize), at.file_name()) {
+        (Some(Ok(folder)), Some(name)) => folder.join(name),
+        _ => at,
+    }
 }
 
 /// `path` made absolute (against the working folder) with its `.` and `..` taken out by
@@ -1147,7 +1165,13 @@ pub fn output_directory(output: &Path, flag: &str) -> Result<()> {
             output.display()
         );
     }
-    parent_folder_exists(output, flag)
+    parent_folder_exists(output, flag)?;
+    // A folder that exists but cannot be written in (QA of issue #16: found only after the
+    // render, with the temporary file's name).
+    if let Err(e) = radiosity::io::check_writable(output) {
+        bail!("{flag} {}: cannot write there: {}", output.display(), e);
+    }
+    Ok(())
 }
 
 /// Refuses `path` (given with `flag`) whose folder does not exist: no output makes the

@@ -80,8 +80,29 @@ pub(crate) fn temporary_beside(
     }
     // The file is written through its own handle; `tmp` removes it when dropped, which is
     // what happens on every early return of the callers.
-    let (file, tmp) = builder.tempfile_in(dir)?.into_parts();
+    // tempfile's error names the temporary file ("permission denied at path
+    // \"ro/.x.png.3551.W83OrR.tmp\""), which the user never asked for: its cause alone.
+    let made = builder.tempfile_in(dir).map_err(|e| {
+        let text = e.to_string();
+        let cause = text.split(" at path ").next().unwrap_or(&text).to_string();
+        io::Error::new(e.kind(), cause)
+    })?;
+    let (file, tmp) = made.into_parts();
     Ok((file, tmp, path.to_path_buf()))
+}
+
+/// Whether [`write_atomically`] can write `path`, found without writing it: a temporary
+/// file is made beside it and removed (a device or other non-regular file that exists is
+/// taken as writable). For checking outputs before long work (QA of issue #16: a render
+/// into a read-only folder failed only after its solve).
+pub fn check_writable(path: &Path) -> io::Result<()> {
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() {
+            return Ok(());
+        }
+    }
+    let (_file, _tmp, _) = temporary_beside(path)?;
+    Ok(())
 }
 
 /// How long a dead run's temporary file is left alone: longer than any write of ours takes
