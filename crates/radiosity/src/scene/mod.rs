@@ -24,6 +24,12 @@ pub mod overlap;
 pub(crate) mod shape;
 
 pub use builtin::cornell_box;
+
+/// The largest emission (exitance per band, in the scene's units), luminance or flux a
+/// scene may give: the emitted power, summed over surfaces of up to 1e60 units^2
+/// ([`crate::geometry::MAX_COORDINATE`] squared), stays finite (QA of issue #16: an `Er`
+/// of 1e308 gave energy lines of "inf %").
+pub const MAX_EMISSION: f64 = 1e30;
 pub use generate::{building, BuildingError, BuildingParams};
 pub use overlap::{lying_on, Overlap};
 

@@ -63,6 +63,7 @@ use std::path::{Path, PathBuf};
 use glam::{DMat4, DVec3};
 use serde::Deserialize;
 
+use super::face_soup::{material_problem, MaterialField};
 use super::{
     check_count, default_settings, scaled_unit, FaceSoup, Format, ImportError, ImportOptions,
     ImportWarning, Imported, SoupFace, SoupMaterial,
@@ -1047,9 +1048,13 @@ impl Builder<'_> {
         };
         let mut material_of_layer = Vec::with_capacity(self.layers.len());
         for name in &self.layers {
-            let (m, line) = match (table.layers.get(name), &table.default) {
-                (Some(m), _) => (m, table.line_of(&format!("[layers.{name}]"))),
-                (None, Some(d)) => (d, table.line_of("[default]")),
+            let (m, line, what) = match (table.layers.get(name), &table.default) {
+                (Some(m), _) => (m, table.line_of(&format!("[layers.{name}]")), name.clone()),
+                (None, Some(d)) => (
+                    d,
+                    table.line_of("[default]"),
+                    format!("[default] for layer {name}"),
+                ),
                 (None, None) => {
                     // A table that names no layer is most likely this one misspelt.
                     let unused: Vec<String> = table
@@ -1079,11 +1084,24 @@ impl Builder<'_> {
                     });
                 }
             };
+            let reflectance = Rgb(*m.reflectance.get_ref());
+            let emission = Rgb(m.emission.as_ref().map_or([0.0; 3], |e| *e.get_ref()));
+            // A colour the scene format cannot hold is reported at its own line, and a
+            // layer that takes [default] says so (QA of issue #16: an emission of NaN in
+            // [default] on line 3 was reported at line 1 as the layer's).
+            let line = match material_problem(reflectance, emission) {
+                Some((MaterialField::Reflectance, _)) => table.line_at(m.reflectance.span().start),
+                Some((MaterialField::Emission, _)) => m
+                    .emission
+                    .as_ref()
+                    .map_or(line, |e| table.line_at(e.span().start)),
+                None => line,
+            };
             material_of_layer.push(soup.materials.len() as u32);
             soup.materials.push(SoupMaterial {
-                name: name.clone(),
-                reflectance: Rgb(m.reflectance),
-                emission: Rgb(m.emission.unwrap_or([0.0; 3])),
+                name: what,
+                reflectance,
+                emission,
                 defined_at: Some((materials_file.to_string(), line)),
             });
         }
@@ -1111,8 +1129,9 @@ impl Builder<'_> {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LayerMaterial {
-    reflectance: [f64; 3],
-    emission: Option<[f64; 3]>,
+    /// With its place in the file, so that a wrong colour's message names its own line.
+    reflectance: toml::Spanned<[f64; 3]>,
+    emission: Option<toml::Spanned<[f64; 3]>>,
 }
 
 #[derive(Deserialize)]
@@ -1188,6 +1207,11 @@ impl MaterialsFile {
                 }
             })
             .collect()
+    }
+
+    /// The line (from 1) of byte `at` of the file.
+    fn line_at(&self, at: usize) -> usize {
+        1 + self.text[..at.min(self.text.len())].matches('\n').count()
     }
 
     /// The line of a table header (for messages about its colours); 0 when it is written

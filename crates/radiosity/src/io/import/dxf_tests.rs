@@ -366,12 +366,35 @@ fn a_missing_layer_or_materials_file_lists_the_layers_found() {
         e.ends_with("layers with faces: \"Floor\", \"Wall\", or a [default] table for all"),
         "{e}"
     );
-    // A reflectance of 1 is the shared check's error, at the table's line.
+    // A reflectance of 1 is the shared check's error, at the line of the value, naming
+    // the table it is in (QA of issue #16: line 1, and the layer's name alone).
     assert_eq!(
         err(&text, Some("[default]\nreflectance = [1, 0.5, 0.5]\n")),
-        "t.materials.toml:1: error: material \"Floor\": the red reflectance is 1; reflectance \
-         must be at least 0 and below 1 (a surface cannot reflect all the light it receives, \
-         or more)"
+        "t.materials.toml:2: error: material \"[default] for layer Floor\": the red \
+         reflectance is 1; reflectance must be at least 0 and below 1 (a surface cannot \
+         reflect all the light it receives, or more)"
+    );
+    let e = err(
+        &text,
+        Some("[default]\nreflectance = [0.5, 0.5, 0.5]\nemission = [nan, 1, 1]\n"),
+    );
+    assert!(
+        e.starts_with(
+            "t.materials.toml:3: error: material \"[default] for layer Floor\": the \
+                       red emission is NaN"
+        ),
+        "{e}"
+    );
+    let e = err(
+        &text,
+        Some(
+            "[layers.Floor]\nreflectance = [0.5, 0.5, 0.5]\n\n[layers.Wall]\n\
+             reflectance = [0.5, -0.5, 0.5]\n",
+        ),
+    );
+    assert!(
+        e.starts_with("t.materials.toml:5: error: material \"Wall\": the green reflectance"),
+        "{e}"
     );
     // Not TOML, or a misspelt key: the line.
     let e = err(

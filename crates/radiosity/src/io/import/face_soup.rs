@@ -66,11 +66,61 @@ pub struct SoupMaterial {
     pub defined_at: Option<(String, usize)>,
 }
 
+/// Which colour of a material the scene format cannot hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum MaterialField {
+    /// The reflectance.
+    Reflectance,
+    /// The emission.
+    Emission,
+}
+
+/// The first colour of a material that the scene format cannot hold, and why: reflectance
+/// at least 0 and below 1, emission finite, at least 0 and at most
+/// [`crate::scene::MAX_EMISSION`]. Importers that know each colour's own line (the DXF
+/// materials file) use the field to point at it.
+pub(crate) fn material_problem(reflectance: Rgb, emission: Rgb) -> Option<(MaterialField, String)> {
+    for (band, &r) in ["red", "green", "blue"].iter().zip(&reflectance.0) {
+        if !(0.0..1.0).contains(&r) {
+            return Some((
+                MaterialField::Reflectance,
+                format!(
+                    "the {band} reflectance is {r}; reflectance must be at least 0 and below 1 \
+                     (a surface cannot reflect all the light it receives, or more)"
+                ),
+            ));
+        }
+    }
+    for (band, &e) in ["red", "green", "blue"].iter().zip(&emission.0) {
+        if !(e >= 0.0 && e.is_finite()) {
+            return Some((
+                MaterialField::Emission,
+                format!(
+                    "the {band} emission is {e}; emission must be a finite number of at least 0"
+                ),
+            ));
+        }
+        if e > crate::scene::MAX_EMISSION {
+            return Some((
+                MaterialField::Emission,
+                format!(
+                    "the {band} emission is {e:e}, above the largest the program supports \
+                     ({:e}): the power summed over the scene would overflow",
+                    crate::scene::MAX_EMISSION
+                ),
+            ));
+        }
+    }
+    None
+}
+
 /// One output surface before naming: its object, material and corners.
 struct Piece {
     object: u32,
     material: u32,
     vertices: Vec<DVec3>,
+    /// The face it comes from (an index into the soup's faces).
+    face: usize,
 }
 
 impl FaceSoup {
@@ -105,6 +155,7 @@ impl FaceSoup {
                     object: face.object,
                     material: face.material,
                     vertices,
+                    face: f,
                 })
             };
             match geometry::validate_polygon(&corners) {
@@ -185,8 +236,9 @@ impl FaceSoup {
                 faces: self.faces.len(),
             });
         }
+        let faces: Vec<usize> = pieces.iter().map(|p| p.face).collect();
         let mut surfaces = self.name_pieces(pieces);
-        self.drop_duplicates(&mut surfaces, &mut warnings);
+        self.drop_duplicates(&mut surfaces, &faces, &mut warnings);
         Ok((
             Scene {
                 surfaces,
@@ -236,21 +288,8 @@ impl FaceSoup {
                     message,
                 }
             };
-            for (band, &r) in ["red", "green", "blue"].iter().zip(&m.reflectance.0) {
-                if !(0.0..1.0).contains(&r) {
-                    return Err(bad(format!(
-                        "the {band} reflectance is {r}; reflectance must be at least 0 and \
-                         below 1 (a surface cannot reflect all the light it receives, or more)"
-                    )));
-                }
-            }
-            for (band, &e) in ["red", "green", "blue"].iter().zip(&m.emission.0) {
-                if !(e >= 0.0 && e.is_finite()) {
-                    return Err(bad(format!(
-                        "the {band} emission is {e}; emission must be a finite number of at \
-                         least 0"
-                    )));
-                }
+            if let Some((_, message)) = material_problem(m.reflectance, m.emission) {
+                return Err(bad(message));
             }
         }
         Ok(())
@@ -435,13 +474,24 @@ impl FaceSoup {
 
     /// Drops every surface that repeats another exactly (the scene reader's duplicate
     /// check), with a warning.
-    fn drop_duplicates(&self, surfaces: &mut Vec<Surface>, warnings: &mut Vec<ImportWarning>) {
+    fn drop_duplicates(
+        &self,
+        surfaces: &mut Vec<Surface>,
+        faces: &[usize],
+        warnings: &mut Vec<ImportWarning>,
+    ) {
         let pairs = duplicate_surfaces(surfaces);
         if pairs.is_empty() {
             return;
         }
         let mut drop = vec![false; surfaces.len()];
         let mut named = Vec::new();
+        // The face a surface comes from, as the other warnings name faces (QA of issue
+        // #16: "face 7 of object \"Room\" (line 21)" beside a bare "\"Room.6\"").
+        let face = |s: usize| match self.faces[faces[s]].line {
+            0 => self.describe_face(faces[s]),
+            l => format!("{}, line {l}", self.describe_face(faces[s])),
+        };
         for &(upper, lower) in &pairs {
             if drop[upper] || drop[lower] {
                 continue;
@@ -451,11 +501,19 @@ impl FaceSoup {
                 // One name for both (a shape placed twice): said once (QA of issue #16:
                 // "\"Lamp.0\" (the same as \"Lamp.0\")").
                 named.push(if surfaces[upper].name == surfaces[lower].name {
-                    format!("\"{}\" (twice)", surfaces[upper].name)
+                    format!(
+                        "\"{}\" ({}; the same as {})",
+                        surfaces[upper].name,
+                        face(upper),
+                        face(lower)
+                    )
                 } else {
                     format!(
-                        "\"{}\" (the same as \"{}\")",
-                        surfaces[upper].name, surfaces[lower].name
+                        "\"{}\" ({}; the same as \"{}\", {})",
+                        surfaces[upper].name,
+                        face(upper),
+                        surfaces[lower].name,
+                        face(lower)
                     )
                 });
             }

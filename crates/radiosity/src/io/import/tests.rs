@@ -289,10 +289,11 @@ fn a_face_given_twice_is_dropped_with_a_warning() {
     .unwrap();
     assert_eq!(scene.surfaces.len(), 1);
     assert_eq!(warnings.len(), 1);
-    assert!(
-        warnings[0]
-            .message
-            .starts_with("dropped 1 face given twice"),
+    // Named by face, as the degenerate faces are (QA of issue #16).
+    assert_eq!(
+        warnings[0].message,
+        "dropped 1 face given twice (the same polygon facing the same way): \"B\" (face 2 of \
+         object \"B\", line 2; the same as \"A\", face 1 of object \"A\", line 1)",
         "{}",
         warnings[0]
     );

@@ -312,6 +312,14 @@ impl<'a> Lexer<'a> {
                 None => Err((line, format!("\"{word}\" is not a number"))),
             };
         }
+        // NaN and infinities spelt as words (QA of issue #16: `1 0 nan` read as a node type
+        // named "nan", and the error spoke of a missing '{'). No VRML identifier is meant so.
+        if ["nan", "inf", "infinity"]
+            .iter()
+            .any(|w| word.eq_ignore_ascii_case(w))
+        {
+            return Err((line, format!("\"{word}\" is not a finite number")));
+        }
         Ok((Tok::Ident(word.to_string()), line))
     }
 }

@@ -383,9 +383,21 @@ fn non_finite_numbers_are_refused_at_their_line() {
         err("#VRML V2.0 utf8\nShape { geometry Sphere {\nradius 1e999 } }"),
         "t.wrl:3: error: \"1e999\" is not a finite number (inf)"
     );
+    // NaN spelt as a word (QA of issue #16: "expected '{' after the node type nan").
+    assert_eq!(
+        err("#VRML V2.0 utf8\nShape { geometry Sphere { radius nan } }"),
+        "t.wrl:2: error: \"nan\" is not a finite number"
+    );
+    assert_eq!(
+        err(
+            "#VRML V2.0 utf8\nShape { appearance Appearance { material Material {\n\
+             diffuseColor 0.5 0.5 NaN } } geometry Sphere { } }"
+        ),
+        "t.wrl:3: error: \"NaN\" is not a finite number"
+    );
     assert!(
-        err("#VRML V2.0 utf8\nShape { geometry Sphere { radius nan } }")
-            .contains("expected '{' after the node type nan")
+        err("#VRML V2.0 utf8\nShape { geometry Sphere { radius Infinity } }")
+            .contains("\"Infinity\" is not a finite number")
     );
     assert!(
         err("#VRML V2.0 utf8\nShape { geometry Sphere { radius -1 } }")

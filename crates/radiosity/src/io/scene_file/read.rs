@@ -927,6 +927,14 @@ impl<'a> Parser<'a> {
                     let msg = format!("{what} must not be negative, found \"{}\"", token.text);
                     self.error_at(token, &line, msg);
                 }
+                if let (true, Some(token)) = (v > crate::scene::MAX_EMISSION, token) {
+                    let what = if k == Keyword::Luminance {
+                        "LUMINANCE"
+                    } else {
+                        "FLUX"
+                    };
+                    self.error_at(token, &line, too_bright(what, token.text));
+                }
                 if k == Keyword::Luminance {
                     emission = [std::f64::consts::PI * v; 3];
                     photometry.emission = EmissionGiven::Luminance(v);
@@ -953,6 +961,9 @@ impl<'a> Parser<'a> {
                         let msg =
                             format!("emission must not be negative, found \"{}\"", token.text);
                         self.error_at(token, &line, msg);
+                    }
+                    if let (true, Some(token)) = (v > crate::scene::MAX_EMISSION, token) {
+                        self.error_at(token, &line, too_bright("emission", token.text));
                     }
                     emission[i] = v;
                 }
@@ -1580,3 +1591,13 @@ mod round_tests;
 #[cfg(test)]
 #[path = "photometric_tests.rs"]
 mod photometric_tests;
+
+/// The error for an emission, LUMINANCE or FLUX (`what`) given as `text`, past
+/// [`crate::scene::MAX_EMISSION`].
+fn too_bright(what: &str, text: &str) -> String {
+    format!(
+        "{what} \"{text}\" is above the largest the program supports ({:e}): the power \
+         summed over the scene would overflow",
+        crate::scene::MAX_EMISSION
+    )
+}

@@ -874,6 +874,27 @@ fn box_faces_too_small_or_too_thin_are_refused_at_the_size_line() {
     assert_eq!(e[0].0, 18, "{e:#?}");
 }
 
+// QA of issue #16: an emission of 1e308 was read, and the energy account said "inf %".
+// Emission, LUMINANCE and FLUX above 1e30 are refused at their word; 1e30 itself is read.
+#[test]
+fn emission_beyond_the_supported_range_is_refused_at_its_word() {
+    one_error(&with_line(7, "Er 1e308"), 7, 4, "above the largest");
+    one_error(&with_line(9, "Eb 2e30"), 9, 4, "(1e30)");
+    one_error(
+        &with_lines(&[(7, "LUMINANCE 1e31"), (8, ""), (9, "")]),
+        7,
+        11,
+        "LUMINANCE",
+    );
+    one_error(
+        &with_lines(&[(7, "FLUX 1e31"), (8, ""), (9, "")]),
+        7,
+        6,
+        "FLUX",
+    );
+    assert!(errors(&with_line(8, "Eg 1e30")).is_empty());
+}
+
 // Regression (issue 12): coordinates of 1e20 and more panicked in the BVH builder, and ones
 // near 1e154..1e308 gave "VERTEX0 and VERTEX1 are the same point" (the squared length
 // overflowed). Coordinates beyond 1e30 are refused at their own word, with the range.
