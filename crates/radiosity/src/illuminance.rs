@@ -795,6 +795,8 @@ pub struct GridAxes {
     pub first: [f64; 2],
     /// From one column (row) to the next: the spacing, signed.
     pub step: [f64; 2],
+    /// Row 0 drawn at the top, not the bottom ([`GridAxes::seen_from`]).
+    pub rows_down: bool,
 }
 
 impl GridAxes {
@@ -810,6 +812,7 @@ impl GridAxes {
                 names: [name(u), name(w)],
                 first: [a[u], a[w]],
                 step: [(b[u] - a[u]).signum() * spacing, 0.0],
+                rows_down: false,
             });
         }
         let [u, v] = varying[..] else { return None };
@@ -820,7 +823,28 @@ impl GridAxes {
                 (b[u] - a[u]).signum() * spacing,
                 (b[v] - a[v]).signum() * spacing,
             ],
+            rows_down: false,
         })
+    }
+
+    /// The axes drawn as the grid looks from the side its meters face (`normal`), its
+    /// columns running left to right: rows run up where the row axis is `normal` x the
+    /// column axis, down where it is the opposite. A z-up floor grid (normal +z) is a plan
+    /// seen from above either way; a y-up one (normal +y, rows along z) draws z downward,
+    /// as a plan seen from above does (QA of issue #16: it was drawn seen from below).
+    pub fn seen_from(self, normal: DVec3) -> Self {
+        let unit = |name: char, step: f64| {
+            let i = "xyz".find(name).unwrap_or(0);
+            DVec3::AXES[i] * if step < 0.0 { -1.0 } else { 1.0 }
+        };
+        let (right, rows) = (
+            unit(self.names[0], self.step[0]),
+            unit(self.names[1], self.step[1]),
+        );
+        Self {
+            rows_down: rows.dot(normal.cross(right)) < 0.0,
+            ..self
+        }
     }
 
     /// The labels of `n` columns (`axis` 0) or rows (1), with the decimals of the step.
@@ -843,7 +867,7 @@ const LEGEND_FONT: i64 = 3;
 /// the uniformity U0 ([`GridSummary`]); one cell per point coloured by its value on the
 /// false-colour scale from 0 to a round top ([`nice_scale`] of the largest value), the value
 /// printed in the cell (where it fits), row 0 at the bottom (a plan seen from above for a
-/// z-up floor grid); on the right a scale bar with its values and the unit `lx`. `values`
+/// z-up floor grid) unless the axes say otherwise ([`GridAxes::seen_from`]); on the right a scale bar with its values and the unit `lx`. `values`
 /// run column by column within rows (as [`grid`] makes them); `dims` = [columns, rows].
 pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
     grid_picture_with_axes(values, dims, None)
@@ -874,6 +898,9 @@ pub fn grid_picture_with_axes(
     let (gw, gh) = (cell * nu as i64, cell * nv as i64);
     let top = GRID_TOP;
     let labels = axes.map(|a| (a.labels(0, nu), a.labels(1, nv)));
+    // Where row j is drawn, counted from the top.
+    let rows_down = axes.is_some_and(|a| a.rows_down);
+    let row_at = |j: usize| if rows_down { j } else { nv - 1 - j };
     // Room for the row labels on the left and the column labels below.
     let (left, below) = match &labels {
         Some((_, rows)) => {
@@ -903,7 +930,7 @@ pub fn grid_picture_with_axes(
             draw_text(&mut img, x, top + gh + 6, 2, label, [0; 3]);
         }
         for (j, label) in rows.iter().enumerate().step_by(every_row) {
-            let centre = top + (nv - 1 - j) as i64 * cell + cell / 2;
+            let centre = top + row_at(j) as i64 * cell + cell / 2;
             let x = margin - 6 - text_width(label, 2);
             draw_text(&mut img, x, centre - 5, 2, label, [0; 3]);
         }
@@ -930,7 +957,7 @@ pub fn grid_picture_with_axes(
         for i in 0..nu {
             let v = values.get(j * nu + i).copied().unwrap_or(0.0);
             let c = false_colour(scale_of(v));
-            let (x0, y0) = (margin + i as i64 * cell, top + (nv - 1 - j) as i64 * cell);
+            let (x0, y0) = (margin + i as i64 * cell, top + row_at(j) as i64 * cell);
             for y in y0..y0 + cell {
                 for x in x0..x0 + cell {
                     let edge = x == x0 || y == y0;
