@@ -281,7 +281,7 @@ pub fn energy_note(
         BAND_NAMES[band],
         share(b.absorbed[band]),
         escaped,
-        escaped_meaning(escaped)
+        escaped_meaning(escaped, &solution.report)
     );
     if let SolutionReport::Progressive(_) = solution.report {
         text.push_str(" (the rest is still unshot)");
@@ -425,7 +425,9 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
             significant(100.0 * absorbed, 2)
         )
     } else {
-        "so pictures are black".to_string()
+        // The emitters themselves still show (QA of issue #16: a glowing box was said to
+        // make black pictures).
+        "so nothing is lit: pictures show at most the emitters themselves".to_string()
     };
     // Blame the emitters' orientation only where it is to blame: an emitter with no other
     // surface in front of it (QA of issue #16: a lamp facing a ground 20 m below, and the
@@ -438,8 +440,9 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
     if !facing_nothing.is_empty() {
         return Some(format!(
             "{:.2} % of the emitted light reaches no surface ({pictures}): {} {} out of the \
-             scene, with no surface in front of {} (corners listed clockwise, seen from the \
-             side to light, face the other way: reverse their order)",
+             scene, with no surface in front of {} (if that is not meant: a polygon whose \
+             corners run clockwise seen from the side to light faces the other way, so reverse \
+             their order; a BOX lit from inside takes FACING IN)",
             100.0 * (1.0 - absorbed),
             names(&facing_nothing),
             if facing_nothing.len() == 1 {
@@ -514,8 +517,11 @@ fn faces_nothing(scene: &Scene, s: usize) -> bool {
 }
 
 /// What an escaped share (percent of the emitted power) means, for the energy notes.
-fn escaped_meaning(percent: f64) -> String {
-    if percent < 0.0 {
+fn escaped_meaning(percent: f64, report: &SolutionReport) -> String {
+    if percent < 0.0 && matches!(report, SolutionReport::Hierarchical(_)) {
+        // QA of issue #16: hierarchical radiosity has no rows to blame.
+        format!("negative: {COUNTED_TWICE_LINKS}")
+    } else if percent < 0.0 {
         format!("negative: {COUNTED_TWICE}")
     } else {
         format!("light that reached no element: {ESCAPED}")
@@ -542,6 +548,11 @@ const UNSOLVED: &str = "the form factors are reciprocal, so it is light the solv
 /// What a row of form factors above 1 does, in the same places.
 const COUNTED_TWICE: &str = "light counted twice where the form factors' rows sum above 1 \
                              (near pairs' visibility misjudged)";
+
+/// The same for hierarchical radiosity, which has links, not rows.
+const COUNTED_TWICE_LINKS: &str = "light counted twice where the estimated form factors of a \
+                                   node's links sum above 1 (coarse links near corners and \
+                                   contacts)";
 
 /// Prints the note on surfaces lying on others (a rug in or just above a floor's plane):
 /// how many pairs, and which, by index and name, with the gap and the area covered.
@@ -953,7 +964,7 @@ pub fn check(
         outln!(
             "                  (powers: exitance E times {area_unit}, so {watts}; escaped: \
              {}; {} is the band emitting most)",
-            escaped_meaning(100.0 * b.escaped[k] / b.emitted[k]),
+            escaped_meaning(100.0 * b.escaped[k] / b.emitted[k], &solution.report),
             BAND_NAMES[k]
         );
         if let Some(why) = account_error_reason(prepared.method(), solution) {

@@ -129,7 +129,7 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     // A scene with no light was warned of when it was read: every point is dark there.
     let lit =
         crate::setup::no_emitter(&prepared.scene, radiosity::io::import::Format::Scene).is_none();
-    if let Some(w) = dark_points(&points, &lux, args.grid.is_some()).filter(|_| lit) {
+    if let Some(w) = dark_points(&prepared, &points, &lux, args.grid.is_some()).filter(|_| lit) {
         // Printed even with --quiet: figures that are surely not what was meant.
         errln!("warning: {w}");
     }
@@ -144,7 +144,11 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         let totals: Vec<f64> = lux.iter().map(|l| l.total).collect();
         let axes = args
             .grid
-            .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing));
+            .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing))
+            .map(|axes| match points.first() {
+                Some(p) => axes.seen_from(p.normal),
+                None => axes,
+            });
         let img = illuminance::grid_picture_with_axes(&totals, dims, axes);
         crate::progress_bar::run_file_stage(&reporter, Stage::Write, png, || {
             radiosity::io::png::write_png(&img, png)
@@ -198,32 +202,98 @@ fn grid_short_of_corner(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> Option<
 
 /// A warning when some points get no light at all (QA of issue #16: points inside the
 /// cupboard, under the floor and outside the room gave 0 lx without a word, and spoiled a
-/// grid's minimum and uniformity).
-fn dark_points(points: &[CalcPoint], lux: &[illuminance::Lux], grid: bool) -> Option<String> {
+/// grid's minimum and uniformity), and why: a point that sees the front of some surface
+/// is in the open, in full shadow among surfaces that pass no light on (QA of issue #16:
+/// points in a black room's shadow were asked whether they were inside furniture).
+fn dark_points(
+    prepared: &radiosity::pipeline::Prepared,
+    points: &[CalcPoint],
+    lux: &[illuminance::Lux],
+    grid: bool,
+) -> Option<String> {
     let dark: Vec<&CalcPoint> = points
         .iter()
         .zip(lux)
         .filter(|(_, l)| l.total == 0.0)
         .map(|(p, _)| p)
         .collect();
-    let first = dark.first()?;
+    dark.first()?;
+    let (open, shut): (Vec<&CalcPoint>, Vec<&CalcPoint>) = dark
+        .iter()
+        .partition(|p| sees_a_front(prepared, p.position, p.normal));
+    let first = |p: &[&CalcPoint]| {
+        p.first().map(|p| {
+            format!(
+                "the first: \"{}\" at {},{},{}",
+                p.name, p.position.x, p.position.y, p.position.z
+            )
+        })
+    };
+    let mut why = Vec::new();
+    if let Some(f) = first(&shut) {
+        why.push(format!(
+            "{} ({f}) {} only the backs of faces, or nothing: inside furniture, under the \
+             floor or outside the scene?",
+            shut.len(),
+            if shut.len() == 1 { "sees" } else { "see" },
+        ));
+    }
+    if let Some(f) = first(&open) {
+        why.push(format!(
+            "{} ({f}) {} surfaces but no light: in full shadow, where what {} sees \
+             reflects nothing (reflectance 0, or unlit itself)",
+            open.len(),
+            if open.len() == 1 { "sees" } else { "see" },
+            if open.len() == 1 { "it" } else { "each" },
+        ));
+    }
     Some(format!(
-        "{} of {} {} no light at all, 0 lx (the first: \"{}\" at {},{},{}): inside \
-         furniture, under the floor or outside the scene? A meter there sees only the backs \
-         of faces, or nothing{}",
+        "{} of {} {} no light at all, 0 lx: {}{}",
         crate::report::count(dark.len() as u64, "point"),
         points.len(),
         if dark.len() == 1 { "gets" } else { "get" },
-        first.name,
-        first.position.x,
-        first.position.y,
-        first.position.z,
+        why.join("; "),
         if grid {
             "; the grid's minimum and uniformity count them"
         } else {
             ""
         }
     ))
+}
+
+/// Whether a meter at `p` facing `normal` is in the open: of 64 rays over its hemisphere
+/// (an 8 x 8 grid in solid angle, cosine-weighted), more meet the front of a surface first
+/// than meet a back. A meter under a floor sees the floor's back overhead, though rays
+/// near its horizon may pass the floor's edge and meet the front of something outside.
+fn sees_a_front(
+    prepared: &radiosity::pipeline::Prepared,
+    p: glam::DVec3,
+    normal: glam::DVec3,
+) -> bool {
+    let Some(n) = normal.try_normalize() else {
+        return false;
+    };
+    let (u, v) = n.any_orthonormal_pair();
+    let start = 1e-7 * prepared.occluders.scale();
+    let (mut fronts, mut backs) = (0, 0);
+    for k in 0..64 {
+        let (a, b) = ((k % 8) as f64 + 0.5, (k / 8) as f64 + 0.5);
+        let (r, phi) = ((a / 8.0).sqrt(), std::f64::consts::TAU * b / 8.0);
+        let dir =
+            (u * (r * phi.cos()) + v * (r * phi.sin()) + n * (1.0 - r * r).sqrt()).normalize();
+        let facing = prepared
+            .occluders
+            .closest_hit(p, dir, start, f64::INFINITY)
+            .and_then(|hit| prepared.scene.surfaces.get(hit.id as usize))
+            .and_then(|s| radiosity::geometry::polygon_normal(&s.vertices))
+            .map(|m| m.dot(dir));
+        match facing {
+            Some(c) if c < 0.0 => fronts += 1,
+            Some(_) => backs += 1,
+            None => {}
+        }
+    }
+    fronts > backs
 }
 
 /// Why a `--grid` is refused, with what would fit: corners that differ in all three axes,

@@ -291,10 +291,16 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         let shown = report::significant(scale, 4);
         let how = match (args.tone.exposure, white) {
             (Exposure::Auto, Some(white)) => format!(
-                "auto: {}, the mean radiosity of the brightest 2 % of the non-emitting area, \
+                "auto: {}, the mean radiosity of the brightest 2 % of the {}, \
                  is white, as `render` makes it, estimated at {} points by {} paths each; \
                  the view's own brightest 2 % of pixels would give {}; ",
                 report::significant(white, 5),
+                // QA of issue #16: said of a scene with no non-emitting area.
+                if scene.surfaces.iter().all(|s| s.emission.max_band() > 0.0) {
+                    "area (every surface emits, so all of it counts)"
+                } else {
+                    "non-emitting area"
+                },
                 radiosity::pathtrace::EXPOSURE_POINTS,
                 radiosity::pathtrace::EXPOSURE_PATHS,
                 report::significant(view.auto_exposure_scale(), 4)

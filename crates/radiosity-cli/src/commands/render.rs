@@ -232,6 +232,29 @@ pub fn run(args: RenderArgs) -> Result<()> {
              whatever the light; hierarchical radiosity and --adapt-rounds solve first, as \
              they make their own elements)",
         );
+        // Flags for the light it does not compute (QA of issue #16: `--method hemicube
+        // --solver lu` passed without a word, where --gamma and --exposure were warned of).
+        let mut unused = Vec::new();
+        if let Some(m) = args.scene.method.method {
+            unused.push(format!(
+                "--method {}",
+                clap::ValueEnum::to_possible_value(&m)
+                    .map_or_else(String::new, |v| v.get_name().to_string())
+            ));
+        }
+        if args.solve.solver.0 != radiosity::solve::SolverKind::Auto {
+            unused.push(format!("--solver {}", args.solve.solver));
+        }
+        if args.solve.tolerance.is_some() {
+            unused.push("--tolerance".to_string());
+        }
+        if !unused.is_empty() {
+            errln!(
+                "warning: {} ignored: a wireframe of this mesh needs no light, so nothing is \
+                 solved",
+                unused.join(" and ")
+            );
+        }
         let black = vec![[0.0; 3]; prepared.mesh.len()];
         let image = shade_and_render(
             &prepared,

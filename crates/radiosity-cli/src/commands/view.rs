@@ -46,6 +46,24 @@ pub fn run(args: ViewArgs) -> Result<()> {
         outln!("{table}");
         return Ok(());
     }
+    // The bench's flags without --bench (QA of issue #16: `--bench-elements 0` passed
+    // without a word here, and was refused with --bench).
+    let mut unused = Vec::new();
+    if args.bench_triangles != 1_000_000 {
+        unused.push("--bench-triangles");
+    }
+    if args.bench_elements != [1000, 5000, 20000] {
+        unused.push("--bench-elements");
+    }
+    if args.bench_frames != 30 {
+        unused.push("--bench-frames");
+    }
+    if !unused.is_empty() {
+        errln!(
+            "warning: {} ignored without --bench (they set what the offscreen timing measures)",
+            unused.join(" and ")
+        );
+    }
     check_flags(&args)?;
     let file = match &args.scene {
         Some(path) => {

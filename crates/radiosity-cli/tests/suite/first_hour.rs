@@ -1287,6 +1287,12 @@ fn outputs_that_cannot_be_written_are_refused_before_any_work() {
             vec!["generate", "building", "-o", "nowhere/b.scene"],
             "the directory nowhere does not exist",
         ),
+        // A folder that exists but takes no new files (even for root: /proc), found before
+        // the work, and named without the temporary file's name (QA of issue #16).
+        (
+            vec!["render", "absent.scene", "-o", "/proc/radiosity-test.png"],
+            "-o /proc/radiosity-test.png: cannot write there: ",
+        ),
     ] {
         let out = radiosity(&args, &dir);
         let err = stderr(&out);
@@ -1296,6 +1302,7 @@ fn outputs_that_cannot_be_written_are_refused_before_any_work() {
             !err.contains("absent.scene"),
             "{args:?} read the scene first: {err}"
         );
+        assert!(!err.contains(".tmp"), "{args:?}: {err}");
     }
     assert!(!dir.join("nowhere").exists());
     std::fs::remove_dir_all(&dir).unwrap();
@@ -1921,7 +1928,42 @@ fn points_that_get_no_light_are_warned_of() {
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(
-        err.contains("warning: 2 points of 3 get no light at all, 0 lx (the first: \"below\""),
+        err.contains(
+            "warning: 2 points of 3 get no light at all, 0 lx: 2 (the first: \"below\" at \
+             2.5,-1,2) see only the backs of faces, or nothing"
+        ),
+        "{err}"
+    );
+    // QA of issue #16: a point in the open, in a black room whose lamp lights only the
+    // black ceiling, was asked whether it was inside furniture.
+    std::fs::write(
+        dir.join("black.scene"),
+        "MAX_PATCH_AREA 1\nINTEGRAL_STEPS 2\nSCENEBEGIN\nBOXBEGIN\n#Room\nFACING IN\n\
+         Er 0\nEg 0\nEb 0\nRr 0\nRg 0\nRb 0\nORIGIN 0 0 0\nSIZE 4 3 4\nBOXEND\n\
+         PATCHBEGIN\n#Up light\nVERTICES 4\nEr 15\nEg 15\nEb 15\nRr 0\nRg 0\nRb 0\n\
+         VERTEX0 2.5 2.9 1.5\nVERTEX1 1.5 2.9 1.5\nVERTEX2 1.5 2.9 2.5\nVERTEX3 2.5 2.9 2.5\n\
+         PATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("q.csv"),
+        "name,x,y,z,nx,ny,nz\nfloor,2,0.8,2,0,1,0\n",
+    )
+    .unwrap();
+    let args = [
+        "illuminance",
+        "black.scene",
+        "--points",
+        "q.csv",
+        "-o",
+        "m.csv",
+    ];
+    let err = stderr(&radiosity(&args, &dir));
+    assert!(
+        err.contains(
+            "1 (the first: \"floor\" at 2,0.8,2) sees surfaces but no light: in full \
+                      shadow"
+        ),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
@@ -2127,8 +2169,8 @@ fn a_light_that_reaches_no_surface_is_warned_of() {
         (
             "up.scene",
             "VERTEX0 2.5 3 1.5\nVERTEX1 1.5 3 1.5\nVERTEX2 1.5 3 2.5\nVERTEX3 2.5 3 2.5\n",
-            "100.00 % of the emitted light reaches no surface (so pictures are black): \
-             surface 6 \"Light\" faces out of the scene, with no surface in front of it",
+            "100.00 % of the emitted light reaches no surface (so nothing is lit: pictures \
+             show at most the emitters themselves): surface 6 \"Light\" faces out of the scene, with no surface in front of it",
         ),
         (
             "above.scene",

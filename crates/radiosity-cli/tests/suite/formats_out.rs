@@ -256,6 +256,32 @@ fn solve_report_has_one_row_per_surface_at_the_closed_form() {
         assert_eq!(out.status.code(), Some(1));
         assert!(stderr(&out).contains(needle), "{}", stderr(&out));
     }
+    // Nor through a link to the solution's file, written or not yet (QA of issue #16:
+    // the report was written over the solution).
+    #[cfg(unix)]
+    for exists in [false, true] {
+        let _ = std::fs::remove_file(dir.join("link.csv"));
+        std::os::unix::fs::symlink("fresh.csv", dir.join("link.csv")).unwrap();
+        if exists {
+            std::fs::write(dir.join("fresh.csv"), "x").unwrap();
+        }
+        let args = [
+            "solve",
+            "furnace.scene",
+            "-q",
+            "-o",
+            "fresh.csv",
+            "--report",
+            "link.csv",
+        ];
+        let out = radiosity(&args, &dir);
+        assert_eq!(out.status.code(), Some(1), "exists {exists}");
+        assert!(
+            stderr(&out).contains("is -o fresh.csv too"),
+            "{}",
+            stderr(&out)
+        );
+    }
     assert_eq!(
         std::fs::read_to_string(dir.join("furnace.scene")).unwrap(),
         FURNACE
@@ -431,5 +457,52 @@ fn exported_glb_checks_as_the_scene_it_came_from() {
     // The same figures in the same unit: a .scene file's lengths are metres, as glTF's.
     let got: Vec<String> = lines("room.glb");
     assert_eq!(got, want);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_view_of_emitters_alone_is_measured_and_compared() {
+    // QA of issue #16: in a box whose every face emits, the path tracer said "none to
+    // measure: the pixels that show no emitter are black (0 pixels ...)" and `--compare`
+    // failed with "the reference is black". Where every pixel shows an emitter none is
+    // left out, and the furnace (B = E / (1 - rho) everywhere) compares within noise.
+    let dir = scratch_dir("all-emit");
+    std::fs::write(dir.join("furnace.scene"), FURNACE).unwrap();
+    let mut args = vec!["pathtrace", "furnace.scene", "--paths", "64"];
+    args.extend(INSIDE);
+    let saved: Vec<&str> = args
+        .iter()
+        .copied()
+        .chain(["--save-reference", "r.exr", "-o", "p.png"])
+        .collect();
+    let out = radiosity(&saved, &dir);
+    let err = stderr(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{err}");
+    assert!(text.contains("0 showing an emitter left out"), "{text}");
+    assert!(!text.contains("none to measure"), "{text}");
+    assert!(err.contains("every surface emits"), "{err}");
+    let compared: Vec<&str> = args
+        .iter()
+        .copied()
+        .chain(["--reference", "r.exr", "--compare"])
+        .collect();
+    let out = radiosity(&compared, &dir);
+    let err = stderr(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{err}");
+    // The radiosity render of a furnace is exact up to the mesh's row sums; 64 paths a
+    // pixel leave a few per cent of noise, so the RMS stays under 10 %.
+    let rms: f64 = text
+        .lines()
+        .find_map(|l| {
+            l.strip_prefix("rms               ")?
+                .split(' ')
+                .next()?
+                .parse()
+                .ok()
+        })
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(rms < 10.0, "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -245,11 +245,14 @@ impl PathTraced {
         &self.shows_emitter
     }
 
-    /// The noise over the pixels that show no emitter (zeros for none).
+    /// The noise over the pixels that show no emitter, or over all where every pixel
+    /// shows one (a view of emitters alone: QA of issue #16 found "none to measure ... 0
+    /// pixels" there); zeros for an empty image.
     pub fn noise(&self) -> NoiseSummary {
         let (mut pixels, mut se, mut se2, mut y) = (0usize, 0.0, 0.0, 0.0);
+        let leave_out = !self.shows_emitter.iter().all(|&e| e);
         for (i, sample) in self.film.samples().iter().enumerate() {
-            if self.shows_emitter[i] {
+            if leave_out && self.shows_emitter[i] {
                 continue;
             }
             let s = self.luminance_standard_error[i];
