@@ -363,6 +363,14 @@ impl PolygonBvh {
     /// The segment's ends are trimmed by 1e-7 of the scene's diagonal, so surfaces that
     /// `p` and `q` lie on, and surfaces that meet them at a shared edge, do not block it.
     pub fn segment_blocked(&self, p: DVec3, q: DVec3) -> bool {
+        self.segment_blocked_except(p, q, u32::MAX)
+    }
+
+    /// [`PolygonBvh::segment_blocked`], not counting the polygons whose caller's id is
+    /// `ignored`: the surface a segment ends on, which a planar convex surface can only
+    /// cross there, but which rounding makes it cross earlier where the segment runs
+    /// along its plane (a point on the edge where two walls meet, QA of issue #16).
+    pub fn segment_blocked_except(&self, p: DVec3, q: DVec3, ignored: u32) -> bool {
         if self.polygons.is_empty() {
             return false;
         }
@@ -381,6 +389,9 @@ impl PolygonBvh {
             ((len * 1.001 + eps) * to_local) as f32,
         );
         !self.bvh.ray_traverse_miss(ray, |_, k| {
+            if self.polygons[k].id == ignored {
+                return f32::INFINITY;
+            }
             match self.intersect(k, p, dir, eps, len - eps) {
                 Some(t) => (t * to_local) as f32,
                 None => f32::INFINITY,

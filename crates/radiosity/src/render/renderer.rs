@@ -310,9 +310,14 @@ impl<'m> Renderer<'m> {
             let y = rows.start + r;
             let mut rays_scratch: Vec<[f64; 3]> = Vec::new();
             for (x, pixel) in row.chunks_exact_mut(n * n).enumerate() {
-                let salt = (y * camera.width as usize + x) as u64;
+                let index = (y * camera.width as usize + x) as u64;
                 let seen = |sx: f64, sy: f64| {
                     let dir = camera.direction_in(screen, sx, sy);
+                    // Each ray of the pixel jitters the direct light's strata its own way
+                    // (see `direct`), so that a pixel's rays average the shadow rays' noise.
+                    let salt = crate::splitmix::splitmix64(
+                        index ^ sx.to_bits().rotate_left(17) ^ sy.to_bits().rotate_left(41),
+                    );
                     self.trace(
                         camera.eye, dir, footprint, element_b, vertex_b, shading, salt,
                     )
