@@ -211,20 +211,25 @@ mod tests {
     use super::*;
     use glam::DVec3;
 
+    /// A camera 3 units before the origin, looking at it, `width` x `height` pixels.
+    fn camera(width: u32, height: u32) -> Camera {
+        Camera {
+            eye: DVec3::new(0.0, 0.0, -3.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+            width,
+            height,
+        }
+    }
+
     #[test]
     fn radiance_is_radiosity_over_pi_unclamped_and_in_order() {
         // Values far above 1 and a pixel order that a transposition would break.
         let film: Vec<[f64; 3]> = (0..6)
             .map(|i| [i as f64 * 10.0, 0.5, std::f64::consts::PI * 1000.0])
             .collect();
-        let camera = Camera {
-            eye: DVec3::new(0.0, 0.0, -3.0),
-            look_at: DVec3::ZERO,
-            up: DVec3::Y,
-            fov_y_degrees: 40.0,
-            width: 3,
-            height: 2,
-        };
+        let camera = camera(3, 2);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("view.exr");
         write_radiance(&path, 3, 2, &film, &camera, "test", "metres x 0.001").unwrap();
@@ -262,14 +267,7 @@ mod tests {
     #[test]
     fn the_same_image_is_the_same_bytes() {
         let film = vec![[1.0, 2.0, 3.0]; 4];
-        let camera = Camera {
-            eye: DVec3::new(0.0, 0.0, -3.0),
-            look_at: DVec3::ZERO,
-            up: DVec3::Y,
-            fov_y_degrees: 40.0,
-            width: 2,
-            height: 2,
-        };
+        let camera = camera(2, 2);
         let dir = tempfile::tempdir().unwrap();
         let files: Vec<Vec<u8>> = (0..8)
             .map(|k| {
