@@ -124,7 +124,8 @@ pub struct SceneArgs {
     /// SCALE. A .scene file's MAX_PATCH_AREA is scaled with it, so it meshes the same.
     #[arg(long, default_value_t = 1.0, value_name = "SCALE")]
     pub scale: f64,
-    /// Override the scene's MAX_PATCH_AREA (scene units squared).
+    /// Override the scene's MAX_PATCH_AREA, in the units after --scale squared (the file's
+    /// own MAX_PATCH_AREA is scaled by --scale^2; this one is taken as given).
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,
     /// Override the scene's INTEGRAL_STEPS (points along each axis of each element, for
@@ -222,8 +223,8 @@ pub struct SolveOptions {
     /// finer and slower).
     #[arg(long, default_value_t = 0.05, value_name = "E")]
     pub epsilon: f64,
-    /// Hierarchical: nodes of at most this area (scene units squared) are not split
-    /// (default: MAX_PATCH_AREA / 16).
+    /// Hierarchical: nodes of at most this area (the units after --scale, squared) are not
+    /// split (default: MAX_PATCH_AREA / 16).
     #[arg(long, value_name = "AREA")]
     pub min_area: Option<f64>,
     /// Hierarchical: leave out the final gather (each leaf then takes its ancestors'
@@ -699,7 +700,8 @@ pub struct ViewArgs {
     /// SCALE. A .scene file's MAX_PATCH_AREA is scaled with it, so it meshes the same.
     #[arg(long, default_value_t = 1.0, value_name = "SCALE")]
     pub scale: f64,
-    /// Override the scene's MAX_PATCH_AREA (scene units squared).
+    /// Override the scene's MAX_PATCH_AREA, in the units after --scale squared (the file's
+    /// own MAX_PATCH_AREA is scaled by --scale^2; this one is taken as given).
     #[arg(long, value_name = "AREA")]
     pub max_area: Option<f64>,
     /// Override the scene's INTEGRAL_STEPS.

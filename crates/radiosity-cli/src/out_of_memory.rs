@@ -5,6 +5,12 @@
 //! malloc arenas, the binary itself). This allocator is the system's, and when it returns
 //! nothing it says what happened and exits with status 1, as other errors do.
 //!
+//! A failed `try_reserve` ends the program too (it reaches the allocator as any
+//! allocation): the library's graceful path there (a form-factor file too large to read,
+//! `FormFactorFileError::OutOfMemory`) stays for its other callers, and the memory
+//! estimates refuse most such work before it starts. A run ended here may leave its
+//! temporary output file (`.NAME.PID.RANDOM.tmp`), removed as stale by the next run.
+//!
 //! Written by hand because no crate does this, and `std::alloc::set_alloc_error_hook` is
 //! not stable. Nothing may allocate here (the allocator has just failed), so the message
 //! is written with `write(2)` from a stack buffer and the process leaves with `_exit`.

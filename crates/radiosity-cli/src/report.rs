@@ -820,8 +820,15 @@ pub fn check(
         significant(prepared.settings.max_patch_area, 6)
     );
     outln!("INTEGRAL_STEPS    {}", prepared.settings.integral_steps);
-    outln!("method            {}", prepared.method());
-    outln!("occlusion         {}", prepared.method().occlusion());
+    // Hierarchical radiosity estimates each link itself (QA of issue #16: `check
+    // --solver hierarchical` named the method it had just said it ignores).
+    if matches!(solver, Solver::Hierarchical(_)) {
+        outln!("method            hierarchical radiosity's own: exact near pairs, Lambert's point-to-polygon at middle distance, point pairs far");
+        outln!("occlusion         point pairs a link (16 between patches, up to 8 for clusters) through the surfaces' BVH");
+    } else {
+        outln!("method            {}", prepared.method());
+        outln!("occlusion         {}", prepared.method().occlusion());
+    }
     outln!("solver            {solver}");
     if let Some(stats) = stats {
         outln!(

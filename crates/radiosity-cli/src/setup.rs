@@ -474,15 +474,7 @@ pub fn note_output(path: &Path, flag: &str, label: &str) -> Result<()> {
 /// name and its folders are (QA of issue #16: `--report link.csv`, a link to the `-o`
 /// file not yet written, wrote over it), whether or not the file itself exists yet.
 fn resolved(path: &Path) -> std::path::PathBuf {
-    let mut at = lexical_absolute(path);
-    // A link's target, relative to its folder; a cycle ends after 40, as the system's.
-    for _ in 0..40 {
-        let Ok(target) = std::fs::read_link(&at) else {
-            break;
-        };
-        let folder = at.parent().map(Path::to_path_buf).unwrap_or_default();
-        at = lexical_absolute(&folder.join(target));
-    }
+    let at = lexical_absolute(&radiosity::io::link_target(&lexical_absolute(path)));
     match (at.parent().map(std::fs::canonicalize), at.file_name()) {
         (Some(Ok(folder)), Some(name)) => folder.join(name),
         _ => at,

@@ -795,7 +795,7 @@ pub struct GridAxes {
     pub first: [f64; 2],
     /// From one column (row) to the next: the spacing, signed.
     pub step: [f64; 2],
-    /// Row 0 drawn at the top, not the bottom ([`GridAxes::seen_from`]).
+    /// Row 0 drawn at the top, not the bottom ([`GridAxes::as_drawn`]).
     pub rows_down: bool,
 }
 
@@ -827,22 +827,16 @@ impl GridAxes {
         })
     }
 
-    /// The axes drawn as the grid looks from the side its meters face (`normal`), its
-    /// columns running left to right: rows run up where the row axis is `normal` x the
-    /// column axis, down where it is the opposite. A z-up floor grid (normal +z) is a plan
-    /// seen from above either way; a y-up one (normal +y, rows along z) draws z downward,
-    /// as a plan seen from above does (QA of issue #16: it was drawn seen from below).
-    pub fn seen_from(self, normal: DVec3) -> Self {
-        let unit = |name: char, step: f64| {
-            let i = "xyz".find(name).unwrap_or(0);
-            DVec3::AXES[i] * if step < 0.0 { -1.0 } else { 1.0 }
-        };
-        let (right, rows) = (
-            unit(self.names[0], self.step[0]),
-            unit(self.names[1], self.step[1]),
-        );
+    /// The axes drawn as lighting plans and elevations are, columns left to right: rows
+    /// running up the picture as their coordinate grows, except on a horizontal grid of a
+    /// y-up scene (`z_up` false; axes x and z), a plan seen from above with x to the
+    /// right, where z grows down the picture (QA of issue #16: it was drawn as seen from
+    /// below). A wall's height (y, or z in a z-up scene) runs up when it is the row axis.
+    /// Corners given high to low along the row axis draw the same picture.
+    pub fn as_drawn(self, z_up: bool) -> Self {
+        let plan_z_down = !z_up && self.names == ['x', 'z'];
         Self {
-            rows_down: rows.dot(normal.cross(right)) < 0.0,
+            rows_down: plan_z_down != (self.step[1] < 0.0),
             ..self
         }
     }
@@ -867,7 +861,7 @@ const LEGEND_FONT: i64 = 3;
 /// the uniformity U0 ([`GridSummary`]); one cell per point coloured by its value on the
 /// false-colour scale from 0 to a round top ([`nice_scale`] of the largest value), the value
 /// printed in the cell (where it fits), row 0 at the bottom (a plan seen from above for a
-/// z-up floor grid) unless the axes say otherwise ([`GridAxes::seen_from`]); on the right a scale bar with its values and the unit `lx`. `values`
+/// z-up floor grid) unless the axes say otherwise ([`GridAxes::as_drawn`]); on the right a scale bar with its values and the unit `lx`. `values`
 /// run column by column within rows (as [`grid`] makes them); `dims` = [columns, rows].
 pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
     grid_picture_with_axes(values, dims, None)

@@ -407,20 +407,44 @@ fn the_grid_picture_prints_the_coordinates_of_its_columns_and_rows() {
 }
 
 /// QA of issue #16: a y-up floor grid was drawn as the plan seen from below (z up the
-/// picture). Seen from the side the meters face, columns left to right, the rows run up
-/// where the row axis is normal x column axis: +y for a z-up floor, -z for a y-up one.
+/// picture), and (pass 12) a wall's height ran down where its corners were given high to
+/// low. Plans are seen from above with x to the right; a wall's height runs up.
 #[test]
-fn a_grid_is_drawn_as_seen_from_the_side_its_meters_face() {
-    let z_up = GridAxes::of(dvec3(0.0, 0.0, 0.8), dvec3(2.0, 3.0, 0.8), 1.0).unwrap();
-    assert!(!z_up.seen_from(DVec3::Z).rows_down);
-    let y_up = GridAxes::of(dvec3(0.0, 0.8, 0.0), dvec3(2.0, 0.8, 3.0), 1.0).unwrap();
+fn grids_are_drawn_as_plans_and_elevations() {
+    let grid = |a: DVec3, b: DVec3| GridAxes::of(a, b, 1.0).unwrap();
+    // A z-up floor: y up the picture, whichever corner comes first.
+    let floor = grid(dvec3(0.0, 0.0, 0.8), dvec3(2.0, 3.0, 0.8));
+    assert!(!floor.as_drawn(true).rows_down);
+    assert!(
+        grid(dvec3(0.0, 3.0, 0.8), dvec3(2.0, 0.0, 0.8))
+            .as_drawn(true)
+            .rows_down
+    );
+    // A y-up floor: z down the picture.
+    let y_up = grid(dvec3(0.0, 0.8, 0.0), dvec3(2.0, 0.8, 3.0));
     assert_eq!(y_up.names, ['x', 'z']);
-    assert!(y_up.seen_from(DVec3::Y).rows_down);
-    // Corners given the other way along z: row 0 is the largest z, so up the picture.
-    let reversed = GridAxes::of(dvec3(0.0, 0.8, 3.0), dvec3(2.0, 0.8, 0.0), 1.0).unwrap();
-    assert!(!reversed.seen_from(DVec3::Y).rows_down);
-    // A ceiling grid looked at from below (meters facing down) is mirrored back.
-    assert!(!y_up.seen_from(-DVec3::Y).rows_down);
+    assert!(y_up.as_drawn(false).rows_down);
+    assert!(
+        !grid(dvec3(0.0, 0.8, 3.0), dvec3(2.0, 0.8, 0.0))
+            .as_drawn(false)
+            .rows_down
+    );
+    // Walls: y-up (x, y) and z-up (x, z) have their height up.
+    assert!(
+        !grid(dvec3(0.5, 0.5, 3.99), dvec3(4.5, 2.5, 3.99))
+            .as_drawn(false)
+            .rows_down
+    );
+    assert!(
+        grid(dvec3(0.5, 2.5, 3.99), dvec3(4.5, 0.5, 3.99))
+            .as_drawn(false)
+            .rows_down
+    );
+    assert!(
+        !grid(dvec3(0.0, 3.9, 0.0), dvec3(4.0, 3.9, 2.5))
+            .as_drawn(true)
+            .rows_down
+    );
     // Drawn: the cell of row 0 (the least value) at the top when rows run down.
     let values = [1.0, 1.0, 100.0, 100.0];
     let drawn = |axes: GridAxes| grid_picture_with_axes(&values, [2, 2], Some(axes));
@@ -428,7 +452,7 @@ fn a_grid_is_drawn_as_seen_from_the_side_its_meters_face() {
         let c = img.get_pixel(60, (GRID_TOP + 10) as u32).0;
         c[0] as u32 + c[1] as u32 + c[2] as u32
     };
-    let (down, up) = (drawn(y_up.seen_from(DVec3::Y)), drawn(y_up));
+    let (down, up) = (drawn(y_up.as_drawn(false)), drawn(y_up));
     assert_ne!(top_left(&down), top_left(&up));
 }
 

@@ -645,8 +645,46 @@ mod tests {
                     .map(|p| p as u32)
                     .collect();
                 assert_eq!(found, expected, "query {lo} .. {hi}");
+                // Filtered and limited: the same polygons the filter keeps, all of them
+                // (true) up to the limit, else limit + 1 of them (false), the traversal
+                // ended early.
+                let keep = |k: u32| bvh.id_of(k) % 3 != 0;
+                let kept: Vec<u32> = expected.iter().copied().filter(|id| id % 3 != 0).collect();
+                for limit in [0, 1, 5, 32, usize::MAX] {
+                    let mut out = Vec::new();
+                    let all = bvh.overlapping_where(lo, hi, limit, keep, &mut out);
+                    let mut out: Vec<u32> = out.into_iter().map(|f| bvh.id_of(f)).collect();
+                    out.sort_unstable();
+                    assert_eq!(all, kept.len() <= limit, "limit {limit}");
+                    if all {
+                        assert_eq!(out, kept, "limit {limit}");
+                    } else {
+                        assert_eq!(out.len(), limit + 1, "limit {limit}");
+                        assert!(out.iter().all(|id| kept.contains(id)), "limit {limit}");
+                    }
+                }
             }
         }
+    }
+
+    /// A segment that ends on a surface and runs along its plane is not blocked by that
+    /// surface where it is ignored (review of issue #16: a point on the edge where two
+    /// walls meet had its shadow rays to the other wall blocked by rounding).
+    #[test]
+    fn a_segment_is_not_blocked_by_the_surface_it_ignores() {
+        // A wall in the plane z = 0, id 7 (no polygon has id 8).
+        let wall = vec![
+            dvec3(0.0, 0.0, 0.0),
+            dvec3(1.0, 0.0, 0.0),
+            dvec3(1.0, 1.0, 0.0),
+            dvec3(0.0, 1.0, 0.0),
+        ];
+        let bvh = PolygonBvh::new(&[wall], &[7]);
+        // Crossing the wall's middle: blocked unless the wall is ignored.
+        let (p, q) = (dvec3(0.5, 0.5, -1.0), dvec3(0.5, 0.5, 1.0));
+        assert!(bvh.segment_blocked(p, q));
+        assert!(bvh.segment_blocked_except(p, q, 8));
+        assert!(!bvh.segment_blocked_except(p, q, 7));
     }
 
     #[test]

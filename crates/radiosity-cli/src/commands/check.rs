@@ -71,7 +71,11 @@ pub fn run(args: CheckArgs) -> Result<()> {
         errln!(
             "checking {stem}: {} by {}, solver {}; the report follows the solve",
             crate::report::count(prepared.mesh.len() as u64, "element"),
-            prepared.method(),
+            match solver {
+                radiosity::solve::Solver::Hierarchical(_) =>
+                    "its links' own form factors".to_string(),
+                _ => prepared.method().to_string(),
+            },
             solver.kind().name()
         );
     }

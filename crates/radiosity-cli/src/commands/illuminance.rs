@@ -145,10 +145,7 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         let axes = args
             .grid
             .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing))
-            .map(|axes| match points.first() {
-                Some(p) => axes.seen_from(p.normal),
-                None => axes,
-            });
+            .map(|axes| axes.as_drawn(radiosity::render::z_is_up(&prepared.scene)));
         let img = illuminance::grid_picture_with_axes(&totals, dims, axes);
         crate::progress_bar::run_file_stage(&reporter, Stage::Write, png, || {
             radiosity::io::png::write_png(&img, png)
@@ -202,8 +199,8 @@ fn grid_short_of_corner(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> Option<
 
 /// A warning when some points get no light at all (QA of issue #16: points inside the
 /// cupboard, under the floor and outside the room gave 0 lx without a word, and spoiled a
-/// grid's minimum and uniformity), and why: a point that sees the front of some surface
-/// is in the open, in full shadow among surfaces that pass no light on (QA of issue #16:
+/// grid's minimum and uniformity), and why: a point that sees more fronts of surfaces
+/// than backs ([`sees_a_front`]) is in the open, in full shadow among surfaces that pass no light on (QA of issue #16:
 /// points in a black room's shadow were asked whether they were inside furniture).
 fn dark_points(
     prepared: &radiosity::pipeline::Prepared,

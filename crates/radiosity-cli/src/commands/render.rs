@@ -233,7 +233,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
              they make their own elements)",
         );
         // Flags for the light it does not compute (QA of issue #16: `--method hemicube
-        // --solver lu` passed without a word, where --gamma and --exposure were warned of).
+        // --solver lu` passed without a word, where --gamma and --exposure were warned of;
+        // --tolerance has its own warning).
         let mut unused = Vec::new();
         if let Some(m) = args.scene.method.method {
             unused.push(format!(
@@ -244,9 +245,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         if args.solve.solver.0 != radiosity::solve::SolverKind::Auto {
             unused.push(format!("--solver {}", args.solve.solver));
-        }
-        if args.solve.tolerance.is_some() {
-            unused.push("--tolerance".to_string());
         }
         if !unused.is_empty() {
             errln!(

@@ -282,6 +282,30 @@ fn solve_report_has_one_row_per_surface_at_the_closed_form() {
             stderr(&out)
         );
     }
+    // A link to a file not yet written is written through (review of issue #16: it was
+    // refused with "no such file or folder").
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink("other.csv", dir.join("r2.csv")).unwrap();
+        let args = [
+            "solve",
+            "furnace.scene",
+            "-q",
+            "-o",
+            "sol.csv",
+            "--report",
+            "r2.csv",
+        ];
+        let out = radiosity(&args, &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(std::fs::read_to_string(dir.join("other.csv"))
+            .unwrap()
+            .contains("surface,area"));
+        assert!(std::fs::symlink_metadata(dir.join("r2.csv"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    }
     assert_eq!(
         std::fs::read_to_string(dir.join("furnace.scene")).unwrap(),
         FURNACE

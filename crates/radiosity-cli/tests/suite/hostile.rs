@@ -311,8 +311,12 @@ fn memory_budget_honours_ulimit_v() {
 #[test]
 fn a_failed_allocation_is_an_error_not_an_abort() {
     // QA of issue #16: under tight `ulimit -v` limits the hierarchical solve aborted
-    // ("memory allocation of 2048 bytes failed", a backtrace, status 134). Whatever limit
-    // is met first, the run ends with status 1 and a message that names the limit.
+    // ("memory allocation of 2048 bytes failed", a backtrace, status 134). Under an
+    // address-space limit glibc's malloc reserves 64 MiB at a time per thread, so whether
+    // a run fits depends on the threads and cannot be foreseen exactly: each run either
+    // finishes, or ends with status 1 and a message that names the limit. At 60,000 KiB
+    // (less than the program maps once its threads run) it cannot finish, so the message
+    // is seen.
     let dir = scratch_dir("ulimit-oom");
     let bin = env!("CARGO_BIN_EXE_radiosity");
     for kib in [60_000, 250_000, 400_000] {
@@ -325,9 +329,11 @@ fn a_failed_allocation_is_an_error_not_an_abort() {
             .output()
             .unwrap();
         let err = stderr(&out);
-        assert_eq!(out.status.code(), Some(1), "ulimit -v {kib}: {err}");
-        assert!(err.contains("ulimit -v"), "ulimit -v {kib}: {err}");
         assert!(!err.contains("backtrace"), "ulimit -v {kib}: {err}");
+        if kib == 60_000 || out.status.code() != Some(0) {
+            assert_eq!(out.status.code(), Some(1), "ulimit -v {kib}: {err}");
+            assert!(err.contains("ulimit -v"), "ulimit -v {kib}: {err}");
+        }
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -101,11 +101,7 @@ pub fn check_row(i: usize, row: impl IntoIterator<Item = f64>) -> Result<(), Non
 /// - on Linux, what is left of the address-space limit (`ulimit -v`, RLIMIT_AS) and of the
 ///   data-segment limit (`ulimit -d`, RLIMIT_DATA) after what the process already maps
 ///   (`VmSize`, `VmData` of /proc/self/status): an allocation past either fails, however
-///   much memory is free. Under an address-space limit, [`THREAD_ARENA_BYTES`] for each
-///   worker thread and the main one are kept back as well: glibc's malloc reserves that
-///   much address space for each thread's arena the first time the thread allocates (the
-///   hierarchical solve under `ulimit -v 400000` was told 105 MiB fit, and aborted on a
-///   failed allocation with its hierarchy at 25 MiB).
+///   much memory is free.
 ///
 /// The limits are read from /proc/self/limits, the same numbers getrlimit gives, so no
 /// unsafe code is needed. Elsewhere the resource limits are not seen.
@@ -133,19 +129,11 @@ pub fn available_memory_bytes() -> u64 {
 fn resource_limit_headroom() -> Option<u64> {
     let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    // The pool's threads and the main one.
-    let threads = rayon::current_num_threads() as u64 + 1;
-    headroom_from_proc(&limits, &status, threads)
+    headroom_from_proc(&limits, &status)
 }
 
-/// Address space that glibc's malloc reserves for a thread's own arena (HEAP_MAX_SIZE,
-/// twice the largest mmap threshold of 32 MiB on 64-bit systems): counted against
-/// `ulimit -v` though little of it is ever touched.
-pub const THREAD_ARENA_BYTES: u64 = 64 << 20;
-
-/// [`resource_limit_headroom`] from the texts of /proc/self/limits and /proc/self/status,
-/// less [`THREAD_ARENA_BYTES`] for each of `threads` threads from the address-space limit.
-fn headroom_from_proc(limits: &str, status: &str, threads: u64) -> Option<u64> {
+/// [`resource_limit_headroom`] from the texts of /proc/self/limits and /proc/self/status.
+fn headroom_from_proc(limits: &str, status: &str) -> Option<u64> {
     // "Max address space   unlimited   unlimited   bytes": the soft limit is the one enforced.
     let soft = |name: &str| -> Option<u64> {
         let line = limits.lines().find(|l| l.starts_with(name))?;
@@ -166,13 +154,11 @@ fn headroom_from_proc(limits: &str, status: &str, threads: u64) -> Option<u64> {
             .map_or(0, |kib| kib * 1024)
     };
     [
-        ("Max address space", "VmSize:", threads * THREAD_ARENA_BYTES),
-        ("Max data size", "VmData:", 0),
+        ("Max address space", "VmSize:"),
+        ("Max data size", "VmData:"),
     ]
     .into_iter()
-    .filter_map(|(limit, key, kept)| {
-        Some(soft(limit)?.saturating_sub(used(key)).saturating_sub(kept))
-    })
+    .filter_map(|(limit, key)| Some(soft(limit)?.saturating_sub(used(key))))
     .min()
 }
 
@@ -809,18 +795,13 @@ mod tests {
                       Max address space         2147483648           4294967296           bytes\n";
         let status = "Name:\tradiosity\nVmSize:\t  1048576 kB\nVmData:\t   524288 kB\n";
         // 2 GiB - 1 GiB mapped = 1 GiB; 3 GiB - 0.5 GiB = 2.5 GiB.
-        assert_eq!(super::headroom_from_proc(limits, status, 0), Some(1 << 30));
-        // Three threads' arenas come off the address space only: 1 GiB - 192 MiB.
-        assert_eq!(
-            super::headroom_from_proc(limits, status, 3),
-            Some((1 << 30) - 3 * super::THREAD_ARENA_BYTES)
-        );
+        assert_eq!(super::headroom_from_proc(limits, status), Some(1 << 30));
         let unlimited = "Max data size             unlimited            unlimited            bytes\n\
                          Max address space         unlimited            unlimited            bytes\n";
-        assert_eq!(super::headroom_from_proc(unlimited, status, 3), None);
+        assert_eq!(super::headroom_from_proc(unlimited, status), None);
         // A limit below what is already mapped leaves nothing.
         let tight = "Max address space         1024                 unlimited            bytes\n";
-        assert_eq!(super::headroom_from_proc(tight, status, 3), Some(0));
+        assert_eq!(super::headroom_from_proc(tight, status), Some(0));
     }
 
     /// `MemAvailable` read by hand, capped by a cgroup limit read by hand (and by the

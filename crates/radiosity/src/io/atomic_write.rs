@@ -54,14 +54,8 @@ pub fn write_atomically(
 pub(crate) fn temporary_beside(
     path: &Path,
 ) -> io::Result<(std::fs::File, tempfile::TempPath, std::path::PathBuf)> {
-    let resolved;
-    let path = match std::fs::symlink_metadata(path) {
-        Ok(meta) if meta.file_type().is_symlink() => {
-            resolved = std::fs::canonicalize(path)?;
-            resolved.as_path()
-        }
-        _ => path,
-    };
+    let resolved = link_target(path);
+    let path = resolved.as_path();
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -103,6 +97,27 @@ pub fn check_writable(path: &Path) -> io::Result<()> {
     }
     let (_file, _tmp, _) = temporary_beside(path)?;
     Ok(())
+}
+
+/// Where writing `path` writes: `path`, or where the symbolic links it is lead (each
+/// target taken relative to its link's folder), whether or not the last one exists yet (a
+/// link to a file not yet written is written through; `canonicalize` refused it). A loop
+/// of links stops after 40, as the system's resolution does, and the write then fails
+/// there.
+pub fn link_target(path: &Path) -> std::path::PathBuf {
+    let mut at = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::read_link(&at) {
+            Ok(target) => {
+                at = match at.parent() {
+                    Some(folder) => folder.join(target),
+                    None => target,
+                }
+            }
+            Err(_) => break,
+        }
+    }
+    at
 }
 
 /// How long a dead run's temporary file is left alone: longer than any write of ours takes

@@ -34,5 +34,5 @@ pub mod scene_file;
 pub mod solution;
 pub mod surface_report;
 
-pub use atomic_write::{check_writable, is_same_file, write_atomically};
+pub use atomic_write::{check_writable, is_same_file, link_target, write_atomically};
 pub use inputs::{input_at, note_input, protect_inputs, release_input};

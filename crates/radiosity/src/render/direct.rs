@@ -37,9 +37,9 @@
 //! and a pixel's rays average it: salted by pixel alone, every ray of a pixel shared its
 //! strata and the penumbrae came out visibly grainy at 400 pixels across (QA of issue
 //! #16). The noise then also asks adaptive antialiasing for more rays in penumbrae, which
-//! is where they are needed: the default Cornell box render took 3.98 -> 4.72 s, the
-//! occluder's shadow seen close 2.44 -> 4.06 s, the pixel RMS against the path tracer
-//! unchanged (2.25 / 2.24 %). The result depends on the point and the salt only, not on
+//! is where they are needed: the default Cornell box render took 4.25 -> 4.78 s, the
+//! occluder's shadow seen close 2.22 -> 4.10 s, the pixel RMS against the path tracer
+//! unchanged (2.25 / 2.24 %; BENCHMARKS.md). The result depends on the point and the salt only, not on
 //! threads or order.
 
 use std::sync::OnceLock;
@@ -371,7 +371,8 @@ impl<'m> DirectCorrection<'m> {
             let mut sum = Rgb::default();
             let mut area = 0.0;
             for (k, &(x, w)) in points.iter().enumerate() {
-                // Salts of their own, apart from the renderer's pixel salts.
+                // Salts of their own (bit 63 set); the renderer's hashed ones may meet
+                // them by chance, which changes nothing but which strata are drawn.
                 let salt = (1 << 63) | (e as u64 * 64 + k as u64);
                 sum += self.light.irradiance(x, el.normal, salt) * w;
                 area += w;
@@ -446,7 +447,7 @@ impl<'m> DirectCorrection<'m> {
 
     /// The correction at `x` on element `e`, where smooth shading interpolates the vertices
     /// and weights `weights` (see [`super::renderer::interpolation`]); `salt` jitters the shadow rays' strata (the
-    /// renderer passes the pixel's index).
+    /// renderer passes a hash of the ray's pixel and position).
     pub fn at(&self, e: usize, x: DVec3, weights: &Interpolation, salt: u64) -> Rgb {
         let el = &self.mesh.elements[e];
         let rho = self.reflectance[el.surface as usize];

@@ -25,8 +25,9 @@ pub(crate) mod shape;
 
 pub use builtin::cornell_box;
 
-/// The largest emission (exitance per band, in the scene's units), luminance or flux a
-/// scene may give: the emitted power, summed over surfaces of up to 1e60 units^2
+/// The largest emission (exitance per band, in the scene's units), luminance, flux or
+/// intensity a scene may give (as written: a LUMINANCE L is an exitance of pi L, a small
+/// surface's FLUX a larger exitance, both still far from overflowing): the emitted power, summed over surfaces of up to 1e60 units^2
 /// ([`crate::geometry::MAX_COORDINATE`] squared), stays finite (QA of issue #16: an `Er`
 /// of 1e308 gave energy lines of "inf %").
 pub const MAX_EMISSION: f64 = 1e30;

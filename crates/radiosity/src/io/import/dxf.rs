@@ -1151,9 +1151,7 @@ struct MaterialsFile {
 impl MaterialsFile {
     fn parse(name: &str, text: &str) -> Result<MaterialsFile, ImportError> {
         let parsed: MaterialsToml = toml::from_str(text).map_err(|e| {
-            let line = e.span().map_or(0, |s| {
-                1 + text[..s.start.min(text.len())].matches('\n').count()
-            });
+            let line = e.span().map_or(0, |s| line_at(text, s.start));
             ImportError::Syntax {
                 file: name.to_string(),
                 line,
@@ -1211,7 +1209,7 @@ impl MaterialsFile {
 
     /// The line (from 1) of byte `at` of the file.
     fn line_at(&self, at: usize) -> usize {
-        1 + self.text[..at.min(self.text.len())].matches('\n').count()
+        line_at(&self.text, at)
     }
 
     /// The line of a table header (for messages about its colours); 0 when it is written
@@ -1226,6 +1224,11 @@ impl MaterialsFile {
             .position(|l| l.trim() == header || Some(l.trim()) == quoted.as_deref())
             .map_or(0, |k| k + 1)
     }
+}
+
+/// The line (from 1) of byte `at` of `text`.
+fn line_at(text: &str, at: usize) -> usize {
+    1 + text[..at.min(text.len())].matches('\n').count()
 }
 
 #[cfg(test)]

@@ -1169,6 +1169,12 @@ impl<'a> Parser<'a> {
                         );
                         self.error_at(token, &l, msg);
                     }
+                    // Review of issue #16: a light's FLUX or INTENSITY of 1e308 made
+                    // "inf lm" and "NaN %".
+                    if let (true, Some(token)) = (v > crate::scene::MAX_EMISSION, token) {
+                        let what = k.spelling();
+                        self.error_at(token, &l, too_bright(&what, token.text));
+                    }
                     output = Some(if k == Keyword::Intensity {
                         Output::Intensity(v)
                     } else {

@@ -893,6 +893,17 @@ fn emission_beyond_the_supported_range_is_refused_at_its_word() {
         "FLUX",
     );
     assert!(errors(&with_line(8, "Eg 1e30")).is_empty());
+    // A point light's FLUX and INTENSITY too (review of issue #16: "inf lm", "NaN %").
+    for (word, column) in [("FLUX", 6), ("INTENSITY", 11)] {
+        let text = VALID.replace(
+            "SCENEEND",
+            &format!(
+                "LIGHTBEGIN\n#Lamp\nPOSITION 0.5 0.5 1\n{word} 1e308\nDISTRIBUTION ISOTROPIC\n\
+                 LIGHTEND\nSCENEEND"
+            ),
+        );
+        one_error(&text, 21, column, "above the largest");
+    }
 }
 
 // Regression (issue 12): coordinates of 1e20 and more panicked in the BVH builder, and ones

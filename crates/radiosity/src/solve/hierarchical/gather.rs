@@ -414,7 +414,8 @@ impl Solver<'_> {
         if !cached {
             progress.message(&format!(
                 "final gather: the terms of {} points pass the memory left ({} MiB); each of \
-                 {GATHER_PASSES} passes makes them again (the progress counts the first)",
+                 {GATHER_PASSES} passes makes them again (the progress counted the points made \
+                 before they did not fit)",
                 points.len(),
                 budget >> 20
             ));

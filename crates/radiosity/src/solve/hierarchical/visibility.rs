@@ -132,7 +132,9 @@ impl Solver<'_> {
     /// pairs whose points face each other count (a pair with a point behind the other's
     /// plane carries no energy); when no pair faces, all pairs count. Patch <- patch links
     /// use 16 pairs (4 x 4 stratified points on each, paired by a fixed permutation) and
-    /// only the occluders whose boxes overlap the pair's box (none: visible, no ray);
+    /// only the occluders whose boxes overlap the pair's box and that reach in front of
+    /// both nodes' planes (none: visible, no ray; more than [`MAX_CANDIDATES`]: the whole
+    /// BVH);
     /// cluster links use up to eight facing pairs of sample points (a cluster keeps up to
     /// sixteen points drawn from its children's in proportion to area, see
     /// [`super::tree::ClusterSample`]) and the whole BVH, and weigh each facing pair by what
