@@ -102,8 +102,9 @@ pub struct BuildingArgs {
     /// The scene's INTEGRAL_STEPS.
     #[arg(long, default_value_t = 2, value_name = "K")]
     pub steps: u32,
-    /// Exitance of the ceiling panels (lm/m^2, so that `illuminance` gives lux); windows
-    /// emit 0.6 of it, bluish.
+    /// Exitance of the ceiling panels in the red band (lm/m^2, so that `illuminance` gives
+    /// lux): they are tinted warm (1, 0.95, 0.85 times it), so their luminous exitance is
+    /// 0.953 of it; windows emit 0.6 of it, bluish.
     #[arg(long, default_value_t = 20.0, value_name = "E")]
     pub light: f64,
     /// No summary line (rooms, surfaces, size and element count; errors and warnings are

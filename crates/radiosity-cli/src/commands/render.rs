@@ -132,6 +132,18 @@ pub fn run(args: RenderArgs) -> Result<()> {
         if args.tone.gamma != 2.2 {
             errln!("warning: --gamma ignored with --false-colour: its colours are lux");
         }
+        // QA of issue #16: the picture was the same with either.
+        if args.rays.direct_light == crate::args::DirectLightArg::Mesh {
+            errln!(
+                "warning: --direct-light ignored with --false-colour: its colours are the \
+                 elements' lux"
+            );
+        }
+    }
+    // A wireframe is the same at every step of a progressive solve (QA of issue #16: five
+    // identical snapshots after the whole solve).
+    if args.shading == crate::args::ShadingArg::Wireframe && args.snapshots.is_some() {
+        bail!("--shading wireframe draws the mesh, the same at every shot; drop --snapshots");
     }
     let wireframe = settings.shading == render::Shading::Wireframe;
     if wireframe && args.tone.exposure != radiosity::shade::Exposure::Auto {

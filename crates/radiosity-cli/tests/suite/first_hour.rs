@@ -2850,3 +2850,70 @@ fn ninth_pass_findings_are_said() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn twelfth_pass_findings_are_said() {
+    // QA pass 12 of issue #16: a progressive wireframe wrote identical snapshots after the
+    // whole solve; --false-colour ignored --direct-light without a word; `check` named a
+    // method that hierarchical radiosity had just said it ignores.
+    let dir = scratch_dir("twelfth-pass");
+    let args = [
+        "render",
+        "--max-area",
+        "5000",
+        "--solver",
+        "progressive",
+        "--snapshots",
+        "sn",
+        "--shading",
+        "wireframe",
+        "-o",
+        "w.png",
+    ];
+    let out = radiosity(&args, &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("drop --snapshots"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!dir.join("sn").exists());
+    let args = [
+        "render",
+        "--max-area",
+        "5000",
+        "--false-colour",
+        "--direct-light",
+        "mesh",
+        "--width",
+        "16",
+        "-q",
+        "-o",
+        "f.png",
+    ];
+    let out = radiosity(&args, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("warning: --direct-light ignored with --false-colour"),
+        "{}",
+        stderr(&out)
+    );
+    let args = [
+        "check",
+        "--max-area",
+        "5000",
+        "--solver",
+        "hierarchical",
+        "--method",
+        "hemicube",
+    ];
+    let out = radiosity(&args, &dir);
+    let text = crate::fixtures::stdout(&out);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        text.contains("method            hierarchical radiosity's own"),
+        "{text}"
+    );
+    assert!(!text.contains("hemicube"), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
