@@ -45,8 +45,9 @@ pub fn prepare_solve(
     prepare_solve_as(args, options, reporter, false)
 }
 
-/// [`prepare_solve`] for `compare`, whose dense reference uses `--method` whatever the
-/// solver compared: no warning that hierarchical radiosity ignores it.
+/// [`prepare_solve`] without the warning that hierarchical radiosity ignores `--method`:
+/// for `compare`, whose dense reference uses it whatever the solver compared, and for
+/// `bench`'s repeated runs, which say it once.
 pub fn prepare_solve_with_reference(
     args: &SceneArgs,
     options: &SolveOptions,

@@ -17,8 +17,13 @@ use crate::setup::prepare_solve_with_reference;
 
 pub fn run(args: CompareArgs) -> Result<()> {
     let reporter = Reporter::new(args.scene.quiet);
-    let (prepared, stem, solver) =
-        prepare_solve_with_reference(&args.scene, &args.solve, &reporter)?;
+    // Without a reference nothing uses --method where hierarchical radiosity ignores it
+    // (QA of issue #16: no warning then).
+    let (prepared, stem, solver) = if args.no_reference {
+        crate::setup::prepare_solve(&args.scene, &args.solve, &reporter)?
+    } else {
+        prepare_solve_with_reference(&args.scene, &args.solve, &reporter)?
+    };
     // QA of issue #16: with the default `auto` on a small scene the tested solver is the
     // reference's own, and the row compares it with itself.
     if !args.no_reference

@@ -419,6 +419,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             image.pixels().map(|p| p.0 == [0, 0, 0]),
             fronts_in_view(&prepared, &camera),
             false,
+            camera.fov_y_degrees,
         )
         .map(|w| with_exposure_hint(w, exposure))
         {
@@ -429,6 +430,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     reporter.print_timings();
     Ok(())
 }
+
+/// A vertical field of view (degrees) past which a black picture may be the width's fault.
+const WIDE_FOV: f64 = 120.0;
 
 /// Above this share of black pixels a picture of a lit scene is said to show nothing.
 const BLACK_PICTURE_SHARE: f64 = 0.95;
@@ -442,7 +446,14 @@ const BLACK_PICTURE_SHARE: f64 = 0.95;
 /// ([`fronts_in_view`]): where most do, the camera is not to blame, what it sees gets no
 /// light or (unless the picture shows `lux`) reflects none (QA of issue #16: a camera inside a room facing a wall of
 /// reflectance 0 was told to move into the scene).
-fn black_picture(dark: impl Iterator<Item = bool>, fronts: f64, lux: bool) -> Option<String> {
+/// `fov` is the vertical field of view in degrees: past [`WIDE_FOV`] the scene may be in
+/// view but small (QA of issue #16: `--fov 170` was told to move --eye).
+fn black_picture(
+    dark: impl Iterator<Item = bool>,
+    fronts: f64,
+    lux: bool,
+    fov: f64,
+) -> Option<String> {
     let (mut pixels, mut black) = (0u64, 0u64);
     for is_dark in dark {
         pixels += 1;
@@ -461,6 +472,14 @@ fn black_picture(dark: impl Iterator<Item = bool>, fronts: f64, lux: bool) -> Op
                 } else {
                     " or they reflect none (reflectance 0)"
                 }
+            )
+        } else if fov > WIDE_FOV {
+            format!(
+                "{:.1} % of the picture shows nothing lit: at --fov {} the view is so wide \
+                 that what is lit may be a few pixels in it, the rest the backs of faces or \
+                 nothing; a narrower --fov shows more of the scene, or move --eye into it",
+                100.0 * share,
+                crate::report::typed(fov)
             )
         } else {
             format!(
@@ -623,7 +642,8 @@ fn false_colour(
             .iter()
             .zip(&coverage)
             .map(|(&lux, &c)| c <= 0.0 || lux <= 0.0);
-        if let Some(warning) = black_picture(nothing, fronts_in_view(prepared, camera), true) {
+        let fronts = fronts_in_view(prepared, camera);
+        if let Some(warning) = black_picture(nothing, fronts, true, camera.fov_y_degrees) {
             errln!("warning: {warning}");
         }
     }

@@ -2915,5 +2915,40 @@ fn twelfth_pass_findings_are_said() {
         "{text}"
     );
     assert!(!text.contains("hemicube"), "{text}");
+    // compare without a reference, and bench (once, and its table), say so too.
+    let ignored = "warning: --method contour ignored: hierarchical radiosity";
+    let args = [
+        "compare",
+        "--solver",
+        "hierarchical",
+        "--method",
+        "contour",
+        "--no-reference",
+        "--max-area",
+        "5000",
+    ];
+    let out = radiosity(&args, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains(ignored), "{}", stderr(&out));
+    let args = [
+        "bench",
+        "--solver",
+        "hierarchical",
+        "--method",
+        "contour",
+        "--max-area",
+        "5000",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--supersample",
+        "1",
+    ];
+    let out = radiosity(&args, &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(stderr(&out).matches(ignored).count(), 1, "{}", stderr(&out));
+    let text = crate::fixtures::stdout(&out);
+    assert!(text.contains("| links' own |"), "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
