@@ -549,6 +549,11 @@ const UNSOLVED: &str = "the form factors are reciprocal, so it is light the solv
 const COUNTED_TWICE: &str = "light counted twice where the form factors' rows sum above 1 \
                              (near pairs' visibility misjudged)";
 
+/// "1 surface" or "N surfaces".
+fn count_words(n: usize) -> String {
+    count(n as u64, "surface")
+}
+
 /// The same for hierarchical radiosity, which has links, not rows.
 const COUNTED_TWICE_LINKS: &str = "light counted twice where the estimated form factors of a \
                                    node's links sum above 1 (coarse links near corners and \
@@ -1120,7 +1125,14 @@ fn where_escaped(
     // Fewer than five are shown when the rest are below 0.01 % each (QA of issue #16: "the
     // 3 largest of 24" beside a README that said five).
     let all = |shown: usize, count: usize, total: f64| {
-        if shown == count {
+        if shown == 0 && count > 0 {
+            // QA of issue #16: "no surface (the 0 of 4 surfaces with 0.01 % or more ...".
+            format!(
+                "{} below 0.01 % each, {:.2} % in all",
+                count_words(count),
+                100.0 * total
+            )
+        } else if shown == count {
             format!("{:.2} % in all", 100.0 * total)
         } else if shown == 5 {
             format!(
@@ -1137,7 +1149,9 @@ fn where_escaped(
     outln!(
         "escaped from      {} ({}{}; of emitted, by the surface it left, where its rows of \
          form factors sum below 1: {ESCAPED})",
-        if lost.is_empty() {
+        if lost.is_empty() && out_count > 0 {
+            "no surface of 0.01 % or more".to_string()
+        } else if lost.is_empty() {
             "no surface".to_string()
         } else {
             lost.join(", ")
