@@ -549,11 +549,6 @@ const UNSOLVED: &str = "the form factors are reciprocal, so it is light the solv
 const COUNTED_TWICE: &str = "light counted twice where the form factors' rows sum above 1 \
                              (near pairs' visibility misjudged)";
 
-/// "1 surface" or "N surfaces".
-fn count_words(n: usize) -> String {
-    count(n as u64, "surface")
-}
-
 /// The same for hierarchical radiosity, which has links, not rows.
 const COUNTED_TWICE_LINKS: &str = "light counted twice where the estimated form factors of a \
                                    node's links sum above 1 (coarse links near corners and \
@@ -1124,24 +1119,24 @@ fn where_escaped(
             });
     // Fewer than five are shown when the rest are below 0.01 % each (QA of issue #16: "the
     // 3 largest of 24" beside a README that said five).
-    let all = |shown: usize, count: usize, total: f64| {
-        if shown == 0 && count > 0 {
+    let all = |shown: usize, of: usize, total: f64| {
+        if shown == 0 && of > 0 {
             // QA of issue #16: "no surface (the 0 of 4 surfaces with 0.01 % or more ...".
             format!(
                 "{} below 0.01 % each, {:.2} % in all",
-                count_words(count),
+                count(of as u64, "surface"),
                 100.0 * total
             )
-        } else if shown == count {
+        } else if shown == of {
             format!("{:.2} % in all", 100.0 * total)
         } else if shown == 5 {
             format!(
-                "the 5 largest of {count} surfaces, {:.2} % in all",
+                "the 5 largest of {of} surfaces, {:.2} % in all",
                 100.0 * total
             )
         } else {
             format!(
-                "the {shown} of {count} surfaces with 0.01 % or more, {:.2} % in all",
+                "the {shown} of {of} surfaces with 0.01 % or more, {:.2} % in all",
                 100.0 * total
             )
         }
