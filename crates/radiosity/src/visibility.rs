@@ -358,6 +358,77 @@ impl PolygonBvh {
             .any(|&k| self.intersect(k as usize, p, dir, eps, len - eps).is_some())
     }
 
+    /// [`PolygonBvh::segment_blocked_by`], moving the candidate that blocks to the front of
+    /// `candidates`: segments between the same two patches are mostly blocked by the same
+    /// occluder, which the next segment then tests first (a shadow cache, Haines and
+    /// Greenberg 1986). The answer is the same; only the order of the tests changes.
+    #[inline]
+    pub fn segment_blocked_by_first(&self, candidates: &mut [u32], p: DVec3, q: DVec3) -> bool {
+        let d = q - p;
+        let len = d.length();
+        let eps = 1e-7 * self.scale;
+        if len <= 2.0 * eps {
+            return false;
+        }
+        let dir = d / len;
+        match candidates
+            .iter()
+            .position(|&k| self.intersect(k as usize, p, dir, eps, len - eps).is_some())
+        {
+            Some(i) => {
+                candidates.swap(0, i);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// [`PolygonBvh::segment_blocked`], testing polygon `*last` (an index as from
+    /// [`PolygonBvh::overlapping`]) before the hierarchy, and setting it to the polygon that
+    /// blocks this segment, if any: a shadow cache (Haines and Greenberg 1986) for a run of
+    /// segments between the same two patches, where one test then stands for a traversal.
+    /// The answer is the same as without the cache.
+    pub fn segment_blocked_cached(&self, p: DVec3, q: DVec3, last: &mut Option<u32>) -> bool {
+        if self.polygons.is_empty() {
+            return false;
+        }
+        let d = q - p;
+        let len = d.length();
+        let eps = 1e-7 * self.scale;
+        if len <= 2.0 * eps {
+            return false;
+        }
+        let dir = d / len;
+        if let Some(k) = *last {
+            if (k as usize) < self.polygons.len()
+                && self.intersect(k as usize, p, dir, eps, len - eps).is_some()
+            {
+                return true;
+            }
+        }
+        let to_local = self.to_local;
+        let ray = Ray::new(
+            self.local(p),
+            to_f32(dir),
+            0.0,
+            ((len * 1.001 + eps) * to_local) as f32,
+        );
+        let mut blocker = None;
+        let missed = self.bvh.ray_traverse_miss(ray, |_, k| {
+            match self.intersect(k, p, dir, eps, len - eps) {
+                Some(t) => {
+                    blocker = Some(k as u32);
+                    (t * to_local) as f32
+                }
+                None => f32::INFINITY,
+            }
+        });
+        if !missed {
+            *last = blocker;
+        }
+        !missed
+    }
+
     /// True when some polygon crosses the open segment from `p` to `q`.
     ///
     /// The segment's ends are trimmed by 1e-7 of the scene's diagonal, so surfaces that
@@ -685,6 +756,84 @@ mod tests {
         assert!(bvh.segment_blocked(p, q));
         assert!(bvh.segment_blocked_except(p, q, 8));
         assert!(!bvh.segment_blocked_except(p, q, 7));
+    }
+
+    /// The shadow caches change only the order of the tests: across runs of segments, some
+    /// blocked by the square tried first and some not, the answers are those of a
+    /// brute-force test (vertical segments against horizontal squares: blocked where a
+    /// square between the ends holds the segment's (x, y)), and the cache names a square
+    /// that does block.
+    #[test]
+    fn shadow_caches_give_the_brute_force_answers() {
+        // 60 unit squares at heights 0.5, 1.5, ..., offset over a 10 x 6 area.
+        let squares: Vec<(f64, f64, f64)> = (0..60)
+            .map(|k| {
+                let (x, y) = crate::splitmix::jitter(17, k);
+                (9.0 * x, 5.0 * y, 0.5 + (k % 7) as f64)
+            })
+            .collect();
+        let polygons: Vec<Vec<DVec3>> = squares
+            .iter()
+            .map(|&(x, y, z)| {
+                vec![
+                    dvec3(x, y, z),
+                    dvec3(x + 1.0, y, z),
+                    dvec3(x + 1.0, y + 1.0, z),
+                    dvec3(x, y + 1.0, z),
+                ]
+            })
+            .collect();
+        let ids: Vec<u32> = (0..60).collect();
+        let bvh = PolygonBvh::new(&polygons, &ids);
+        let mut last = None;
+        let (mut blocked_count, mut cached_hits) = (0, 0);
+        for k in 0..400 {
+            let (u, v) = crate::splitmix::jitter(99, k);
+            // Runs of eight segments near one another, as a link's point pairs are.
+            let (a, b) = crate::splitmix::jitter(5, k / 8);
+            let (x, y) = (10.0 * a + 0.3 * u, 6.0 * b + 0.3 * v);
+            let (z0, z1) = ((k % 5) as f64, 7.5 - (k % 3) as f64);
+            let (p, q) = (dvec3(x, y, z0), dvec3(x, y, z1));
+            let blocking: Vec<u32> = squares
+                .iter()
+                .enumerate()
+                .filter(|(_, &(sx, sy, sz))| {
+                    sz > z0 && sz < z1 && x >= sx && x <= sx + 1.0 && y >= sy && y <= sy + 1.0
+                })
+                .map(|(i, _)| i as u32)
+                .collect();
+            let expected = !blocking.is_empty();
+            let before = last;
+            assert_eq!(
+                bvh.segment_blocked_cached(p, q, &mut last),
+                expected,
+                "{p} {q}"
+            );
+            if expected {
+                blocked_count += 1;
+                let id = bvh.id_of(last.expect("a blocked segment names its blocker"));
+                assert!(
+                    blocking.contains(&id),
+                    "cached square {id} does not block {p} {q}"
+                );
+                cached_hits += usize::from(before == last);
+            }
+            let mut candidates = Vec::new();
+            bvh.overlapping(p.min(q), p.max(q), &mut candidates);
+            candidates.reverse();
+            assert_eq!(
+                bvh.segment_blocked_by_first(&mut candidates, p, q),
+                expected
+            );
+            if expected {
+                assert!(blocking.contains(&bvh.id_of(candidates[0])));
+            }
+        }
+        // The test must exercise both: blocked segments, and blockers found in the cache.
+        assert!(
+            blocked_count > 50 && cached_hits > 20,
+            "{blocked_count} {cached_hits}"
+        );
     }
 
     #[test]

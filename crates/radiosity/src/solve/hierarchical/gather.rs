@@ -58,6 +58,7 @@ use super::bins::{cluster_emission, irradiance_for};
 use super::link::{patch_form_factor, Link};
 use super::solver::Solver;
 use super::tree::NONE;
+use super::visibility::VisibilityScratch;
 use crate::form_factor::kernel::mean_cos_over_r2;
 use crate::progress::{Progress, Stage};
 
@@ -207,7 +208,7 @@ impl Solver<'_> {
         q: u32,
         hidden: bool,
         terms: &mut LeafTerms,
-        scratch: &mut Vec<u32>,
+        scratch: &mut VisibilityScratch,
     ) {
         let (nl, nq) = (&self.nodes[l as usize], &self.nodes[q as usize]);
         if nq.buried {
@@ -240,7 +241,13 @@ impl Solver<'_> {
 
     /// The terms of the irradiance at leaf `l` through `link`, held by one of l's
     /// ancestors.
-    fn gather_link(&self, l: u32, link: &Link, terms: &mut LeafTerms, scratch: &mut Vec<u32>) {
+    fn gather_link(
+        &self,
+        l: u32,
+        link: &Link,
+        terms: &mut LeafTerms,
+        scratch: &mut VisibilityScratch,
+    ) {
         let q = link.source;
         let nq = &self.nodes[q as usize];
         let nl = &self.nodes[l as usize];
@@ -276,7 +283,7 @@ impl Solver<'_> {
         l: u32,
         link: &Link,
         terms: &mut LeafTerms,
-        scratch: &mut Vec<u32>,
+        scratch: &mut VisibilityScratch,
     ) {
         let q = link.source;
         if self.nodes[q as usize].is_cluster() {
@@ -298,7 +305,7 @@ impl Solver<'_> {
         q: u32,
         hidden: bool,
         terms: &mut LeafTerms,
-        scratch: &mut Vec<u32>,
+        scratch: &mut VisibilityScratch,
     ) {
         let (nl, nq) = (&self.nodes[l as usize], &self.nodes[q as usize]);
         let r = nl.centre.distance(nq.centre);
@@ -638,7 +645,7 @@ impl Solver<'_> {
         let this = &*self;
         let terms: Vec<LeafTerms> = leaves
             .par_iter()
-            .map_init(Vec::new, |scratch, &l| {
+            .map_init(VisibilityScratch::default, |scratch, &l| {
                 let mut t = LeafTerms::default();
                 // The leaf's own links: already at its resolution.
                 for link in &this.nodes[l as usize].links {

@@ -8,6 +8,7 @@ use glam::DVec3;
 use super::near_pairs::NearPairMemo;
 use super::solver::Solver;
 use super::tree::Node;
+use super::visibility::VisibilityScratch;
 use crate::form_factor::exact::point_to_polygon;
 use crate::form_factor::kernel::{mean_cos_over_r2, mean_point_pairs, mean_point_to_polygon};
 use crate::geometry;
@@ -104,7 +105,13 @@ impl Solver<'_> {
     }
 
     /// Estimates the link p <- q.
-    pub(super) fn estimate(&self, p: u32, q: u32, b_ref: f64, scratch: &mut Vec<u32>) -> Estimate {
+    pub(super) fn estimate(
+        &self,
+        p: u32,
+        q: u32,
+        b_ref: f64,
+        scratch: &mut VisibilityScratch,
+    ) -> Estimate {
         let (np, nq) = (&self.nodes[p as usize], &self.nodes[q as usize]);
         if np.buried || nq.buried {
             return Estimate::Nothing;

@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::link::Estimate;
 use super::solver::Solver;
+use super::visibility::VisibilityScratch;
 use crate::progress::Progress;
 use crate::solve::SolveError;
 
@@ -97,7 +98,7 @@ impl Solver<'_> {
             let this = &*self;
             let estimates: Vec<Estimate> = pairs
                 .par_iter()
-                .map_init(Vec::new, |scratch, &(p, q)| {
+                .map_init(VisibilityScratch::default, |scratch, &(p, q)| {
                     if p == q {
                         // Expanded again next time round (a child cluster's self-link).
                         Estimate::TooClose

@@ -81,6 +81,16 @@ fn spread_stride(n: usize) -> usize {
     s
 }
 
+/// What one thread keeps between visibility queries: the candidate occluders' list, and
+/// the occluder that blocked its last ray traced through the whole hierarchy, tried first
+/// by the next (the links a thread takes in turn are mostly between neighbours, hidden
+/// from one another by the same wall).
+#[derive(Default)]
+pub(super) struct VisibilityScratch {
+    candidates: Vec<u32>,
+    last: Option<u32>,
+}
+
 /// The most candidate occluders a patch <- patch link tests its rays against one by one;
 /// with more it traverses the whole hierarchy.
 const MAX_CANDIDATES: usize = 32;
@@ -141,7 +151,12 @@ impl Solver<'_> {
     /// it stands for of the exchange, A_x cos_x A_y cos_y / d^2 (the point-to-point kernel
     /// of Cohen & Wallace 1993, eq. 4.16, times the areas), so that the legs hidden under a
     /// table top do not count as much as the top.
-    pub(super) fn visibility(&self, p: u32, q: u32, scratch: &mut Vec<u32>) -> (f64, u64, u32) {
+    pub(super) fn visibility(
+        &self,
+        p: u32,
+        q: u32,
+        scratch: &mut VisibilityScratch,
+    ) -> (f64, u64, u32) {
         let (np, nq) = (&self.nodes[p as usize], &self.nodes[q as usize]);
         let occ = self.occluders;
         let mut pairs = [(DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, DVec3::ZERO); 16];
@@ -162,7 +177,7 @@ impl Solver<'_> {
             let (mp, mq) = (self.normal[sp as usize], self.normal[sq as usize]);
             let (op, oq) = (np.polygon()[0], nq.polygon()[0]);
             let tol = 1e-9 * occ.scale();
-            scratch.clear();
+            scratch.candidates.clear();
             // Occluders of the two surfaces themselves, or wholly behind either plane, cannot
             // cross a segment between facing points (it runs in front of both planes); a
             // pair that does not face counts only where none faces.
@@ -178,9 +193,9 @@ impl Solver<'_> {
                         && corners.iter().any(|c| mp.dot(*c - op) > tol)
                         && corners.iter().any(|c| mq.dot(*c - oq) > tol)
                 },
-                scratch,
+                &mut scratch.candidates,
             );
-            if scratch.is_empty() {
+            if scratch.candidates.is_empty() {
                 return (1.0, 0, 16);
             }
             use_candidates = short;
@@ -237,11 +252,15 @@ impl Solver<'_> {
             }
             count = m;
         }
-        let blocked = |x: DVec3, y: DVec3| {
+        // The occluder that blocked the last pair is tested first by the next (most of a
+        // link's blocked pairs are blocked by one occluder): moved to the front of the
+        // candidates, or kept in the scratch (any occluder of the hierarchy).
+        let VisibilityScratch { candidates, last } = scratch;
+        let mut blocked = |x: DVec3, y: DVec3| {
             if use_candidates {
-                occ.segment_blocked_by(scratch, x, y)
+                occ.segment_blocked_by_first(candidates, x, y)
             } else {
-                occ.segment_blocked(x, y)
+                occ.segment_blocked_cached(x, y, last)
             }
         };
         let (mut facing, mut visible, mut all_visible) = (0u32, 0u32, 0u32);
