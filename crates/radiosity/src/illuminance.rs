@@ -6,8 +6,10 @@
 //!   fraction (shadow rays, [`crate::render::DirectLight`]), plus each point luminaire's
 //!   I cos / d^2 where its segment is clear.
 //! * **Indirect**: the light that arrives from reflected light: every element's reflected
-//!   exitance (its radiosity less its surface's own emission; progressive refinement's
-//!   ambient term included) times the exact point-to-polygon form factor to the element
+//!   exitance (its radiosity less its surface's own emission; of a progressive run stopped
+//!   early, the light shot so far, as `solve` writes it, not the paper's ambient term for
+//!   the unshot rest, a uniform guess that put a point of the Cornell box at 0.43 lx after
+//!   one shot against 0.24 lx converged) times the exact point-to-polygon form factor to the element
 //!   times the visible fraction of the element (kernel-weighted shadow rays to 3 x 3 points
 //!   of it; an element seen whole needs no more). The first reflection of the point
 //!   luminaires' light is not taken from the element's mean: the solver's share of it
@@ -56,8 +58,8 @@ pub struct Lux {
 /// The shadow-ray points per element side for the indirect light's visibility.
 const ELEMENT_POINTS: u32 = 3;
 
-/// Each element's reflectance (its surface's) and the exitance it shows
-/// ([`Solution::display_radiosity`]: progressive refinement's ambient term included).
+/// Each element's reflectance (its surface's) and its radiosity (of a progressive run
+/// stopped early, the light shot so far: no ambient term, see the module documentation).
 fn reflectance_and_shown(scene: &crate::scene::Scene, solution: &Solution) -> (Vec<Rgb>, Vec<Rgb>) {
     let reflectance: Vec<Rgb> = solution
         .mesh
@@ -65,8 +67,7 @@ fn reflectance_and_shown(scene: &crate::scene::Scene, solution: &Solution) -> (V
         .iter()
         .map(|e| scene.surfaces[e.surface as usize].reflectance)
         .collect();
-    let shown = solution.display_radiosity(&reflectance);
-    (reflectance, shown)
+    (reflectance, solution.radiosity.0.clone())
 }
 
 /// The illuminance at each of `points` for the scene of `prepared` solved as `solution`
@@ -627,6 +628,7 @@ fn glyph(c: char) -> Option<[u8; 5]> {
         'e' => [7, 5, 7, 4, 7],
         '+' => [0, 2, 7, 2, 0],
         '/' => [1, 1, 2, 4, 4],
+        '=' => [0, 7, 0, 7, 0],
         'A' => [2, 5, 7, 5, 5],
         'E' => [7, 4, 6, 4, 7],
         'I' => [7, 2, 2, 2, 7],
@@ -704,7 +706,10 @@ pub fn lux_label(v: f64) -> String {
         format!("{v:.0}")
     } else if a >= 10.0 {
         format!("{v:.1}")
-    } else if a >= 0.1 || a == 0.0 || !a.is_finite() {
+    } else if a == 0.0 {
+        // Plain 0 among whole lux (QA pass 13 of #16: "MIN 0.00 ... MAX 516").
+        "0".to_string()
+    } else if a >= 0.1 || !a.is_finite() {
         format!("{v:.2}")
     } else if a >= 1e-6 {
         let decimals = (-a.log10()).floor() as usize + 2;
@@ -854,6 +859,21 @@ impl GridAxes {
     }
 }
 
+/// The coordinates a grid from `a` to `b` holds fixed, as the grid picture prints them under
+/// its summary: "z = 0.8" for a plan, "y = 0.8  z = 1" for a line, all three for a point
+/// (QA pass 13 of #16: a one-point grid's picture said nowhere where it was, a line's only
+/// one of its two fixed coordinates). Empty when every coordinate varies.
+pub fn held_coordinates(a: DVec3, b: DVec3) -> String {
+    (0..3)
+        .filter(|&i| a[i] == b[i])
+        .map(|i| {
+            let d = decimals_of(a[i]);
+            format!("{} = {:.*}", ['x', 'y', 'z'][i], d, a[i] + 0.0)
+        })
+        .collect::<Vec<_>>()
+        .join("  ")
+}
+
 /// The font scale of the scale bars' text (3 x 5 glyphs drawn 3 times: 9 x 15 pixels).
 const LEGEND_FONT: i64 = 3;
 
@@ -864,16 +884,18 @@ const LEGEND_FONT: i64 = 3;
 /// z-up floor grid) unless the axes say otherwise ([`GridAxes::as_drawn`]); on the right a scale bar with its values and the unit `lx`. `values`
 /// run column by column within rows (as [`grid`] makes them); `dims` = [columns, rows].
 pub fn grid_picture(values: &[f64], dims: [usize; 2]) -> image::RgbImage {
-    grid_picture_with_axes(values, dims, None)
+    grid_picture_with_axes(values, dims, None, "")
 }
 
 /// [`grid_picture`] with the coordinates of the columns below the cells and of the rows
 /// left of them (every column or row where the labels fit, else every second, third, ...),
-/// each axis named at the end of its labels.
+/// each axis named at the end of its labels, and `held` (the coordinates the grid holds
+/// fixed, [`held_coordinates`]) under the summary line.
 pub fn grid_picture_with_axes(
     values: &[f64],
     dims: [usize; 2],
     axes: Option<GridAxes>,
+    held: &str,
 ) -> image::RgbImage {
     let [nu, nv] = dims;
     let summary = GridSummary::of(values);
@@ -908,10 +930,12 @@ pub fn grid_picture_with_axes(
     // The scale bar runs beside the cells, 200 px at least.
     let bar_bottom = top + gh.max(200);
     let height = bar_bottom + below;
-    let width =
-        (gw + margin + GRID_MARGIN + GRID_LEGEND_WIDTH).max(text_width(&line, 2) + 2 * GRID_MARGIN);
+    let width = (gw + margin + GRID_MARGIN + GRID_LEGEND_WIDTH)
+        .max(text_width(&line, 2) + 2 * GRID_MARGIN)
+        .max(text_width(held, 2) + 2 * GRID_MARGIN);
     let mut img = image::RgbImage::from_pixel(width as u32, height as u32, image::Rgb([255; 3]));
     draw_text(&mut img, GRID_MARGIN, 10, 2, &line, [0; 3]);
+    draw_text(&mut img, GRID_MARGIN, 24, 2, held, [0; 3]);
     if let (Some((cols, rows)), Some(axes)) = (&labels, axes) {
         // Every k-th column so that the labels keep 6 px apart; every k-th row so that
         // they keep 4 px apart (10 px tall).
@@ -1036,8 +1060,8 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
 
 /// The illuminance in lux (Y of the bands) on the front of every element of the solution's
 /// mesh, for `render --false-colour`. Where the element reflects in every band it is read
-/// back from the solution: the irradiance H = (B - E) / rho per band (B the display
-/// radiosity, progressive refinement's ambient term included, E the surface's own
+/// back from the solution: the irradiance H = (B - E) / rho per band (B the solution's
+/// radiosity, of a progressive run the light shot so far, E the surface's own
 /// emission), the mean over the element as the solver has it. Where a band's reflectance is
 /// 0 the solution holds no trace of the light that arrived, so the illuminance is computed
 /// at the element's centroid as [`illuminance`] computes it at a calculation point (direct

@@ -223,7 +223,7 @@ fn the_grid_picture_colours_cells_by_value_with_a_legend() {
     // Dim and bright values keep two or three significant figures.
     assert_eq!(lux_label(0.01434), "0.014");
     assert_eq!(lux_label(0.001234), "0.0012");
-    assert_eq!(lux_label(0.0), "0.00");
+    assert_eq!(lux_label(0.0), "0");
     assert_eq!(lux_label(2.5e-9), "2.5e-9");
     assert_eq!(lux_label(4.5e30), "4.50e30");
 }
@@ -396,7 +396,7 @@ fn the_grid_picture_prints_the_coordinates_of_its_columns_and_rows() {
             .filter(|&(x, y)| img.get_pixel(x, y).0 == [0; 3])
             .count()
     };
-    let with = grid_picture_with_axes(&values, [3, 2], Some(axes));
+    let with = grid_picture_with_axes(&values, [3, 2], Some(axes), "");
     let without = grid_picture(&values, [3, 2]);
     // The cells are 38 px ("10.0": 30 px + 8); 2 rows from GRID_TOP, labels 6 px below.
     let below = (GRID_TOP + 2 * 38 + 6) as u32;
@@ -447,7 +447,7 @@ fn grids_are_drawn_as_plans_and_elevations() {
     );
     // Drawn: the cell of row 0 (the least value) at the top when rows run down.
     let values = [1.0, 1.0, 100.0, 100.0];
-    let drawn = |axes: GridAxes| grid_picture_with_axes(&values, [2, 2], Some(axes));
+    let drawn = |axes: GridAxes| grid_picture_with_axes(&values, [2, 2], Some(axes), "");
     let top_left = |img: &image::RgbImage| {
         let c = img.get_pixel(60, (GRID_TOP + 10) as u32).0;
         c[0] as u32 + c[1] as u32 + c[2] as u32
@@ -499,4 +499,36 @@ fn a_lamp_close_to_a_floor_reflects_what_fine_quadrature_says() {
         "{} against {want}",
         lux.indirect
     );
+}
+
+/// QA pass 13 of #16: a one-point grid's picture said nowhere where it was, and a line's
+/// named only one of its two fixed coordinates.
+#[test]
+fn a_grid_picture_says_the_coordinates_it_holds_fixed() {
+    let (a, b) = (DVec3::new(1.0, 0.8, 1.0), DVec3::new(3.0, 0.8, 4.0));
+    assert_eq!(held_coordinates(a, b), "y = 0.8");
+    assert_eq!(
+        held_coordinates(a, DVec3::new(1.0, 2.8, 1.0)),
+        "x = 1  z = 1"
+    );
+    assert_eq!(held_coordinates(a, a), "x = 1  y = 0.8  z = 1");
+    assert_eq!(held_coordinates(a, DVec3::new(2.0, 1.0, 2.0)), "");
+    // Drawn under the summary line (rows 24 to 34, above the scale bar's "lx" at 36),
+    // nothing there without it.
+    let ink = |img: &image::RgbImage| {
+        (24..34)
+            .flat_map(|y| (0..img.width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0 == [0; 3])
+            .count()
+    };
+    let values = [120.0];
+    assert!(
+        ink(&grid_picture_with_axes(
+            &values,
+            [1, 1],
+            None,
+            "x = 1  y = 0.8  z = 1"
+        )) > 60
+    );
+    assert_eq!(ink(&grid_picture(&values, [1, 1])), 0);
 }

@@ -146,7 +146,11 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
             .grid
             .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing))
             .map(|axes| axes.as_drawn(radiosity::render::z_is_up(&prepared.scene)));
-        let img = illuminance::grid_picture_with_axes(&totals, dims, axes);
+        let held = args
+            .grid
+            .map(|(a, b, _)| illuminance::held_coordinates(a, b))
+            .unwrap_or_default();
+        let img = illuminance::grid_picture_with_axes(&totals, dims, axes, &held);
         crate::progress_bar::run_file_stage(&reporter, Stage::Write, png, || {
             radiosity::io::png::write_png(&img, png)
         })
