@@ -604,12 +604,33 @@ fn lights(prepared: &Prepared) {
     }
     let occluders = radiosity::form_factor::occluder_bvh(scene);
     for (i, l) in scene.lights.iter().enumerate() {
-        let flux = l.flux();
+        let untinted = l.flux();
         let landing = radiosity::luminaire::landing_flux(&prepared.mesh, l, &occluders);
-        let share = if flux > 0.0 { landing / flux } else { 0.0 };
+        let share = if untinted > 0.0 {
+            landing / untinted
+        } else {
+            0.0
+        };
+        // COLOUR multiplies the output in each band, so the lumens emitted are the untinted
+        // lumens times its luminance (QA pass 13 of #16: COLOUR 2 2 2 emitted 2,000 lm
+        // where this line said 1,000).
+        let tint = l.colour.luminance();
+        let flux = untinted * tint;
+        let tinted = if l.colour.0 == [1.0; 3] {
+            String::new()
+        } else {
+            format!(
+                " ({} lm times COLOUR {} {} {}, luminance {})",
+                significant(untinted, 6),
+                l.colour.0[0],
+                l.colour.0[1],
+                l.colour.0[2],
+                significant(tint, 4)
+            )
+        };
         let p = l.position;
         outln!(
-            "{}{} {:.1} lm at ({}, {}, {}); {:.1} % lands on the fronts of surfaces",
+            "{}{} {:.1} lm{tinted} at ({}, {}, {}); {:.1} % lands on the fronts of surfaces",
             if i == 0 {
                 "point lights      "
             } else {
@@ -807,8 +828,8 @@ pub fn check(
     } else {
         // One wording with hierarchical radiosity's "leaf contacts" below (QA of issue #16).
         outln!(
-            "contacts          {} elements split, {} dropped whole; buried and left out: {} {area_unit} (of the grid's elements)",
-            contacts.split,
+            "contacts          {} split, {} dropped whole; buried and left out: {} {area_unit} (of the grid's elements)",
+            count(contacts.split as u64, "element"),
             contacts.dropped,
             significant(contacts.buried_area, 4)
         );

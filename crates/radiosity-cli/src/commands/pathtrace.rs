@@ -135,6 +135,25 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             ),
             ("--adapt-rounds", args.solve.adapt_rounds.is_some()),
             (
+                "--adapt-contrast",
+                args.solve.adapt_contrast != radiosity::mesh::DEFAULT_CONTRAST,
+            ),
+            (
+                "--adapt-max-elements",
+                args.solve.adapt_max_elements.is_some(),
+            ),
+            // The form-factor methods' own settings (QA pass 13 of #16: `--seed 3` went
+            // without a word, though the path tracer's seed is --path-seed).
+            (
+                "--resolution",
+                s.method.resolution != crate::args::MethodArgs::RESOLUTION,
+            ),
+            (
+                "--samples",
+                s.method.samples != crate::args::MethodArgs::SAMPLES,
+            ),
+            ("--seed", s.method.seed != crate::args::MethodArgs::SEED),
+            (
                 "--max-shots",
                 args.solve.max_shots != radiosity::solve::ProgressiveSettings::default().max_shots,
             ),
@@ -159,8 +178,13 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             errln!(
                 "warning: {} ignored without --compare: the path tracer traces the scene's \
                  polygons (the meshing, form-factor and solver flags set the radiosity solve \
-                 --compare adds)",
-                ignored.join(", ")
+                 --compare adds){}",
+                ignored.join(", "),
+                if ignored.contains(&"--seed") {
+                    "; the path tracer's own seed is --path-seed"
+                } else {
+                    ""
+                }
             );
         }
         if args.error_scale != 0.2 {

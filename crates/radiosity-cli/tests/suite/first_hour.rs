@@ -705,7 +705,11 @@ fn check_lists_the_point_lights_and_warns_of_one_whose_light_is_lost() {
     assert!(text.contains("POSITION 1.5 2.6 1.5"));
     std::fs::write(
         dir.join("far.scene"),
-        text.replace("POSITION 1.5 2.6 1.5", "POSITION 100 100 100"),
+        text.replace("POSITION 1.5 2.6 1.5", "POSITION 100 100 100")
+            .replace(
+                "POSITION 3.5 2.6 2.5",
+                "POSITION 3.5 2.6 2.5\nCOLOUR 1 0.8 0.6",
+            ),
     )
     .unwrap();
     let out = radiosity(&["check", "far.scene", "--max-area", "4"], &dir);
@@ -719,8 +723,15 @@ fn check_lists_the_point_lights_and_warns_of_one_whose_light_is_lost() {
         err.contains("warning: point luminaire Down1 at (100, 100, 100): only 0.0 %"),
         "{err}"
     );
-    // The other one, in the room, lands (almost) whole and is not warned about.
+    // The other one, in the room, lands (almost) whole and is not warned about. Its
+    // COLOUR scales its output in each band, so it emits FLUX times the colour's
+    // luminance: 3000 x (0.2126 + 0.7152 x 0.8 + 0.0722 x 0.6) = 2484.24 lm (Rec. 709
+    // weights; QA pass 13 of #16: COLOUR 2 2 2 emitted twice what this line said).
     assert!(!err.contains("luminaire Down2"), "{err}");
+    assert!(
+        text.contains("Down2 2484.2 lm (3000 lm times COLOUR 1 0.8 0.6, luminance 0.8281) at"),
+        "{text}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -1003,6 +1014,10 @@ fn pathtrace_says_which_compare_flags_it_ignores_without_compare() {
             "flat",
             "--epsilon",
             "0.1",
+            "--seed",
+            "3",
+            "--adapt-contrast",
+            "0.5",
             "--paths",
             "2",
             "--width",
@@ -1021,8 +1036,11 @@ fn pathtrace_says_which_compare_flags_it_ignores_without_compare() {
         err.contains("warning: --shading, --supersample ignored without --compare"),
         "{err}"
     );
+    // QA pass 13: --seed (the form factors', not the path tracer's --path-seed) and the
+    // adaptive subdivision's flags were ignored without a word.
     assert!(
-        err.contains("warning: --epsilon ignored without --compare"),
+        err.contains("warning: --epsilon, --adapt-contrast, --seed ignored without --compare")
+            && err.contains("the path tracer's own seed is --path-seed"),
         "{err}"
     );
     // With --compare they are used: no such warning.

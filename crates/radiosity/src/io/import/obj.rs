@@ -51,6 +51,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use super::face_soup::{material_problem, MaterialField};
 use super::{
     default_settings, scaled_unit, FaceSoup, Format, ImportError, ImportOptions, ImportWarning,
     Imported, SoupFace, SoupMaterial,
@@ -512,6 +513,15 @@ impl Reader {
                     format!("Ke (the emission) is {v} in the {band} band; it must be at least 0"),
                 ));
             }
+        }
+        // The soup's own check (an emission past MAX_EMISSION) at the line of the colour it
+        // names, not at `newmtl` (QA pass 13 of #16: "kd.mtl:1" for a Ke on line 3).
+        if let Some((field, message)) = material_problem(reflectance, emission) {
+            let line = match field {
+                MaterialField::Reflectance => entry.kd.map(|(_, l)| l),
+                MaterialField::Emission => entry.ke.map(|(_, l)| l),
+            };
+            return Err(bad(line.unwrap_or(entry.line), message));
         }
         self.soup.materials.push(SoupMaterial {
             name: name.to_string(),

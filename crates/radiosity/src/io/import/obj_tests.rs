@@ -177,6 +177,17 @@ fn reflectance_of_one_is_refused_at_its_mtl_line() {
         ),
         "{e}"
     );
+    // An emission too large for the scene is reported at its Ke line, not at newmtl.
+    let e = read_text(
+        &format!("mtllib m.mtl\n{SQUARE}usemtl e\nf 1 2 3 4\n"),
+        &[("m.mtl", "newmtl e\nKd 0.5\nKe 1e39 1 1\n")],
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("m.mtl:3: error: material \"e\": the red emission is 1e39"),
+        "{e}"
+    );
     let e = read_text(
         &format!("mtllib m.mtl\n{SQUARE}f 1 2 3 4\n"),
         &[("m.mtl", "Kd 0.5 0.5\n")],

@@ -111,7 +111,7 @@
 //! AIM 0 0 -1              // the axis of the distribution (a direction; default 0 0 -1: -z)
 //! INTENSITY 1000          // cd on the axis; or FLUX 10000 (lm in all directions)
 //! DISTRIBUTION COSINE     // ISOTROPIC | COSINE (I0 cos theta, nothing above 90 deg) | IES file.ies
-//! COLOUR 1 1 1            // optional tint per band (COLOR is read too)
+//! COLOUR 1 1 1            // optional filter per band, multiplying the output (COLOR is read too)
 //! LIGHTEND
 //! ```
 //!

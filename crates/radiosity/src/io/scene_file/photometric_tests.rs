@@ -242,6 +242,21 @@ fn light_block_errors_name_the_line_and_what_was_expected() {
                 INTENSITY 5\nDISTRIBUTION COSINE\nLIGHTEND\nSCENEEND\n";
     let e = errors(text);
     assert!(e[0].2.contains("no patches"), "{e:?}");
+    // QA pass 13 of #16: a colour's numbers are named as bands, and a black light is
+    // refused at its line (it passed, and `check` said nothing emits light).
+    let e = lines(
+        "LIGHTBEGIN\n#L\nPOSITION 0 0 1\nINTENSITY 5\nCOLOUR 1 0.5\nDISTRIBUTION COSINE\nLIGHTEND",
+    );
+    assert_eq!(e[0].0, 22, "{e:?}");
+    assert!(e[0].2.contains("the blue"), "{e:?}");
+    let e = lines(
+        "LIGHTBEGIN\n#L\nPOSITION 0 0 1\nINTENSITY 5\nCOLOUR 0 0 0\nDISTRIBUTION COSINE\nLIGHTEND",
+    );
+    assert_eq!((e.len(), e[0].0, e[0].1), (1, 22, 1), "{e:?}");
+    assert!(
+        e[0].2.contains("COLOUR 0 0 0 makes the light emit nothing"),
+        "{e:?}"
+    );
 }
 
 #[test]

@@ -527,7 +527,13 @@ impl<'a> Parser<'a> {
     ) -> Step<([Option<(f64, Token<'a>)>; 3], Line<'a>)> {
         let line = self.expect(keyword)?;
         let mut xyz = [None; 3];
-        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+        // A colour's three numbers are its bands (QA pass 13 of #16: "the z band").
+        let names = if keyword == Keyword::Colour {
+            ["red", "green", "blue"]
+        } else {
+            ["x", "y", "z"]
+        };
+        for (i, axis) in names.iter().enumerate() {
             match self.number(&line, i + 1, &format!("a number (the {axis} {what})")) {
                 Ok(found) => xyz[i] = Some(found),
                 Err(Reported) => return Ok((xyz, line)),
@@ -1194,7 +1200,21 @@ impl<'a> Parser<'a> {
                             self.error_at(*token, &l, msg);
                         }
                     }
-                    colour = Some(Rgb(read.map(|t| t.map_or(0.0, |t| t.0))));
+                    let c = Rgb(read.map(|t| t.map_or(0.0, |t| t.0)));
+                    // QA pass 13 of #16: a black light passed, and `check` then said that
+                    // nothing in the scene emits light and that the lamp was inside
+                    // furniture.
+                    if read.iter().all(Option::is_some) && c.0.iter().all(|&v| v == 0.0) {
+                        let head = l.head();
+                        self.error_at(
+                            head,
+                            &l,
+                            "COLOUR 0 0 0 makes the light emit nothing: COLOUR multiplies its \
+                             output in each band (1 1 1 for white); leave the light out to \
+                             switch it off",
+                        );
+                    }
+                    colour = Some(c);
                 }
                 _ => {
                     // Reported, and the rest of the block still read: the light is
