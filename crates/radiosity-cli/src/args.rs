@@ -54,6 +54,10 @@ pub struct Cie171Args {
     /// (the repository keeps them under validation/); with --case, those cases' only.
     #[arg(long, value_name = "DIR")]
     pub write: Option<PathBuf>,
+    /// With --write: replace the case files that are already in DIR (scene files are
+    /// inputs: without this flag none is written over).
+    #[arg(long, requires = "write")]
+    pub force: bool,
     /// Run (or, with --write, write) only the cases whose id starts with this, e.g. 5.8 or
     /// 5.11.
     #[arg(long, value_name = "ID")]

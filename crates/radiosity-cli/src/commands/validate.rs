@@ -38,6 +38,30 @@ pub fn cie171(args: Cie171Args) -> Result<()> {
         // As every other output: a missing folder's parent is not made (QA of issue #16:
         // `--write nowhere/deep/x` made three folders without a word).
         crate::setup::parent_folder_exists(dir, "--write")?;
+        // As `generate`: no scene file is written over without --force (QA pass 13 of #16:
+        // a second --write replaced all 26 files without a word).
+        if !args.force {
+            let existing: Vec<String> = cases
+                .iter()
+                .flat_map(|c| {
+                    [
+                        format!("{}.scene", c.stem),
+                        format!("{}.points.csv", c.stem),
+                    ]
+                })
+                .filter(|name| dir.join(name).exists())
+                .collect();
+            if let Some(first) = existing.first() {
+                bail!(
+                    "--write {}: {} of the case files {} already there ({first}{}); give \
+                     another folder, or --force to replace them",
+                    dir.display(),
+                    existing.len(),
+                    if existing.len() == 1 { "is" } else { "are" },
+                    if existing.len() > 1 { ", ..." } else { "" }
+                );
+            }
+        }
         let written = cie171::write_case_files(dir, &cases)
             .with_context(|| format!("cannot write the validation files into {}", dir.display()))?;
         if !args.quiet {

@@ -81,6 +81,23 @@ fn validate_cie171_write_with_case_writes_only_that_case() {
     names.sort();
     assert_eq!(names.len(), 2, "{names:?}");
     assert!(names[0].ends_with(".points.csv") && names[1].ends_with(".scene"));
+    // Again into the same folder: refused without --force, the files left as they were
+    // (QA pass 13 of #16: all were written over without a word); replaced with it.
+    let scene = dir.join("cases").join(&names[1]);
+    std::fs::write(&scene, "edited").unwrap();
+    let again = ["validate", "cie171", "--write", "cases", "--case", "5.11"];
+    let out = radiosity(&again, &dir);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("2 of the case files are already there")
+            && stderr(&out).contains("--force"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(std::fs::read_to_string(&scene).unwrap(), "edited");
+    let out = radiosity(&[&again[..], &["--force"]].concat(), &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_ne!(std::fs::read_to_string(&scene).unwrap(), "edited");
     let out = radiosity(
         &["validate", "cie171", "--write", "more", "--case", "9.9"],
         &dir,
