@@ -88,7 +88,7 @@
 //! # Final gather
 //!
 //! With [`HierarchicalSettings::final_gather`] (the default), once the hierarchy has
-//! converged every leaf's irradiance is gathered again at the leaf's own resolution (see
+//! converged (to the rounds' tolerance) every leaf's irradiance is gathered again at the leaf's own resolution (see
 //! the `gather` module): each link held by an ancestor is evaluated again with the leaf as
 //! the receiver, descending into large near sources, with visibility sampled again from
 //! the leaf where the link saw its source partly hidden; the terms are kept and iterated
@@ -173,7 +173,9 @@ pub const DEFAULT_HIERARCHICAL_TOLERANCE: f64 = 1e-6;
 /// The changing power (fraction of the emitted) at which the solves between refinement
 /// rounds stop: the oracle that follows tests links against epsilon = 0.05 of B, so a
 /// thousandth of the power is plenty, and the sweeps to 1e-6 are made once, at the end (on
-/// the million-element building: 134 sweeps over 6 solves before).
+/// the million-element building: 134 sweeps over 6 solves before); with the final gather
+/// its passes over the gathered terms iterate to 1e-6 instead (its first pass changes far
+/// more than 1e-3 of the power anyway).
 const ROUND_TOLERANCE: f64 = 1e-3;
 /// The most the memo of near pairs' exact form factors holds (see the `near_pairs` module):
 /// the million-element building's shapes take a few MiB.
@@ -227,10 +229,12 @@ pub struct HierarchicalReport {
     pub initial_links: usize,
     /// Refinement rounds (solve, then refine) made.
     pub rounds: usize,
-    /// Gather / push-pull sweeps made in all.
+    /// Gather / push-pull sweeps made in all, the final gather's passes over its terms
+    /// included.
     pub iterations: usize,
-    /// Power that still changed in the last sweep, as a fraction of the emitted power (the
-    /// largest band): the analogue of the unshot fraction.
+    /// Power that still changed in the last sweep (or the final gather's last pass), as a
+    /// fraction of the emitted power (the largest band): the analogue of the unshot
+    /// fraction.
     pub residual: f64,
     /// Visibility segments tested.
     pub rays: u64,
@@ -432,8 +436,15 @@ pub fn solve_hierarchical(
                 // by far less than the oracle's own tolerance: the last one.
                 let links: usize = solver.nodes.iter().map(|n| n.links.len()).sum();
                 if refined * 10_000 <= links || rounds >= MAX_ROUNDS {
-                    if refined > 0 || residual > settings.tolerance {
-                        let (sweeps, r) = solver.solve(emitted, settings.tolerance)?;
+                    // The final gather iterates to the tolerance itself (see
+                    // `Solver::final_gather`).
+                    let last = if settings.final_gather {
+                        round_tolerance
+                    } else {
+                        settings.tolerance
+                    };
+                    if refined > 0 || residual > last {
+                        let (sweeps, r) = solver.solve(emitted, last)?;
                         iterations += sweeps;
                         residual = r;
                     }
@@ -445,7 +456,15 @@ pub fn solve_hierarchical(
     // The final gather, at each leaf's own resolution: a stage of its own, with the gather
     // points as its progress (QA of issue #16: on large scenes it ran for a minute inside
     // the solve stage, whose lines counted refinement rounds that no longer changed).
-    let gathered = (settings.final_gather && lit).then(|| solver.final_gather(progress));
+    let (mut iterations, mut residual) = (iterations, residual);
+    let gathered = if settings.final_gather && lit {
+        let g = solver.final_gather(emitted, progress)?;
+        iterations += g.sweeps + g.passes;
+        residual = g.residual;
+        Some(g.h_of)
+    } else {
+        None
+    };
 
     // Each leaf's total irradiance, for the energy account (gathered again at each leaf, or
     // pushed down); the leaves as a mesh; where the emitted power went.
