@@ -536,7 +536,25 @@ fn point_of_line(
     line: usize,
     first_line_of: &mut std::collections::HashMap<String, usize>,
 ) -> Result<CalcPoint, String> {
-    let fields: Vec<&str> = line_text.split(',').map(str::trim).collect();
+    // CSV fields, so that a quoted name may hold commas, as `solve` and this program's
+    // other CSV files write them (QA pass 13 of #16); a quoted name is taken as written,
+    // the other fields trimmed.
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(line_text.as_bytes());
+    let mut record = csv::StringRecord::new();
+    match reader.read_record(&mut record) {
+        Ok(true) => {}
+        Ok(false) => return Err("expected 7 fields (name,x,y,z,nx,ny,nz), found none".into()),
+        Err(e) => return Err(format!("not a CSV line: {e}")),
+    }
+    let quoted = line_text.trim_start().starts_with('"');
+    let fields: Vec<&str> = record
+        .iter()
+        .enumerate()
+        .map(|(k, f)| if k == 0 && quoted { f } else { f.trim() })
+        .collect();
     if fields.len() != 7 {
         return Err(format!(
             "expected 7 fields (name,x,y,z,nx,ny,nz), found {}",
@@ -598,7 +616,8 @@ pub fn write_lux_csv(
         writeln!(
             out,
             "{},{},{},{},{},{},{},{},{},{}",
-            p.name, x.x, x.y, x.z, n.x, n.y, n.z, l.direct, l.indirect, l.total
+            crate::io::surface_report::csv_name(&p.name),
+            x.x, x.y, x.z, n.x, n.y, n.z, l.direct, l.indirect, l.total
         )?;
     }
     Ok(())

@@ -194,6 +194,43 @@ fn points_files_are_read_and_bad_lines_named() {
 }
 
 #[test]
+fn a_quoted_name_may_hold_commas_and_comes_back_quoted() {
+    // QA pass 13 of #16: `solve` writes names such as "Desk, north" quoted, and the points
+    // reader split them at the comma ("expected 7 fields, found 8").
+    let pts = parse_points(
+        "name,x,y,z,nx,ny,nz\n\"Desk, north\",1,2,3,0,0,1\n\" sill \"\"A\"\"\", 4,5,6,0,1,0\n",
+        "p.csv",
+    )
+    .unwrap();
+    assert_eq!(pts[0].name, "Desk, north");
+    assert_eq!(pts[0].position, dvec3(1.0, 2.0, 3.0));
+    // Quoted: kept as written, inner space and doubled quotes included.
+    assert_eq!(pts[1].name, " sill \"A\"");
+    assert_eq!(pts[1].position, dvec3(4.0, 5.0, 6.0));
+    let lux = Lux {
+        direct: 1.0,
+        indirect: 2.0,
+        total: 3.0,
+    };
+    let mut out = Vec::new();
+    write_lux_csv(&pts, &[lux, lux], &mut out).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert!(
+        text.contains("\n\"Desk, north\",1,2,3,0,0,1,1,2,3\n\" sill \"\"A\"\"\",4,5,6,"),
+        "{text}"
+    );
+    // And what it writes reads back as the same points.
+    let back: String = text
+        .lines()
+        .map(|l| l.rsplitn(4, ',').last().unwrap().to_string() + "\n")
+        .collect::<String>()
+        .replacen("name,x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux", "name,x,y,z,nx,ny,nz", 1);
+    let again = parse_points(&back, "lux.csv").unwrap();
+    assert_eq!(again[0].name, pts[0].name);
+    assert_eq!(again[1].name, pts[1].name);
+}
+
+#[test]
 fn the_grid_picture_colours_cells_by_value_with_a_legend() {
     // 3 x 2 cells, values rising along the row; the largest is red, 0 dark blue.
     let values = [0.0, 50.0, 100.0, 25.0, 75.0, 100.0];

@@ -142,7 +142,7 @@ pub fn write_surface_report(
 /// A surface name as a CSV field: quoted (inner quotes doubled) when it holds a comma, a
 /// quote, a line break, or starts with '#' or a space (where a reader that skips comment
 /// lines, or trims, would misread it); as it is otherwise. The other fields are numbers.
-fn csv_name(name: &str) -> String {
+pub(crate) fn csv_name(name: &str) -> String {
     let needs = name.starts_with(['#', ' ', '\t'])
         || name.ends_with([' ', '\t'])
         || name.contains([',', '"', '\r', '\n']);
