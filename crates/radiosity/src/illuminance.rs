@@ -617,7 +617,15 @@ pub fn write_lux_csv(
             out,
             "{},{},{},{},{},{},{},{},{},{}",
             crate::io::surface_report::csv_name(&p.name),
-            x.x, x.y, x.z, n.x, n.y, n.z, l.direct, l.indirect, l.total
+            x.x,
+            x.y,
+            x.z,
+            n.x,
+            n.y,
+            n.z,
+            l.direct,
+            l.indirect,
+            l.total
         )?;
     }
     Ok(())
@@ -1052,13 +1060,16 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
     let ticks = labels.len() - 1;
     // Every tick is drawn, but only every `stride`-th labelled where the bar is too short
     // for all the labels to stand apart (QA of issue #16: at the smallest picture, 160
-    // pixels tall, eight labels ran into each other). `stride` divides the ticks, so the
-    // top is labelled.
+    // pixels tall, eight labels ran into each other), and the top always; the stride-th
+    // label nearest the top is left out where it would touch the top's. (A stride that
+    // had to divide the ticks labelled only the ends of a bar of 7 ticks: QA pass 12.)
     let spacing = (by1 - by0 - 1) as f64 / ticks.max(1) as f64;
     let need = (5 * LEGEND_FONT + 3) as f64;
     let stride = (1..=ticks.max(1))
-        .find(|&s| ticks % s == 0 && spacing * s as f64 >= need)
+        .find(|&s| spacing * s as f64 >= need)
         .unwrap_or(ticks.max(1));
+    let labelled =
+        |k: usize| k == ticks || (k % stride == 0 && (ticks - k) as f64 * spacing >= need);
     for (k, label) in labels.iter().enumerate() {
         let t = k as f64 / ticks as f64;
         let y = by1 - 1 - ((by1 - by0 - 1) as f64 * t).round() as i64;
@@ -1070,7 +1081,7 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
                 }
             }
         }
-        if k % stride == 0 {
+        if labelled(k) {
             let half = 5 * LEGEND_FONT / 2;
             draw_text(img, bx + 27, (y - half).max(0), LEGEND_FONT, label, [0; 3]);
         }

@@ -224,7 +224,11 @@ fn a_quoted_name_may_hold_commas_and_comes_back_quoted() {
         .lines()
         .map(|l| l.rsplitn(4, ',').last().unwrap().to_string() + "\n")
         .collect::<String>()
-        .replacen("name,x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux", "name,x,y,z,nx,ny,nz", 1);
+        .replacen(
+            "name,x,y,z,nx,ny,nz,direct_lux,indirect_lux,total_lux",
+            "name,x,y,z,nx,ny,nz",
+            1,
+        );
     let again = parse_points(&back, "lux.csv").unwrap();
     assert_eq!(again[0].name, pts[0].name);
     assert_eq!(again[1].name, pts[1].name);
@@ -568,4 +572,25 @@ fn a_grid_picture_says_the_coordinates_it_holds_fixed() {
         )) > 60
     );
     assert_eq!(ink(&grid_picture(&values, [1, 1])), 0);
+}
+
+/// QA pass 12 of #16: a short scale bar of 7 ticks (a prime) labelled only its ends, as the
+/// stride had to divide the ticks.
+#[test]
+fn a_short_scale_bar_of_seven_ticks_labels_more_than_its_ends() {
+    // The bar from row 24 to 110: 85 px for 7 ticks, 12.1 px apart, under the 18 px a
+    // label needs, so every second is labelled (0, 2, 4) and the top (7); 6 would touch
+    // the top's label and is left out.
+    let mut img = image::RgbImage::from_pixel(200, 120, image::Rgb([255; 3]));
+    draw_scale_bar(&mut img, 0, 0, 110, 7.0, 7);
+    // Runs of rows with ink right of the ticks (the labels start 27 px right of the bar).
+    let inked: Vec<bool> = (24..120)
+        .map(|y| (27..200).any(|x| img.get_pixel(x, y).0 == [0; 3]))
+        .collect();
+    let runs = inked
+        .iter()
+        .zip(std::iter::once(&false).chain(&inked))
+        .filter(|(&now, &before)| now && !before)
+        .count();
+    assert_eq!(runs, 4, "{inked:?}");
 }
