@@ -337,6 +337,11 @@ pub enum DirectLightArg {
 impl RayArgs {
     /// `--adaptive-contrast`'s default.
     pub const ADAPTIVE_CONTRAST: f64 = 0.02;
+
+    /// `--direct-light`, or its default (gather).
+    pub fn direct_light(&self) -> DirectLightArg {
+        self.direct_light.unwrap_or(DirectLightArg::Gather)
+    }
 }
 
 /// Exposure and gamma: the flags `render` and `pathtrace` share.
@@ -412,9 +417,11 @@ pub struct RayArgs {
     /// casts all N x N everywhere.
     #[arg(long, default_value_t = RayArgs::ADAPTIVE_CONTRAST, value_name = "FRACTION", value_parser = parse_fraction)]
     pub adaptive_contrast: f64,
-    /// Smooth shading's direct light: gathered per ray, or from the mesh.
-    #[arg(long, value_enum, default_value_t = DirectLightArg::Gather)]
-    pub direct_light: DirectLightArg,
+    /// Smooth shading's direct light: gathered per ray, or from the mesh [default: gather].
+    // No clap default, so that a `--direct-light gather` that the shading ignores can be
+    // warned of (QA pass 12 of #16); `RayArgs::direct_light` gives the default.
+    #[arg(long, value_enum, value_name = "DIRECT_LIGHT")]
+    pub direct_light: Option<DirectLightArg>,
 }
 
 #[derive(Args)]

@@ -1024,8 +1024,9 @@ pub fn ray_settings(rays: &RayArgs, shading_arg: ShadingArg) -> RenderSettings {
             );
         }
     }
-    if rays.direct_light != DirectLightArg::Gather && shading_arg != ShadingArg::Smooth {
-        // QA of issue #16: --direct-light mesh with --shading flat ran without a word.
+    if rays.direct_light.is_some() && shading_arg != ShadingArg::Smooth {
+        // QA of issue #16: --direct-light mesh with --shading flat ran without a word (and
+        // `gather`, the default given explicitly, until QA pass 12).
         errln!(
             "warning: --direct-light ignored: it chooses smooth shading's direct light, and \
              --shading {}",
@@ -1040,7 +1041,7 @@ pub fn ray_settings(rays: &RayArgs, shading_arg: ShadingArg) -> RenderSettings {
         shading: shading(shading_arg),
         supersample: rays.supersample,
         adaptive_contrast: (rays.adaptive_contrast > 0.0).then_some(rays.adaptive_contrast),
-        direct_light: rays.direct_light == DirectLightArg::Gather,
+        direct_light: rays.direct_light() == DirectLightArg::Gather,
         ..RenderSettings::default()
     }
 }

@@ -168,10 +168,7 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                 "--adaptive-contrast",
                 args.rays.adaptive_contrast != crate::args::RayArgs::ADAPTIVE_CONTRAST,
             ),
-            (
-                "--direct-light",
-                args.rays.direct_light != crate::args::DirectLightArg::Gather,
-            ),
+            ("--direct-light", args.rays.direct_light.is_some()),
         ];
         let ignored: Vec<&str> = crate::setup::flags_given(&given);
         if !ignored.is_empty() {

@@ -133,7 +133,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             errln!("warning: --gamma ignored with --false-colour: its colours are lux");
         }
         // QA of issue #16: the picture was the same with either.
-        if args.rays.direct_light == crate::args::DirectLightArg::Mesh {
+        if args.rays.direct_light.is_some() {
             errln!(
                 "warning: --direct-light ignored with --false-colour: its colours are the \
                  elements' lux"

@@ -2916,6 +2916,31 @@ fn twelfth_pass_findings_are_said() {
         "{}",
         stderr(&out)
     );
+    // QA pass 12: the default given explicitly, where flat shading ignores it, was silent;
+    // left out, no warning.
+    for (given, warned) in [(&["--direct-light", "gather"][..], true), (&[][..], false)] {
+        let mut args = vec![
+            "render",
+            "--max-area",
+            "5000",
+            "--shading",
+            "flat",
+            "--width",
+            "16",
+            "-q",
+            "-o",
+            "flat.png",
+        ];
+        args.extend_from_slice(given);
+        let out = radiosity(&args, &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert_eq!(
+            stderr(&out).contains("warning: --direct-light ignored: it chooses smooth shading's"),
+            warned,
+            "{given:?}: {}",
+            stderr(&out)
+        );
+    }
     let args = [
         "check",
         "--max-area",
