@@ -342,17 +342,34 @@ impl PolygonBvh {
         &self.corners[poly.first as usize..(poly.first + poly.count) as usize]
     }
 
+    /// The unit direction, length and end trim (1e-7 of the scene's diagonal) of the segment
+    /// from `p` to `q`; `None` where it is no longer than the two trims.
+    #[inline]
+    fn trimmed(&self, p: DVec3, q: DVec3) -> Option<(DVec3, f64, f64)> {
+        let d = q - p;
+        let len = d.length();
+        let eps = 1e-7 * self.scale;
+        (len > 2.0 * eps).then(|| (d / len, len, eps))
+    }
+
+    /// The BVH ray (local f32 coordinates) along a segment of [`PolygonBvh::trimmed`], a
+    /// little longer than the segment so that f32 rounding cannot cut it short.
+    fn segment_ray(&self, p: DVec3, dir: DVec3, len: f64, eps: f64) -> Ray {
+        Ray::new(
+            self.local(p),
+            to_f32(dir),
+            0.0,
+            ((len * 1.001 + eps) * self.to_local) as f32,
+        )
+    }
+
     /// True when one of the polygons `candidates` (indices from [`PolygonBvh::overlapping`])
     /// crosses the open segment from `p` to `q`, trimmed as in [`PolygonBvh::segment_blocked`].
     #[inline]
     pub fn segment_blocked_by(&self, candidates: &[u32], p: DVec3, q: DVec3) -> bool {
-        let d = q - p;
-        let len = d.length();
-        let eps = 1e-7 * self.scale;
-        if len <= 2.0 * eps {
+        let Some((dir, len, eps)) = self.trimmed(p, q) else {
             return false;
-        }
-        let dir = d / len;
+        };
         candidates
             .iter()
             .any(|&k| self.intersect(k as usize, p, dir, eps, len - eps).is_some())
@@ -364,13 +381,9 @@ impl PolygonBvh {
     /// Greenberg 1986). The answer is the same; only the order of the tests changes.
     #[inline]
     pub fn segment_blocked_by_first(&self, candidates: &mut [u32], p: DVec3, q: DVec3) -> bool {
-        let d = q - p;
-        let len = d.length();
-        let eps = 1e-7 * self.scale;
-        if len <= 2.0 * eps {
+        let Some((dir, len, eps)) = self.trimmed(p, q) else {
             return false;
-        }
-        let dir = d / len;
+        };
         match candidates
             .iter()
             .position(|&k| self.intersect(k as usize, p, dir, eps, len - eps).is_some())
@@ -392,13 +405,9 @@ impl PolygonBvh {
         if self.polygons.is_empty() {
             return false;
         }
-        let d = q - p;
-        let len = d.length();
-        let eps = 1e-7 * self.scale;
-        if len <= 2.0 * eps {
+        let Some((dir, len, eps)) = self.trimmed(p, q) else {
             return false;
-        }
-        let dir = d / len;
+        };
         if let Some(k) = *last {
             if (k as usize) < self.polygons.len()
                 && self.intersect(k as usize, p, dir, eps, len - eps).is_some()
@@ -407,12 +416,7 @@ impl PolygonBvh {
             }
         }
         let to_local = self.to_local;
-        let ray = Ray::new(
-            self.local(p),
-            to_f32(dir),
-            0.0,
-            ((len * 1.001 + eps) * to_local) as f32,
-        );
+        let ray = self.segment_ray(p, dir, len, eps);
         let mut blocker = None;
         let missed = self.bvh.ray_traverse_miss(ray, |_, k| {
             match self.intersect(k, p, dir, eps, len - eps) {
@@ -445,20 +449,11 @@ impl PolygonBvh {
         if self.polygons.is_empty() {
             return false;
         }
-        let d = q - p;
-        let len = d.length();
-        let eps = 1e-7 * self.scale;
-        if len <= 2.0 * eps {
+        let Some((dir, len, eps)) = self.trimmed(p, q) else {
             return false;
-        }
-        let dir = d / len;
+        };
         let to_local = self.to_local;
-        let ray = Ray::new(
-            self.local(p),
-            to_f32(dir),
-            0.0,
-            ((len * 1.001 + eps) * to_local) as f32,
-        );
+        let ray = self.segment_ray(p, dir, len, eps);
         !self.bvh.ray_traverse_miss(ray, |_, k| {
             if self.polygons[k].id == ignored {
                 return f32::INFINITY;
