@@ -284,6 +284,7 @@ fn meshing_refuses_a_degenerate_surface_before_planning() {
     };
     match mesh_scene(&unit, 1e-300) {
         Err(e @ MeshError::TooManyElements { suggested, .. }) => {
+            let suggested = suggested.unwrap();
             // Area 1 over 8 million elements, and at most the 0.1 % more that a grid's
             // rounding up of rows and columns (2,828 of them) can take.
             assert!(

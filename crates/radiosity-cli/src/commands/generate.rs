@@ -60,6 +60,63 @@ fn flag_at_fault(e: &BuildingError, args: &BuildingArgs) -> String {
     }
 }
 
+/// Refuses a building of several storeys whose one storey, times the storeys, is more than
+/// 10 % past the meshing limit, before the whole is built (QA pass 14 of #16: `--floors
+/// 1000` took minutes and gigabytes to be refused, and was then told to "raise" its area
+/// to a smaller one). Nearer the limit the whole building is meshed and judged exactly;
+/// the margin covers the storeys' differences (their furniture, from the seed).
+fn refuse_far_past_the_limit(params: &scene::BuildingParams, args: &BuildingArgs) -> Result<()> {
+    if params.floors <= 1 {
+        return Ok(());
+    }
+    let one = scene::building(&scene::BuildingParams {
+        floors: 1,
+        ..params.clone()
+    });
+    let limit = radiosity::mesh::MAX_ELEMENTS;
+    let floors = params.floors as f64;
+    let fewest = radiosity::mesh::fewest_elements(&one.scene);
+    let per_storey = radiosity::mesh::planned_elements(&one.scene, args.max_area);
+    let most_floors = |per: f64| ((limit as f64 / per).floor() as u64).max(1);
+    if fewest * floors > 1.1 * limit as f64 {
+        bail!(
+            "--floors {}: about {} surfaces ({} a storey), each at least one element at any \
+             --max-area, past the limit of {limit} elements that the other commands mesh; \
+             at most about {} floors of {} x {} rooms fit at any --max-area",
+            params.floors,
+            (one.scene.surfaces.len() as f64 * floors).round(),
+            one.scene.surfaces.len(),
+            most_floors(fewest),
+            params.rooms_x,
+            params.rooms_z
+        );
+    }
+    if per_storey * floors > 1.1 * limit as f64 {
+        let area = radiosity::mesh::largest_area_that_fits(
+            &one.scene,
+            // 2 % below a storey's share: the storeys differ.
+            (0.98 * limit as f64 / floors).floor() as u64,
+        );
+        bail!(
+            "--max-area {}: about {} elements ({} a storey, {} floors), past the limit of \
+             {limit} that the other commands mesh; give at most {} floors{}",
+            crate::report::typed(args.max_area),
+            (per_storey * floors).round(),
+            per_storey,
+            params.floors,
+            most_floors(per_storey),
+            match area {
+                Some(a) => format!(
+                    ", or --max-area about {} or more",
+                    radiosity::mesh::four_digits_up(a)
+                ),
+                None => String::new(),
+            }
+        );
+    }
+    Ok(())
+}
+
 pub fn building(args: BuildingArgs) -> Result<()> {
     let params = scene::BuildingParams {
         floors: args.floors,
@@ -95,6 +152,7 @@ pub fn building(args: BuildingArgs) -> Result<()> {
     if let Err(e) = params.check() {
         bail!("{}", flag_at_fault(&e, &args));
     }
+    refuse_far_past_the_limit(&params, &args)?;
     let built = scene::building(&params);
     // A building no other command could mesh is refused before its file is written (QA of
     // issue #16: it was written, then refused by every command that read it).

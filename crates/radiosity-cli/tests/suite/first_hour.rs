@@ -1373,6 +1373,16 @@ fn generate_refusals_name_the_flag_at_fault() {
             vec!["--rooms-x", "1000", "--rooms-z", "1000"],
             "make 2000000 rooms, more than the limit of 100000",
         ),
+        // QA pass 14: refused from one storey at once (minutes and gigabytes before), and
+        // with no "raise MAX_PATCH_AREA" to a smaller area where none fits.
+        (
+            vec!["--floors", "1000"],
+            "each at least one element at any --max-area, past the limit of 8000000 elements",
+        ),
+        (
+            vec!["--floors", "600"],
+            "600 floors), past the limit of 8000000 that the other commands mesh; give at most",
+        ),
     ] {
         let mut args = vec!["generate", "building", "-o", "b.scene"];
         args.extend(&flags);

@@ -128,10 +128,17 @@ pub enum MeshError {
     /// The subdivision would make more elements than the limit.
     #[error(
         "meshing with MAX_PATCH_AREA = {} would make {} elements, more than the \
-         limit of {limit}; raise MAX_PATCH_AREA to at least {}",
+         limit of {limit}; {}",
         compact(*max_area),
         if *count == u64::MAX { "more than 1.8e19".to_string() } else { count.to_string() },
-        four_digits_up(*suggested)
+        match suggested {
+            Some(a) => format!("raise MAX_PATCH_AREA to at least {}", four_digits_up(*a)),
+            None => format!(
+                "no MAX_PATCH_AREA fits: the scene's {surfaces} surfaces make at least \
+                 {fewest} elements at any area (one a surface, more for polygons of more \
+                 than four corners); use fewer surfaces"
+            ),
+        }
     )]
     TooManyElements {
         /// The requested maximum element area.
@@ -140,14 +147,19 @@ pub enum MeshError {
         count: u64,
         /// The largest element count allowed.
         limit: u64,
-        /// A maximum area that would stay within the limit.
-        suggested: f64,
+        /// The largest maximum area that stays within the limit; `None` where none does
+        /// (the surfaces alone make more elements than the limit).
+        suggested: Option<f64>,
+        /// The scene's surfaces.
+        surfaces: usize,
+        /// The fewest elements the scene meshes into, at any area.
+        fewest: u64,
     },
 }
 
 /// `x` rounded up to four significant digits, plainly written where it is an everyday
 /// number: a value to type back (QA of issue #16: "at least 2.522e-1").
-fn four_digits_up(x: f64) -> String {
+pub fn four_digits_up(x: f64) -> String {
     if !(x.is_finite() && x > 0.0) {
         return compact(x);
     }
@@ -177,49 +189,59 @@ fn planned_count(plan: &Result<Plan, f64>) -> f64 {
     plan.map_or_else(|n| n, |p| p.element_count() as f64)
 }
 
-/// The largest MAX_PATCH_AREA at which `scene` meshes to at most [`MAX_ELEMENTS`]: a
+/// The elements [`mesh_scene`] makes of `scene` at MAX_PATCH_AREA `a` (before contact
+/// refinement), counted in f64 from the plans without meshing: a refused request may be
+/// astronomically large.
+pub fn planned_elements(scene: &Scene, a: f64) -> f64 {
+    scene
+        .surfaces
+        .iter()
+        .map(|s| planned_count(&plan(&s.vertices, a)))
+        .sum()
+}
+
+/// The fewest elements `scene` meshes into at any MAX_PATCH_AREA: at an area as large as
+/// the whole scene's, every surface is one element, or a fan of triangles.
+pub fn fewest_elements(scene: &Scene) -> f64 {
+    planned_elements(scene, scene.total_area().max(f64::MIN_POSITIVE) * 2.0)
+}
+
+/// The largest MAX_PATCH_AREA at which `scene` meshes to at most `limit` elements
+/// ([`MAX_ELEMENTS`] but in tests): a
 /// property of the scene, found by bisection on the planned counts, so that the refusal
 /// suggests the same value whatever too-small area was asked (QA of issue #16: 1.498e-5
-/// against 1.500e-5 from the old proportional estimate). Where even one element per
-/// surface is too many, the total area over the limit.
-fn largest_area_that_fits(scene: &Scene) -> f64 {
-    let count_at = |a: f64| -> f64 {
-        scene
-            .surfaces
-            .iter()
-            .map(|s| planned_count(&plan(&s.vertices, a)))
-            .sum()
-    };
-    let fallback = scene.total_area() / MAX_ELEMENTS as f64;
-    let limit = MAX_ELEMENTS as f64;
+/// against 1.500e-5 from the old proportional estimate). `None` where even the fewest
+/// elements are too many (QA pass 14 of #16: a building of 11.6 million surfaces was told
+/// to "raise" its area to one smaller than it had, after minutes of doubling).
+pub fn largest_area_that_fits(scene: &Scene, limit: u64) -> Option<f64> {
+    let limit = limit as f64;
+    if fewest_elements(scene) > limit {
+        return None;
+    }
+    let fallback = scene.total_area() / limit;
     if !(fallback > 0.0 && fallback.is_finite()) {
-        return fallback;
+        return None;
     }
     // `fits` meshes within the limit, `over` does not; start from the area that the
     // limit's elements would have without rounding (every grid rounds up, so it is over).
+    // Doubling ends by the scene's total area at the latest, where the fewest are made.
     let (mut over, mut fits) = (fallback, fallback);
-    for _ in 0..200 {
-        if count_at(fits) <= limit {
-            break;
-        }
+    while planned_elements(scene, fits) > limit {
         fits *= 2.0;
     }
-    if count_at(fits) > limit {
-        return fallback; // more surfaces than the limit: no area fits
-    }
-    if count_at(over) <= limit {
-        return over;
+    if planned_elements(scene, over) <= limit {
+        return Some(over);
     }
     // Geometric bisection to a relative width of 1e-9.
     while fits / over > 1.0 + 1e-9 {
         let mid = (over * fits).sqrt();
-        if count_at(mid) <= limit {
+        if planned_elements(scene, mid) <= limit {
             fits = mid;
         } else {
             over = mid;
         }
     }
-    fits
+    Some(fits)
 }
 
 /// The most elements [`mesh_scene`] will make: about 1.2 GB of mesh (112 bytes per element
@@ -402,7 +424,9 @@ pub fn mesh_scene(scene: &Scene, max_area: f64) -> Result<Mesh, MeshError> {
             max_area,
             count,
             limit: MAX_ELEMENTS,
-            suggested: largest_area_that_fits(scene),
+            suggested: largest_area_that_fits(scene, MAX_ELEMENTS),
+            surfaces: scene.surfaces.len(),
+            fewest: fewest_elements(scene).min(u64::MAX as f64) as u64,
         });
     }
 
@@ -942,6 +966,36 @@ mod tests {
         assert_eq!(
             mesh_scene(&scene, 0.0).unwrap_err(),
             MeshError::BadMaxArea(0.0)
+        );
+    }
+
+    /// QA pass 14 of #16: a scene whose surfaces alone are more elements than the limit
+    /// was told to "raise" its area to one smaller than it had; no area fits such a scene.
+    #[test]
+    fn no_area_is_suggested_where_the_surfaces_alone_are_too_many() {
+        // Twelve unit squares: twelve elements at the fewest, 48 at area 0.25.
+        let scene = scene_of((0..12).map(|_| rect(1.0, 1.0)).collect());
+        assert_eq!(fewest_elements(&scene), 12.0);
+        assert_eq!(largest_area_that_fits(&scene, 11), None);
+        // Within 48 elements: every square cut 2 x 2 (area 0.25) and no finer; the
+        // bisection stops within 1e-9 of the boundary.
+        let a = largest_area_that_fits(&scene, 48).unwrap();
+        assert!((0.25..0.25 * (1.0 + 2e-9)).contains(&a), "{a}");
+        let e = MeshError::TooManyElements {
+            max_area: 1.0,
+            count: 16_638_582,
+            limit: MAX_ELEMENTS,
+            suggested: None,
+            surfaces: 11_616_000,
+            fewest: 11_616_000,
+        };
+        assert!(
+            e.to_string().ends_with(
+                "limit of 8000000; no MAX_PATCH_AREA fits: the scene's 11616000 surfaces \
+                 make at least 11616000 elements at any area (one a surface, more for \
+                 polygons of more than four corners); use fewer surfaces"
+            ),
+            "{e}"
         );
     }
 }
