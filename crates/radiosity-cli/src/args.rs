@@ -650,14 +650,14 @@ pub struct BenchArgs {
     /// MAX_PATCH_AREA values to time, one table row each (several values: separated by
     /// commas, as separate arguments, or the option repeated); the scene's own when
     /// omitted.
-    #[arg(long, value_name = "AREA", num_args = 1.., value_delimiter = ',')]
+    #[arg(long, value_name = "AREA", num_args = 1.., value_delimiter = ',', value_parser = parse_positive)]
     pub max_area: Vec<f64>,
     /// Override the scene's INTEGRAL_STEPS.
     #[arg(long, value_name = "K", value_parser = parse_steps)]
     pub steps: Option<u32>,
     /// Runs per configuration; the table shows the median of each column.
-    #[arg(long, default_value_t = 5, value_name = "N")]
-    pub repeat: usize,
+    #[arg(long, default_value_t = 5, value_name = "N", value_parser = parse_at_least_1)]
+    pub repeat: u32,
     /// Solver for (I - rho F) B = E.
     #[arg(long, value_enum, default_value_t = SolverArg(SolverKind::Auto))]
     pub solver: SolverArg,
@@ -665,14 +665,16 @@ pub struct BenchArgs {
     /// 0.01 unshot for progressive, 1e-6 changing power for hierarchical).
     #[arg(long, value_name = "TOL")]
     pub tolerance: Option<f64>,
-    /// Image width and height in pixels (default 512; --width or --height then sets one
-    /// side).
+    /// Image width and height in pixels (default 512); --width or --height given beside it
+    /// sets that side alone.
     #[arg(long, value_name = "PIXELS", value_parser = parse_at_least_1)]
     pub size: Option<u32>,
-    /// Image width in pixels, as for `render`: alone it sets both sides (default: --size).
+    /// Image width in pixels; without --size or --height it sets both sides, as for
+    /// `render`.
     #[arg(long, value_parser = parse_at_least_1)]
     pub width: Option<u32>,
-    /// Image height in pixels, as for `render`: alone it sets both sides (default: --size).
+    /// Image height in pixels; without --size or --width it sets both sides, as for
+    /// `render`.
     #[arg(long, value_parser = parse_at_least_1)]
     pub height: Option<u32>,
     /// The rays a pixel and the direct light, as for `render` and with its defaults, so that

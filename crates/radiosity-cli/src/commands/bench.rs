@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use radiosity::pipeline::SolutionReport;
 use radiosity::progress::Stage;
 use radiosity::render::{Camera, RenderSettings};
@@ -16,15 +16,6 @@ use crate::report::{self, BenchRow};
 use crate::setup::prepare_solve;
 
 pub fn run(args: BenchArgs) -> Result<()> {
-    if args.repeat == 0 {
-        bail!("--repeat 0: give the runs per configuration, at least 1");
-    }
-    if let Some(&a) = args.max_area.iter().find(|a| !(**a > 0.0 && a.is_finite())) {
-        let a = crate::report::typed(a);
-        bail!(
-            "--max-area {a}: give the largest element area (scene units squared), a number above 0"
-        );
-    }
     let areas: Vec<Option<f64>> = if args.max_area.is_empty() {
         vec![None]
     } else {
@@ -73,7 +64,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     // Flags the method does not use, said once here, not once per run.
     crate::setup::warn_ignored_method_flags(&args.method, args.steps.is_some());
     report::bench_header(
-        args.repeat,
+        args.repeat as usize,
         image_size(&args),
         &settings,
         args.solver.0,

@@ -3005,3 +3005,33 @@ fn twelfth_pass_findings_are_said() {
     assert!(text.contains("| links' own |"), "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn bench_refuses_its_counts_and_areas_as_every_flag_does() {
+    // QA pass 14 of #16: `--repeat 0` said "at least 1" and `--repeat -1` "at least 0";
+    // `--max-area ,,` showed the float parser's "cannot parse float from empty string".
+    let dir = scratch_dir("bench-flags");
+    for (flags, needle) in [
+        (
+            ["--repeat", "0"],
+            "--repeat 0: give a whole number of at least 1",
+        ),
+        (
+            ["--repeat", "-1"],
+            "--repeat -1: give a whole number of at least 1",
+        ),
+        (
+            ["--max-area", ",,"],
+            "--max-area \"\": give a number above 0",
+        ),
+        (["--max-area", "1,0"], "--max-area 0: give a number above 0"),
+    ] {
+        let mut args = vec!["bench"];
+        args.extend(flags);
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{flags:?}: {err}");
+        assert!(err.contains(needle), "{flags:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
