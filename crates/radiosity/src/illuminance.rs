@@ -785,12 +785,17 @@ impl GridSummary {
     /// The line printed above the grid: "MIN 12.3  MEAN 45.6  MAX 78.9 lx  U0 0.27" (the
     /// picture's font has capitals for these words only).
     pub fn line(&self) -> String {
+        // U0 = min / mean has no value on a dark grid (QA pass 14 of #16: "U0 0.00").
+        let u0 = if self.mean > 0.0 {
+            format!("{:.2}", self.uniformity())
+        } else {
+            "-".to_string()
+        };
         format!(
-            "MIN {}  MEAN {}  MAX {} lx  U0 {:.2}",
+            "MIN {}  MEAN {}  MAX {} lx  U0 {u0}",
             lux_label(self.min),
             lux_label(self.mean),
             lux_label(self.max),
-            self.uniformity()
         )
     }
 }
@@ -969,10 +974,14 @@ pub fn grid_picture_with_axes(
         let widest = cols.iter().map(|l| text_width(l, 2)).max().unwrap_or(0);
         let every_col = ((widest + 6 + cell - 1) / cell).max(1) as usize;
         let every_row = ((14 + cell - 1) / cell).max(1) as usize;
+        // The column axis's name goes right of the cells, or of the last label where that
+        // reaches further (QA pass 14 of #16: "5200x").
+        let mut name_x = margin + gw + 6;
         for (i, label) in cols.iter().enumerate().step_by(every_col) {
             let centre = margin + i as i64 * cell + cell / 2;
             let x = centre - text_width(label, 2) / 2;
             draw_text(&mut img, x, top + gh + 6, 2, label, [0; 3]);
+            name_x = name_x.max(x + text_width(label, 2) + 8);
         }
         for (j, label) in rows.iter().enumerate().step_by(every_row) {
             let centre = top + row_at(j) as i64 * cell + cell / 2;
@@ -983,7 +992,7 @@ pub fn grid_picture_with_axes(
         let name = |c: char| c.to_string();
         draw_text(
             &mut img,
-            margin + gw + 6,
+            name_x,
             top + gh + 6,
             2,
             &name(axes.names[0]),

@@ -276,8 +276,10 @@ fn the_grid_summary_gives_min_mean_max_and_the_uniformity() {
     assert_eq!((s.min, s.mean, s.max), (40.0, 70.0, 100.0));
     assert!((s.uniformity() - 4.0 / 7.0).abs() < 1e-15);
     assert_eq!(s.line(), "MIN 40.0  MEAN 70.0  MAX 100 lx  U0 0.57");
-    // A dark grid: U0 0, not a division by zero.
-    assert_eq!(GridSummary::of(&[0.0, 0.0]).unwrap().uniformity(), 0.0);
+    // A dark grid: U0 0, not a division by zero, and drawn as "-" (it has no value).
+    let dark = GridSummary::of(&[0.0, 0.0]).unwrap();
+    assert_eq!(dark.uniformity(), 0.0);
+    assert_eq!(dark.line(), "MIN 0  MEAN 0  MAX 0 lx  U0 -");
     assert_eq!(GridSummary::of(&[]), None);
     // Every character of a summary line has a glyph (none is skipped in the picture).
     for c in s.line().chars() {

@@ -314,15 +314,22 @@ fn grid_refusal(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> String {
              agree in at least one axis (the height of a work plane, say)"
         );
     }
+    // Exact below a trillion, else to three digits (QA pass 14 of #16: the float's
+    // "309136000001111989682176").
     let count = grid_count(a, b, spacing);
+    let count = if count < 1e12 {
+        format!("{count:.0}")
+    } else {
+        format!("about {count:.2e}")
+    };
     match smallest_spacing(a, b, spacing, MAX_GRID_POINTS) {
         Some(wider) => format!(
-            "{head} makes {count:.0} points, more than the {MAX_GRID_POINTS} one run \
+            "{head} makes {count} points, more than the {MAX_GRID_POINTS} one run \
              computes, --no-work-limit or not; a spacing of {wider} or more fits (or split \
              the grid into several runs)"
         ),
         None => format!(
-            "{head} makes {count:.0} points, more than one run computes, --no-work-limit or not"
+            "{head} makes {count} points, more than one run computes, --no-work-limit or not"
         ),
     }
 }

@@ -367,6 +367,23 @@ fn illuminance_refuses_a_grid_too_large_and_work_of_hours_saying_what_fits() {
         err.contains("makes 16008001 points") && err.contains("a spacing of 0.00401 or more"),
         "{err}"
     );
+    // QA pass 14 of #16: past a trillion, the count is given to three digits, not with
+    // the float's noise: (4 / 1e-9 + 1)^2 = 1.6e19.
+    let out = radiosity(
+        &[
+            "illuminance",
+            &room(),
+            "--grid",
+            "0,0,0.8:4,4,0.8:1e-9",
+            "--normal",
+            "0,0,1",
+            "-o",
+            "g.csv",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(err.contains("makes about 1.60e19 points"), "{err}");
     // 0.005 m: 801^2 = 641,601 points. On the room's 320 elements (80 m^2 at 0.25) that
     // is 2.1e8 point-element pairs, within the 1e9 work limit; on a mesh of 0.0025 m^2
     // elements (32,000) it is 2.1e10: refused before the solve, with what fits: 31,250
