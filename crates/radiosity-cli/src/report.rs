@@ -629,8 +629,9 @@ fn lights(prepared: &Prepared) {
             )
         };
         let p = l.position;
+        let (length_unit, _) = length_and_area_units();
         outln!(
-            "{}{} {:.1} lm{tinted} at ({}, {}, {}); {:.1} % lands on the fronts of surfaces",
+            "{}{} {:.1} lm{tinted} at ({}, {}, {}) {length_unit}; {:.1} % lands on the fronts of surfaces",
             if i == 0 {
                 "point lights      "
             } else {
@@ -1225,7 +1226,8 @@ pub fn method_accuracy(max_area: f64, quiet: bool) {
         })
         .collect();
     outln!(
-        "Elements of at most {max_area} (unit squares in {} elements); relative errors.",
+        "Elements of at most {max_area} of a unit of area (a unit square in {} elements; the \
+         shapes are measured in units of their own size); relative errors.",
         (1.0 / max_area).round()
     );
     outln!();
@@ -1235,14 +1237,14 @@ pub fn method_accuracy(max_area: f64, quiet: bool) {
     outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in rows {
         outln!(
-            "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {} | {:.1} | {:.2e} |",
+            "| {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {} | {} | {:.1} | {:.2e} |",
             r.method,
             r.opposed,
             r.perpendicular,
             r.discs,
             r.differential,
             r.mean_error(),
-            r.closed_box,
+            exponent(r.closed_box, 2),
             exponent(r.reciprocity, 2),
             r.seconds * 1e3,
             r.mean_error() * r.seconds

@@ -716,7 +716,7 @@ fn check_lists_the_point_lights_and_warns_of_one_whose_light_is_lost() {
     let (text, err) = (crate::fixtures::stdout(&out), stderr(&out));
     assert!(out.status.success(), "{err}");
     assert!(
-        text.contains("point lights      Down1 3000.0 lm at (100, 100, 100); 0.0 % lands"),
+        text.contains("point lights      Down1 3000.0 lm at (100, 100, 100) m; 0.0 % lands"),
         "{text}"
     );
     assert!(
