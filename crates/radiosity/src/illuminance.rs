@@ -803,12 +803,28 @@ impl GridSummary {
 /// The labels of a scale from 0 to `max` in `ticks` equal steps, all with the decimals the
 /// step needs and no more (0, 20, ..., 160; 0, 0.25, ..., 1.25; 0, 0.5, ..., 2.5 as
 /// 0.0, 0.5, ..., 2.5), so that a column of them reads at a glance.
+///
+/// Where such labels would pass 6 characters (the scale bar's room) or the step is below
+/// the 4 decimals they carry, every label but 0 is written with an exponent to two
+/// digits, "2.5E4" (one digit where that is still too long: "2E-31"; QA pass 14 of #16:
+/// `--lux-max 123456` ran off the picture and `--lux-max 1e-6` read 0 at every tick).
 pub fn tick_labels(max: f64, ticks: usize) -> Vec<String> {
     let ticks = ticks.max(1);
     let step = max / ticks as f64;
     let decimals = decimals_of(step);
-    (0..=ticks)
+    let plain: Vec<String> = (0..=ticks)
         .map(|k| format!("{:.*}", decimals, step * k as f64))
+        .collect();
+    if step >= 1e-4 && plain.iter().all(|l| l.len() <= 6) {
+        return plain;
+    }
+    // A capital E: the pictures' small 'e' reads as a 2.
+    (0..=ticks)
+        .map(|k| match format!("{:.1E}", step * k as f64) {
+            _ if k == 0 => "0".to_string(),
+            two if two.len() <= 6 => two,
+            _ => format!("{:.0E}", step * k as f64),
+        })
         .collect()
 }
 

@@ -309,8 +309,24 @@ fn tick_labels_have_the_decimals_of_their_step() {
         ["0.0", "0.5", "1.0", "1.5", "2.0", "2.5"]
     );
     assert_eq!(tick_labels(12_500.0, 5)[5], "12500");
+    // Past the bar's room, or finer than 4 decimals: exponents (QA pass 14 of #16).
+    assert_eq!(
+        tick_labels(123_456.0, 5),
+        ["0", "2.5E4", "4.9E4", "7.4E4", "9.9E4", "1.2E5"]
+    );
+    assert_eq!(tick_labels(1e-6, 5)[1..3], ["2.0E-7", "4.0E-7"]);
+    assert_eq!(tick_labels(1e30, 5)[5], "1.0E30");
+    assert_eq!(tick_labels(1e-30, 5)[1], "2E-31");
     // Each label fits the scale bar beside a view at the legend's font.
-    for (max, ticks) in [(12_500.0, 5), (0.4, 8), (1.25, 5)] {
+    for (max, ticks) in [
+        (12_500.0, 5),
+        (0.4, 8),
+        (1.25, 5),
+        (123_456.0, 5),
+        (1e30, 7),
+        (1e-30, 8),
+        (1e-6, 7),
+    ] {
         for label in tick_labels(max, ticks) {
             assert!(
                 27 + text_width(&label, LEGEND_FONT) <= SCALE_BAR_WIDTH as i64 - 8,
