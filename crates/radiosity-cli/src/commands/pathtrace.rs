@@ -45,6 +45,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         let (width, height) = args.camera.size();
         radiosity::budget::check_path_trace_work(width, height, args.paths)?;
     }
+    // Said once the reference has been read (QA pass 14 of #16: it came before "not a
+    // readable OpenEXR file").
+    let mut ignored_with_reference = None;
     if let Some(path) = &args.reference {
         // Before any work, in the flag's name (QA of issue #16: a missing file was named
         // only after the scene was read, without the flag).
@@ -81,12 +84,12 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
         ];
         let ignored: Vec<&str> = crate::setup::flags_given(&given);
         if !ignored.is_empty() {
-            errln!(
+            ignored_with_reference = Some(format!(
                 "warning: {} ignored with --reference: the path-traced view is read from {} \
                  as it was traced (its paths a pixel and seed are noted when it is read)",
                 ignored.join(", "),
                 path.display()
-            );
+            ));
         }
     }
     if args.compare {
@@ -261,6 +264,9 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             let saved = run_file_stage(&reporter, Stage::Parse, path, || {
                 read_path_traced(path, &camera, scene)
             })?;
+            if let Some(warning) = &ignored_with_reference {
+                errln!("{warning}");
+            }
             reporter.note(&format!(
                 "reference read from {} ({} paths a pixel, seed {})",
                 path.display(),
