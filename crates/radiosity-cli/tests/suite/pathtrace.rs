@@ -286,6 +286,48 @@ fn a_render_exr_as_reference_is_named_for_what_it_is_and_tracing_flags_are_warne
             && !err.contains("another camera"),
         "{err}"
     );
+    // The ignored flags are said once a reference has been read, not before the error
+    // that it cannot be (QA pass 14 of #16).
+    assert!(!err.contains("ignored with --reference"), "{err}");
+    let saved = radiosity(
+        &[
+            "pathtrace",
+            "--width",
+            "6",
+            "--height",
+            "5",
+            "--paths",
+            "2",
+            "--save-reference",
+            "ref.exr",
+            "-o",
+            "p.png",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(saved.status.success(), "{}", stderr(&saved));
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "--reference",
+            "ref.exr",
+            "--width",
+            "6",
+            "--height",
+            "5",
+            "--paths",
+            "64",
+            "--path-seed",
+            "3",
+            "-o",
+            "p2.png",
+            "-q",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
     assert!(
         err.contains("warning: --paths, --path-seed ignored with --reference"),
         "{err}"
