@@ -257,6 +257,13 @@ fn light_block_errors_name_the_line_and_what_was_expected() {
         e[0].2.contains("COLOUR 0 0 0 makes the light emit nothing"),
         "{e:?}"
     );
+    // QA pass 14 of #16: an IES file that cannot be read hid the errors after it.
+    let e = lines(
+        "LIGHTBEGIN\n#L\nPOSITION 0 0 1\nDISTRIBUTION IES no/such.ies\nCOLOUR 0 0 0\nLIGHTEND",
+    );
+    assert_eq!(e.len(), 2, "{e:?}");
+    assert!(e[0].2.contains("IES file \"no/such.ies\""), "{e:?}");
+    assert_eq!(e[1].0, 22, "{e:?}");
 }
 
 #[test]

@@ -1116,6 +1116,7 @@ impl<'a> Parser<'a> {
         let mut output = None;
         let mut distribution = None;
         let mut colour = None;
+        let mut bad_distribution = false;
         let mut seen: Vec<(Keyword, usize)> = Vec::new();
         let errors_before = self.errors.len();
         loop {
@@ -1189,7 +1190,12 @@ impl<'a> Parser<'a> {
                 }
                 Keyword::Distribution => {
                     self.pos += 1;
-                    distribution = Some(self.distribution_line(&line)?);
+                    // Reported, and the rest of the block still read (QA pass 14 of #16:
+                    // a missing IES file hid the COLOUR and AIM errors after it).
+                    match self.distribution_line(&line) {
+                        Ok(d) => distribution = Some(d),
+                        Err(Reported) => bad_distribution = true,
+                    }
                 }
                 Keyword::Colour => {
                     let (read, l) = self.triple_read(Keyword::Colour, "band")?;
@@ -1235,6 +1241,9 @@ impl<'a> Parser<'a> {
             ));
         };
         let Some(distribution) = distribution else {
+            if bad_distribution {
+                return Err(Reported);
+            }
             return Err(self.error(
                 line,
                 column,
