@@ -196,6 +196,27 @@ fn location(file: &str, line: usize) -> String {
 }
 
 /// Why a file could not be read as a scene. Every variant displays as
+/// The most errors of one imported file named one by one.
+pub const MAX_IMPORT_ERRORS: usize = 20;
+
+impl ImportError {
+    /// `errors` as one error: the only one, or [`ImportError::Several`] with the first
+    /// [`MAX_IMPORT_ERRORS`]; `None` where there are none.
+    pub fn from_several(mut errors: Vec<ImportError>) -> Option<ImportError> {
+        match errors.len() {
+            0 => None,
+            1 => errors.pop(),
+            n => {
+                errors.truncate(MAX_IMPORT_ERRORS);
+                Some(ImportError::Several {
+                    errors,
+                    more: n.saturating_sub(MAX_IMPORT_ERRORS),
+                })
+            }
+        }
+    }
+}
+
 /// `FILE[:LINE]: error: ...` naming what in the file is wrong, like the scene reader's
 /// [`SceneError`] (which a `.scene` file gives, as [`ImportError::Scene`]).
 #[derive(Clone, Debug, PartialEq, Error)]
@@ -203,6 +224,16 @@ pub enum ImportError {
     /// A `.scene` file's errors.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// Several errors of one file (and the files it reads), each on its own line, then
+    /// their count; at most [`MAX_IMPORT_ERRORS`] are kept.
+    #[error("{}\n{} errors{}", errors.iter().map(ToString::to_string).collect::<Vec<_>>().join("\n"),
+        errors.len() + more, if *more > 0 { format!(" (the first {} shown)", errors.len()) } else { String::new() })]
+    Several {
+        /// The errors, in the order found.
+        errors: Vec<ImportError>,
+        /// How many more there were.
+        more: usize,
+    },
     /// The file cannot be read.
     #[error("{file}: error: cannot read {what}: {message}")]
     Io {

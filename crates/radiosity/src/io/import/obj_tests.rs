@@ -366,3 +366,27 @@ fn texture_maps_are_said_to_be_left_out() {
         .iter()
         .all(|w| !w.to_string().contains("texture")));
 }
+
+/// QA pass 14 of #16: four errors in an OBJ and its MTL took four runs, one each.
+#[test]
+fn every_error_of_an_obj_and_its_mtl_comes_in_one_run() {
+    let mtl = "newmtl white\nKd 1 1 1\nnewmtl half\nKd 0.5 0.5\n";
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl white\nv nan 0 0\n\
+               v 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 6 7 3\nf 1 2 9\nusemtl white\n";
+    let e = read_text(obj, &[("m.mtl", mtl)]).unwrap_err();
+    let ImportError::Several { errors, more } = &e else {
+        panic!("{e}");
+    };
+    assert_eq!(*more, 0);
+    let text = e.to_string();
+    let lines: Vec<&str> = text.lines().collect();
+    // The MTL's syntax error as it is read (line 1 of the OBJ), the reflectance of 1 at the
+    // first `usemtl white` (not again at the second), the NaN, and the index 9 past the
+    // 7 vertices (the NaN's stand-in keeps the count, so `f 2 6 7 3` is fine).
+    assert_eq!(errors.len(), 4, "{text}");
+    assert!(lines[0].starts_with("m.mtl:4: error:"), "{text}");
+    assert!(lines[1].starts_with("m.mtl:2: error:"), "{text}");
+    assert!(lines[2].starts_with("m.obj:7: error:"), "{text}");
+    assert!(lines[3].starts_with("m.obj:12: error:"), "{text}");
+    assert_eq!(lines[4], "4 errors");
+}
