@@ -58,6 +58,11 @@ struct Polygon {
     hi: DVec3,
 }
 
+/// Where obvhs 0.4's CWBVH traversal starts a ray's box tests (its `EPSILON`,
+/// cwbvh/node.rs, crate-private), in the BVH's local units: boxes a ray leaves before it
+/// are skipped.
+const OBVHS_RAY_START_LOCAL: f64 = 1e-4;
+
 /// Planar convex polygons, each tagged with a caller's id (for example the surface or the
 /// element it is), in a BVH.
 pub struct PolygonBvh {
@@ -409,8 +414,15 @@ impl PolygonBvh {
             return false;
         };
         if let Some(k) = *last {
+            // Trusted only clear of the segment's start: obvhs's traversal skips boxes a
+            // ray leaves within its EPSILON (1e-4 local units) of the origin, so a hit as
+            // near is left to the traversal, whose answer this must be (review of #11: a
+            // hit between the trim and that distance blocked through the cache only).
+            let near = 10.0 * OBVHS_RAY_START_LOCAL / self.to_local;
             if (k as usize) < self.polygons.len()
-                && self.intersect(k as usize, p, dir, eps, len - eps).is_some()
+                && self
+                    .intersect(k as usize, p, dir, eps, len - eps)
+                    .is_some_and(|t| t > near)
             {
                 return true;
             }
@@ -829,6 +841,27 @@ mod tests {
             blocked_count > 50 && cached_hits > 20,
             "{blocked_count} {cached_hits}"
         );
+        // A cached blocker nearer the segment's start than the traversal looks (review of
+        // #11): the answer is still the traversal's, at every distance from the trim (1e-7
+        // of the diagonal) out.
+        let (sx, sy, sz) = squares[0];
+        let centre = dvec3(sx + 0.5, sy + 0.5, sz);
+        let mut found = Vec::new();
+        bvh.overlapping(
+            centre - DVec3::splat(1e-3),
+            centre + DVec3::splat(1e-3),
+            &mut found,
+        );
+        let index = *found.iter().find(|&&k| bvh.id_of(k) == 0).unwrap();
+        for gap in [2e-6, 5e-6, 1e-5, 3e-5, 1e-4, 1e-3] {
+            let (p, q) = (centre - DVec3::Z * gap, centre + DVec3::Z * 0.4);
+            let mut last = Some(index);
+            assert_eq!(
+                bvh.segment_blocked_cached(p, q, &mut last),
+                bvh.segment_blocked(p, q),
+                "gap {gap}"
+            );
+        }
     }
 
     #[test]
