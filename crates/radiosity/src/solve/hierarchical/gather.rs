@@ -1,6 +1,7 @@
 //! The final gather (Lischinski, Tampieri and Greenberg 1993; Smits, Arvo and Greenberg
-//! 1994): once the hierarchy has converged, every leaf's irradiance is gathered again at the
-//! leaf's own resolution instead of being pushed down from its ancestors.
+//! 1994): once the hierarchy has converged (to the rounds' tolerance), every leaf's
+//! irradiance is gathered again at the leaf's own resolution instead of being pushed down
+//! from its ancestors.
 //!
 //! A link held by an ancestor A of leaf L carries A's area-averaged form factor: pushed
 //! down, every leaf under A gets the same irradiance from that source, which is what made
@@ -36,7 +37,8 @@
 //! point of the leaf-level gather rather than one or two bounces from the hierarchy, whose
 //! own excess (a closed cube absorbed 3.2 % more than it emitted without the gather) two
 //! passes left at 1.3 % and the iteration at 0.33 %. Where the terms do not fit in the
-//! memory left, two passes are made, recomputing the terms. The energy account is taken
+//! memory left, the hierarchy is first solved to the tolerance and two passes are made,
+//! recomputing the terms. The energy account is taken
 //! from the gathered H.
 //!
 //! Where the leaves are more than [`super::HierarchicalSettings::gather_points`], the
@@ -440,12 +442,17 @@ impl Solver<'_> {
                 budget >> 20
             ));
         }
-        let mut sweeps = 0;
+        let (mut sweeps, mut solved) = (0, None);
         let passes = if cached {
             MAX_GATHER_PASSES
         } else {
-            let (made, _) = self.solve(solve_emitted, self.settings.tolerance)?;
-            sweeps = made;
+            let (made, r) = self.solve(solve_emitted, self.settings.tolerance)?;
+            (sweeps, solved) = (made, Some(r));
+            if !walk {
+                // The clusters' bins as that solve left them (review of #11: the first
+                // pass took them from before it).
+                from_clusters = self.irradiance_from_clusters();
+            }
             GATHER_PASSES
         };
         let (mut h, mut made, mut residual) = (Vec::new(), 0, 0.0);
@@ -499,7 +506,9 @@ impl Solver<'_> {
             h_of: leaves.iter().copied().zip(h).collect(),
             sweeps,
             passes: made,
-            residual,
+            // Where two passes were made from a solved hierarchy, what converged is that
+            // solve; their own change is not a convergence measure.
+            residual: solved.unwrap_or(residual),
         })
     }
 
@@ -747,7 +756,8 @@ pub(super) struct Gathered {
     pub sweeps: usize,
     /// Passes over the terms.
     pub passes: usize,
-    /// The power that changed in the last pass, a fraction of the emitted (largest band).
+    /// The power that changed in the last pass, a fraction of the emitted (largest band);
+    /// where the terms were not kept, in the last sweep of the solve made first.
     pub residual: f64,
 }
 

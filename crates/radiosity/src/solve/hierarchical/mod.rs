@@ -88,8 +88,9 @@
 //! # Final gather
 //!
 //! With [`HierarchicalSettings::final_gather`] (the default), once the hierarchy has
-//! converged (to the rounds' tolerance) every leaf's irradiance is gathered again at the leaf's own resolution (see
-//! the `gather` module): each link held by an ancestor is evaluated again with the leaf as
+//! converged (to the rounds' tolerance) every leaf's irradiance is gathered again at the
+//! leaf's own resolution (see the `gather` module): each link held by an ancestor is
+//! evaluated again with the leaf as
 //! the receiver, descending into large near sources, with visibility sampled again from
 //! the leaf where the link saw its source partly hidden; the terms are kept and iterated
 //! until the changing power is below the tolerance. Leaves that span several cells of the
