@@ -195,28 +195,23 @@ fn location(file: &str, line: usize) -> String {
     }
 }
 
-/// Why a file could not be read as a scene. Every variant displays as
-/// The most errors of one imported file named one by one.
+/// The most errors of one imported file kept to be named one by one; the rest are
+/// counted.
 pub const MAX_IMPORT_ERRORS: usize = 20;
 
 impl ImportError {
-    /// `errors` as one error: the only one, or [`ImportError::Several`] with the first
-    /// [`MAX_IMPORT_ERRORS`]; `None` where there are none.
-    pub fn from_several(mut errors: Vec<ImportError>) -> Option<ImportError> {
-        match errors.len() {
-            0 => None,
-            1 => errors.pop(),
-            n => {
-                errors.truncate(MAX_IMPORT_ERRORS);
-                Some(ImportError::Several {
-                    errors,
-                    more: n.saturating_sub(MAX_IMPORT_ERRORS),
-                })
-            }
+    /// `errors` (at most [`MAX_IMPORT_ERRORS`] kept) and `more` not kept, as one error: the
+    /// only one, or [`ImportError::Several`]; `None` where there are none.
+    pub fn from_several(mut errors: Vec<ImportError>, more: usize) -> Option<ImportError> {
+        match (errors.len(), more) {
+            (0, _) => None,
+            (1, 0) => errors.pop(),
+            _ => Some(ImportError::Several { errors, more }),
         }
     }
 }
 
+/// Why a file could not be read as a scene. Every variant displays as
 /// `FILE[:LINE]: error: ...` naming what in the file is wrong, like the scene reader's
 /// [`SceneError`] (which a `.scene` file gives, as [`ImportError::Scene`]).
 #[derive(Clone, Debug, PartialEq, Error)]

@@ -54,7 +54,7 @@ use glam::DVec3;
 use super::face_soup::{material_problem, MaterialField};
 use super::{
     default_settings, scaled_unit, FaceSoup, Format, ImportError, ImportOptions, ImportWarning,
-    Imported, SoupFace, SoupMaterial,
+    Imported, SoupFace, SoupMaterial, MAX_IMPORT_ERRORS,
 };
 use crate::io::scene_file::SceneFile;
 use crate::light::Rgb;
@@ -121,16 +121,17 @@ pub fn parse(
         max_patch_area: None,
         integral_steps: None,
         errors: Vec::new(),
+        more_errors: 0,
+        bad_materials: std::collections::HashSet::new(),
+        faces_read: 0,
     };
     for (i, raw) in text.lines().enumerate() {
         if let Err(e) = reader.line(i + 1, raw, load_mtl) {
-            // Each once: a bad material is named at every `usemtl` of it.
-            if !reader.errors.contains(&e) {
-                reader.errors.push(e);
-            }
+            reader.report(e);
         }
     }
-    if let Some(e) = ImportError::from_several(std::mem::take(&mut reader.errors)) {
+    let errors = std::mem::take(&mut reader.errors);
+    if let Some(e) = ImportError::from_several(errors, reader.more_errors) {
         return Err(e);
     }
     let Reader {
@@ -226,8 +227,14 @@ struct Reader {
     max_patch_area: Option<f64>,
     integral_steps: Option<u32>,
     /// The errors found so far, in the OBJ and its MTL files (each reported, and the
-    /// reading goes on: QA pass 14 of #16 found four, one a run).
+    /// reading goes on: QA pass 14 of #16 found four, one a run): the first
+    /// [`MAX_IMPORT_ERRORS`], and how many more.
     errors: Vec<ImportError>,
+    more_errors: usize,
+    /// Materials whose `usemtl` was an error: named once, not at every use.
+    bad_materials: std::collections::HashSet<String>,
+    /// Face lines read so far.
+    faces_read: usize,
 }
 
 /// Statements read silently for what they are: ignored by design (see the module
@@ -268,6 +275,15 @@ impl Reader {
                 comment.trim_end()
             ),
         });
+    }
+
+    /// Keeps `e` among the first [`MAX_IMPORT_ERRORS`], or counts it.
+    fn report(&mut self, e: ImportError) {
+        if self.errors.len() < MAX_IMPORT_ERRORS {
+            self.errors.push(e);
+        } else {
+            self.more_errors += 1;
+        }
     }
 
     fn syntax(&self, line: usize, message: String) -> ImportError {
@@ -318,8 +334,19 @@ impl Reader {
             }
             "usemtl" => {
                 let name = rest().to_string();
-                self.material = Some(self.use_material(&name, n)?);
-                Ok(())
+                if self.bad_materials.contains(&name) {
+                    return Ok(());
+                }
+                match self.use_material(&name, n) {
+                    Ok(m) => {
+                        self.material = Some(m);
+                        Ok(())
+                    }
+                    Err(e) => {
+                        self.bad_materials.insert(name);
+                        Err(e)
+                    }
+                }
             }
             "mtllib" => {
                 for name in words {
@@ -432,7 +459,10 @@ impl Reader {
             }
         };
         let first = self.soup.indices.len();
-        let face_number = self.soup.faces.len() + 1;
+        // Counted over every face line, refused ones too, so that the numbers after a bad
+        // face still name the faces of the file (review of QA pass 14).
+        self.faces_read += 1;
+        let face_number = self.faces_read;
         let count = self.soup.vertices.len();
         for word in words {
             let v = word.split('/').next().unwrap_or("");
@@ -588,13 +618,12 @@ impl Reader {
                 }
                 "Kd" | "Ke" => {
                     let Some(entry) = current.as_ref().and_then(|c| self.library.get_mut(c)) else {
-                        self.errors
-                            .push(syntax(format!("{key} before any \"newmtl\" line")));
+                        self.report(syntax(format!("{key} before any \"newmtl\" line")));
                         continue;
                     };
                     let values: Vec<&str> = words.collect();
                     let Some(colour) = colour(&values) else {
-                        self.errors.push(syntax(format!(
+                        self.report(syntax(format!(
                             "expected \"{key} r g b\" (or \"{key} v\" for a grey) with finite \
                              numbers, found \"{}\"",
                             code.trim()

@@ -388,5 +388,38 @@ fn every_error_of_an_obj_and_its_mtl_comes_in_one_run() {
     assert!(lines[1].starts_with("m.mtl:2: error:"), "{text}");
     assert!(lines[2].starts_with("m.obj:7: error:"), "{text}");
     assert!(lines[3].starts_with("m.obj:12: error:"), "{text}");
+    assert!(lines[3].contains("face 3 of object"), "{text}");
     assert_eq!(lines[4], "4 errors");
+    // A refused face still counts, so the next one is named by its place in the file.
+    let e = read_text(
+        &format!(
+            "{SQUARE}f 1 2 9
+f 1 2 x
+"
+        ),
+        &[],
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("face 2 of object"), "{e}");
+    // Past 20 errors, the rest are counted (a file of bad lines is not held whole).
+    let bad: String = (0..25)
+        .map(|k| {
+            format!(
+                "v {k} 0 q
+"
+            )
+        })
+        .collect();
+    let e = read_text(&bad, &[]).unwrap_err();
+    let ImportError::Several { errors, more } = &e else {
+        panic!("{e}");
+    };
+    assert_eq!((errors.len(), *more), (20, 5));
+    assert!(
+        e.to_string().ends_with(
+            "
+25 errors (the first 20 shown)"
+        ),
+        "{e}"
+    );
 }
