@@ -539,6 +539,13 @@ fn point_of_line(
     // CSV fields, so that a quoted name may hold commas, as `solve` and this program's
     // other CSV files write them (QA pass 13 of #16); a quoted name is taken as written,
     // the other fields trimmed.
+    if line_text.matches('"').count() % 2 == 1 {
+        return Err(
+            "a quote is not closed: a name in quotes ends with a quote, and a quote \
+                    inside it is written twice (\"\")"
+                .into(),
+        );
+    }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
@@ -804,9 +811,9 @@ impl GridSummary {
 /// step needs and no more (0, 20, ..., 160; 0, 0.25, ..., 1.25; 0, 0.5, ..., 2.5 as
 /// 0.0, 0.5, ..., 2.5), so that a column of them reads at a glance.
 ///
-/// Where such labels would pass 6 characters (the scale bar's room) or the step is below
-/// the 4 decimals they carry, every label but 0 is written with an exponent to two
-/// digits, "2.5E4" (one digit where that is still too long: "2E-31"; QA pass 14 of #16:
+/// Where such labels would pass 6 characters (the scale bar's room) or 4 decimals do not
+/// write the step exactly, every label but 0 is written with an exponent to three digits
+/// where they fit, else fewer, "1.25E6", "2.5E-7", "2E-31" (QA pass 14 of #16:
 /// `--lux-max 123456` ran off the picture and `--lux-max 1e-6` read 0 at every tick).
 pub fn tick_labels(max: f64, ticks: usize) -> Vec<String> {
     let ticks = ticks.max(1);
@@ -815,27 +822,37 @@ pub fn tick_labels(max: f64, ticks: usize) -> Vec<String> {
     let plain: Vec<String> = (0..=ticks)
         .map(|k| format!("{:.*}", decimals, step * k as f64))
         .collect();
-    if step >= 1e-4 && plain.iter().all(|l| l.len() <= 6) {
+    if step >= 1e-4 && exact_decimals(step).is_some() && plain.iter().all(|l| l.len() <= 6) {
         return plain;
     }
-    // A capital E: the pictures' small 'e' reads as a 2.
+    // A capital E: the pictures' small 'e' reads as a 2. Three digits where they fit
+    // (1.25E6, a nice scale's top), else two, else one.
     (0..=ticks)
-        .map(|k| match format!("{:.1E}", step * k as f64) {
-            _ if k == 0 => "0".to_string(),
-            two if two.len() <= 6 => two,
-            _ => format!("{:.0E}", step * k as f64),
+        .map(|k| {
+            let v = step * k as f64;
+            match k {
+                0 => "0".to_string(),
+                _ => [2, 1, 0]
+                    .iter()
+                    .map(|&d| format!("{v:.d$E}"))
+                    .find(|l| l.len() <= 6)
+                    .unwrap_or_else(|| format!("{v:.0E}")),
+            }
         })
         .collect()
 }
 
 /// The fewest decimals (up to 4) that write every multiple of `step` exactly.
 fn decimals_of(step: f64) -> usize {
-    (0..=4)
-        .find(|&d| {
-            let scaled = step.abs() * 10f64.powi(d as i32);
-            (scaled - scaled.round()).abs() <= 1e-6 * scaled.max(1.0)
-        })
-        .unwrap_or(4)
+    exact_decimals(step).unwrap_or(4)
+}
+
+/// The fewest decimals (up to 4) that write every multiple of `step` exactly, if any do.
+fn exact_decimals(step: f64) -> Option<usize> {
+    (0..=4).find(|&d| {
+        let scaled = step.abs() * 10f64.powi(d as i32);
+        (scaled - scaled.round()).abs() <= 1e-6 * scaled.max(1.0)
+    })
 }
 
 /// Where a grid's columns and rows stand, for the coordinates printed along the picture's
@@ -1006,14 +1023,15 @@ pub fn grid_picture_with_axes(
         }
         // The axis names: the columns' right of their labels, the rows' above theirs.
         let name = |c: char| c.to_string();
-        draw_text(
-            &mut img,
-            name_x,
-            top + gh + 6,
-            2,
-            &name(axes.names[0]),
-            [0; 3],
-        );
+        // Where that would reach the scale bar, under the last column, a row lower.
+        let column_name = name(axes.names[0]);
+        let bar_x = gw + margin + GRID_MARGIN + 8;
+        let (name_x, name_y) = if name_x + text_width(&column_name, 2) + 2 <= bar_x {
+            (name_x, top + gh + 6)
+        } else {
+            (margin + gw - text_width(&column_name, 2), top + gh + 19)
+        };
+        draw_text(&mut img, name_x, name_y, 2, &column_name, [0; 3]);
         draw_text(
             &mut img,
             margin - 18,

@@ -229,6 +229,12 @@ fn a_quoted_name_may_hold_commas_and_comes_back_quoted() {
             "name,x,y,z,nx,ny,nz",
             1,
         );
+    let err = parse_points("name,x,y,z,nx,ny,nz\n\"Desk,1,2,3,0,0,1\n", "p.csv").unwrap_err();
+    assert!(
+        err.to_string()
+            .starts_with("p.csv:2: error: a quote is not closed"),
+        "{err}"
+    );
     let again = parse_points(&back, "lux.csv").unwrap();
     assert_eq!(again[0].name, pts[0].name);
     assert_eq!(again[1].name, pts[1].name);
@@ -310,13 +316,18 @@ fn tick_labels_have_the_decimals_of_their_step() {
     );
     assert_eq!(tick_labels(12_500.0, 5)[5], "12500");
     // Past the bar's room, or finer than 4 decimals: exponents (QA pass 14 of #16).
+    // 123456 / 5 = 24691.2: 2.47E4, 4.94E4, 7.41E4, 9.88E4, 1.23E5.
     assert_eq!(
         tick_labels(123_456.0, 5),
-        ["0", "2.5E4", "4.9E4", "7.4E4", "9.9E4", "1.2E5"]
+        ["0", "2.47E4", "4.94E4", "7.41E4", "9.88E4", "1.23E5"]
     );
     assert_eq!(tick_labels(1e-6, 5)[1..3], ["2.0E-7", "4.0E-7"]);
     assert_eq!(tick_labels(1e30, 5)[5], "1.0E30");
     assert_eq!(tick_labels(1e-30, 5)[1], "2E-31");
+    // A step of 2.5e-4 needs 5 decimals: not 0.0003, 0.0005, ... (review of #16).
+    assert_eq!(tick_labels(1e-3, 4)[1..3], ["2.5E-4", "5.0E-4"]);
+    // A nice scale's top of 1.25 x 10^6 keeps its three digits.
+    assert_eq!(tick_labels(1.25e6, 5)[5], "1.25E6");
     // Each label fits the scale bar beside a view at the legend's font.
     for (max, ticks) in [
         (12_500.0, 5),

@@ -77,18 +77,21 @@ fn refuse_far_past_the_limit(params: &scene::BuildingParams, args: &BuildingArgs
     let floors = params.floors as f64;
     let fewest = radiosity::mesh::fewest_elements(&one.scene);
     let per_storey = radiosity::mesh::planned_elements(&one.scene, args.max_area);
-    let most_floors = |per: f64| ((limit as f64 / per).floor() as u64).max(1);
+    // 2 % below the limit, as the area suggested below: the storeys differ (review).
+    let most_floors = |per: f64| (0.98 * limit as f64 / per).floor() as u64;
+    let rooms = format!("{} x {} rooms", params.rooms_x, params.rooms_z);
     if fewest * floors > 1.1 * limit as f64 {
+        let fit = match most_floors(fewest) {
+            0 => format!("not one storey of {rooms} fits: give fewer rooms"),
+            n => format!("at most about {n} floors of {rooms} fit at any --max-area"),
+        };
         bail!(
-            "--floors {}: about {} surfaces ({} a storey), each at least one element at any \
-             --max-area, past the limit of {limit} elements that the other commands mesh; \
-             at most about {} floors of {} x {} rooms fit at any --max-area",
+            "--floors {}: no file written: about {} surfaces ({} a storey), each at least one \
+             element at any --max-area, past the limit of {limit} elements that the other \
+             commands mesh; {fit}",
             params.floors,
             (one.scene.surfaces.len() as f64 * floors).round(),
             one.scene.surfaces.len(),
-            most_floors(fewest),
-            params.rooms_x,
-            params.rooms_z
         );
     }
     if per_storey * floors > 1.1 * limit as f64 {
@@ -97,20 +100,27 @@ fn refuse_far_past_the_limit(params: &scene::BuildingParams, args: &BuildingArgs
             // 2 % below a storey's share: the storeys differ.
             (0.98 * limit as f64 / floors).floor() as u64,
         );
+        let mut ways = Vec::new();
+        if let n @ 1.. = most_floors(per_storey) {
+            ways.push(format!("at most {n} floors"));
+        }
+        if let Some(a) = area {
+            ways.push(format!(
+                "--max-area about {} or more",
+                radiosity::mesh::four_digits_up(a)
+            ));
+        }
         bail!(
-            "--max-area {}: about {} elements ({} a storey, {} floors), past the limit of \
-             {limit} that the other commands mesh; give at most {} floors{}",
+            "--max-area {}: no file written: about {} elements ({} a storey, {} floors), past \
+             the limit of {limit} that the other commands mesh; give {}",
             crate::report::typed(args.max_area),
             (per_storey * floors).round(),
             per_storey,
             params.floors,
-            most_floors(per_storey),
-            match area {
-                Some(a) => format!(
-                    ", or --max-area about {} or more",
-                    radiosity::mesh::four_digits_up(a)
-                ),
-                None => String::new(),
+            if ways.is_empty() {
+                format!("fewer rooms than {rooms}")
+            } else {
+                ways.join(", or ")
             }
         );
     }
