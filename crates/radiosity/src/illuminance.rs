@@ -998,6 +998,8 @@ pub fn grid_picture_with_axes(
     let width = (gw + margin + GRID_MARGIN + GRID_LEGEND_WIDTH)
         .max(text_width(&line, 2) + 2 * GRID_MARGIN)
         .max(text_width(held, 2) + 2 * GRID_MARGIN);
+    // Where the scale bar stands, right of the cells.
+    let bar_x = gw + margin + GRID_MARGIN + 8;
     let mut img = image::RgbImage::from_pixel(width as u32, height as u32, image::Rgb([255; 3]));
     draw_text(&mut img, GRID_MARGIN, 10, 2, &line, [0; 3]);
     draw_text(&mut img, GRID_MARGIN, 24, 2, held, [0; 3]);
@@ -1025,7 +1027,6 @@ pub fn grid_picture_with_axes(
         let name = |c: char| c.to_string();
         // Where that would reach the scale bar, under the last column, a row lower.
         let column_name = name(axes.names[0]);
-        let bar_x = gw + margin + GRID_MARGIN + 8;
         let (name_x, name_y) = if name_x + text_width(&column_name, 2) + 2 <= bar_x {
             (name_x, top + gh + 6)
         } else {
@@ -1069,14 +1070,7 @@ pub fn grid_picture_with_axes(
             }
         }
     }
-    draw_scale_bar(
-        &mut img,
-        gw + margin + GRID_MARGIN + 8,
-        top - 24,
-        bar_bottom,
-        max,
-        ticks,
-    );
+    draw_scale_bar(&mut img, bar_x, top - 24, bar_bottom, max, ticks);
     img
 }
 

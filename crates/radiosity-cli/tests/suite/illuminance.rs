@@ -459,10 +459,10 @@ fn a_progressive_run_stopped_early_reads_the_light_shot_so_far() {
     // and fell towards 0.241 lx (the dense solve) as more were shot: the ambient term, a
     // uniform guess at the unshot light, was added. Shooting only adds light, so the
     // indirect illuminance of a capped run grows with the shots and stays below the
-    // converged value (dense Gauss-Seidel: an independent solver). Tolerance 1e-9 relative:
-    // the two solvers converge to 1e-6 of the emitted power or finer, far below the gap
-    // the ambient term made (+76 %), and the shots' sums differ from the dense solve's
-    // in rounding only.
+    // converged value (dense Gauss-Seidel to a residual of 1e-9: an independent solver).
+    // Tolerance 1e-9 relative: the converged value is within about that of the exact one,
+    // far below the gap the ambient term made (+76 %), and 40 shots leave most of the
+    // reflected light unshot, so a capped run stays well below it.
     let dir = scratch_dir("illuminance-progressive-cap");
     std::fs::write(
         dir.join("p.csv"),
