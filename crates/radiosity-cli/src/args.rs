@@ -826,7 +826,13 @@ pub fn plain_number_reason(value: &str, reason: &str) -> String {
             let unbounded = [u32::MAX as u64, u64::MAX, i64::MAX as u64]
                 .iter()
                 .any(|m| hi.parse::<u64>() == Ok(*m));
-            return if unbounded {
+            // Past the top ("--max-bounces 5000000000" for a u32): "at least 0" would be
+            // true of the value given (QA of issue #16), so the top is named.
+            let past_top = match (value.trim().parse::<u128>(), hi.parse::<u128>()) {
+                (Ok(v), Ok(h)) => v > h,
+                _ => false,
+            };
+            return if unbounded && !past_top {
                 format!("give a whole number of at least {lo}")
             } else {
                 format!("give a whole number from {lo} to {hi}")

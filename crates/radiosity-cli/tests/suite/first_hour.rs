@@ -2115,6 +2115,11 @@ fn number_flags_are_refused_in_one_wording() {
             vec!["render", "--supersample", "17"],
             "error: --supersample 17: give a whole number from 1 to 16",
         ),
+        // Past a u32's top, "at least 0" was true of the value given (QA pass 15).
+        (
+            vec!["render", "--adapt-rounds", "5000000000"],
+            "error: --adapt-rounds 5000000000: give a whole number from 0 to 4294967295",
+        ),
         (
             vec!["render", "--solver", "hierarchica"],
             "error: --solver hierarchica: give one of auto, lu, gauss-seidel, progressive, \

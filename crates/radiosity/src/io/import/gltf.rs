@@ -239,6 +239,16 @@ impl Reader<'_> {
         let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
         let blob = raw.blob;
         let json = raw.document.into_json();
+        // The `gltf` crate reads any "asset.version" as 2.0; a glTF 1.0 file (materials as
+        // shader techniques, other buffer rules) then failed later in puzzling ways or read
+        // wrong (QA pass 15 of issue #16).
+        let version = json.asset.version.trim();
+        if version.split('.').next() != Some("2") {
+            return Err(self.error(format!(
+                "asset.version is \"{version}\": this reader takes glTF 2.0 (a glTF 1.0 file \
+                 can be converted to 2.0, for instance by Blender's importer and exporter)"
+            )));
+        }
         self.check_position_indices(&json)?;
         let document = gltf::Document::from_json(json).map_err(invalid)?;
         let doc = &document;

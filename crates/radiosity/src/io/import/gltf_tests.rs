@@ -564,6 +564,20 @@ fn grey() -> Value {
 }
 
 #[test]
+fn a_gltf_1_file_is_refused_by_its_version() {
+    // QA pass 15 of issue #16: "asset.version": "1.0" was read as 2.0 without a word.
+    let mut doc = square_doc(json!([{ "mesh": 0 }]), grey(), None);
+    doc["asset"]["version"] = json!("1.0");
+    let e = read_doc(&doc).unwrap_err().to_string();
+    assert!(
+        e.contains("asset.version is \"1.0\": this reader takes glTF 2.0"),
+        "{e}"
+    );
+    doc["asset"]["version"] = json!("2.0");
+    assert!(read_doc(&doc).is_ok());
+}
+
+#[test]
 fn node_transforms_compose_parent_first() {
     // Parent: translate (10, 0, 0). Child: rotate 90 degrees about z, scale 2, translate
     // (0, 1, 0). The square's corner (1, 0, 0) goes: scale -> (2, 0, 0), rotate -> (0, 2,

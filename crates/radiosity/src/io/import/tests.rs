@@ -280,6 +280,32 @@ fn reflectance_of_one_or_more_is_refused_naming_the_material() {
 }
 
 #[test]
+fn a_triangle_given_twice_beside_its_neighbour_is_dropped_not_joined() {
+    // Two triangles of a unit square and the first again (QA of issue #16: the first was
+    // joined with its neighbour into the square, the copy then matched nothing and stayed:
+    // 1.0024 m^2 where the square is 1).
+    let (scene, warnings) = soup(
+        &unit_square(),
+        &[("A", &[&[0, 1, 2], &[0, 2, 3], &[0, 1, 2]])],
+    )
+    .to_scene(1.0)
+    .unwrap();
+    let area: f64 = scene
+        .surfaces
+        .iter()
+        .map(|s| crate::geometry::polygon_area(&s.vertices))
+        .sum();
+    // Exact up to rounding: the two halves of a unit square.
+    assert!((area - 1.0).abs() < 1e-12, "area {area}");
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.message.starts_with("dropped 1 face given twice")),
+        "{warnings:?}"
+    );
+}
+
+#[test]
 fn a_face_given_twice_is_dropped_with_a_warning() {
     let (scene, warnings) = soup(
         &unit_square(),
