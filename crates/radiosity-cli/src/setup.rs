@@ -1315,7 +1315,29 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
         let d = (p - (lo + hi) * 0.5).length();
         !d.is_finite() || d > reach
     };
-    for (flag, point) in [("--eye", camera.eye), ("--look-at", camera.look_at)] {
+    for (flag, point, given) in [
+        ("--eye", camera.eye, args.eye.is_some()),
+        ("--look-at", camera.look_at, args.look_at.is_some()),
+    ] {
+        // A point the automatic camera chose (QA pass 15 of issue #16: a scene 1e-20 m
+        // across was told "--eye ... is out of range" without any --eye given).
+        if far(point) && !given {
+            bail!(
+                "the automatic camera cannot frame this scene: it is {} across, and its {} \
+                 ({},{},{}) lands farther than 1e9 times that from its centre, where rays \
+                 lose their precision; give --eye and --look-at, or --scale to bring the \
+                 scene's numbers nearer to 1",
+                crate::report::significant(size, 4),
+                if flag == "--eye" {
+                    "eye"
+                } else {
+                    "look-at point"
+                },
+                crate::report::typed(point.x),
+                crate::report::typed(point.y),
+                crate::report::typed(point.z),
+            );
+        }
         if far(point) {
             bail!(
                 "{flag} {},{},{} is out of range: farther than {} (1e9 times the scene's size, \

@@ -196,6 +196,34 @@ fn an_eye_out_of_range_is_not_called_parallel() {
 }
 
 #[test]
+fn a_scene_the_automatic_camera_cannot_frame_does_not_blame_eye() {
+    // QA pass 15 of issue #16: a patch 1e-20 m across was told "--eye 0.00057,... is out of
+    // range" with no --eye given; the point was the automatic camera's.
+    let dir = scratch_dir("tiny-scene");
+    std::fs::write(
+        dir.join("tiny.scene"),
+        "MAX_PATCH_AREA 0.5\nINTEGRAL_STEPS 2\nSCENEBEGIN\nPATCHBEGIN\n#A\nVERTICES 4\n\
+         Er 1\nEg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\nVERTEX0 0 0 0\nVERTEX1 1e-20 0 0\n\
+         VERTEX2 1e-20 1e-20 0\nVERTEX3 0 1e-20 0\nPATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    let out = radiosity(
+        &["render", "tiny.scene", "--width", "8", "-o", "t.png"],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the automatic camera cannot frame this scene: it is 1.414e-20 across")
+            && err.contains("give --eye and --look-at, or --scale"),
+        "{err}"
+    );
+    assert!(!err.contains("--eye 0"), "{err}");
+    assert!(!dir.join("t.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn work_past_the_limit_is_refused_before_it_starts_with_what_fits() {
     let dir = scratch_dir("work-limit");
     let scene = example("triangles.scene");
