@@ -46,3 +46,24 @@ pub(super) fn refinement(coarse: &[Seen; 4], contrast: f64) -> Refine {
         Refine::No
     }
 }
+
+/// True when a neighbouring pixel's first rays saw a surface that none of `coarse` saw, more
+/// than twice as bright as the brightest of `coarse`: the edge of a light (or of anything
+/// bright) may cross this pixel between its four rays, which then see none of it. Without
+/// this, the pixels along a light's edge showed nothing of it: in a 32-pixel Cornell box the
+/// row under the light read 0.10 cd/m^2 against the path tracer's 0.59 to 1.15, about 8 %
+/// of the light's flux in the image lost (QA pass 15 of issue #16). Only brighter
+/// neighbours count: a dark sliver missed costs little light, and every edge of every
+/// object would otherwise be refined three pixels wide.
+pub(super) fn brighter_beside<'a>(
+    coarse: &[Seen; 4],
+    neighbours: impl Iterator<Item = &'a [Seen; 4]>,
+) -> bool {
+    let lum = |s: &Seen| crate::light::Rgb(s.value).luminance();
+    let brightest = coarse.iter().map(lum).fold(0.0, f64::max);
+    neighbours.flatten().any(|s| {
+        s.surface.is_some()
+            && coarse.iter().all(|c| c.surface != s.surface)
+            && lum(s) > 2.0 * brightest
+    })
+}

@@ -27,7 +27,7 @@ use std::ops::Range;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::adaptive::{refinement, Refine, Seen};
+use super::adaptive::{brighter_beside, refinement, Refine, Seen};
 use super::direct::DirectCorrection;
 use super::film::{sample_offset, Film, FilmContent};
 use super::holes::{closest_on_segment, nearest_element, Holes, Uncovered};
@@ -306,22 +306,47 @@ impl<'m> Renderer<'m> {
         let adaptive = self
             .adaptive
             .filter(|_| n > 2 && n % 2 == 0 && shading != Shading::Wireframe);
+        let width = camera.width as usize;
+        // What ray (sx, sy) of pixel `index` sees. Each ray of the pixel jitters the direct
+        // light's strata its own way (see `direct`), so that a pixel's rays average the
+        // shadow rays' noise.
+        let seen = |index: u64, sx: f64, sy: f64| {
+            let dir = camera.direction_in(screen, sx, sy);
+            let salt = crate::splitmix::splitmix64(
+                index ^ sx.to_bits().rotate_left(17) ^ sy.to_bits().rotate_left(41),
+            );
+            self.trace(
+                camera.eye, dir, footprint, element_b, vertex_b, shading, salt,
+            )
+        };
+        let first_rays = |x: usize, y: usize| -> [Seen; 4] {
+            let index = (y * width + x) as u64;
+            std::array::from_fn(|q| {
+                let (i, j) = ((q % 2) as f64, (q / 2) as f64);
+                seen(index, x as f64 + 0.25 + 0.5 * i, y as f64 + 0.25 + 0.5 * j)
+            })
+        };
+        // Under adaptive sampling, the four first rays of every pixel of these rows and of
+        // the rows either side, so that a pixel can look at its neighbours' (see
+        // `brighter_beside`).
+        let around = rows.start.saturating_sub(1)..(rows.end + 1).min(camera.height as usize);
+        let firsts: Vec<[Seen; 4]> = if adaptive.is_some() {
+            around
+                .clone()
+                .into_par_iter()
+                .flat_map_iter(|y| (0..width).map(move |x| (x, y)))
+                .map(|(x, y)| first_rays(x, y))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let first_at = |x: usize, y: usize| &firsts[(y - around.start) * width + x];
         film.par_rows_mut().for_each(|(r, row)| {
             let y = rows.start + r;
             let mut rays_scratch: Vec<[f64; 3]> = Vec::new();
             for (x, pixel) in row.chunks_exact_mut(n * n).enumerate() {
-                let index = (y * camera.width as usize + x) as u64;
-                let seen = |sx: f64, sy: f64| {
-                    let dir = camera.direction_in(screen, sx, sy);
-                    // Each ray of the pixel jitters the direct light's strata its own way
-                    // (see `direct`), so that a pixel's rays average the shadow rays' noise.
-                    let salt = crate::splitmix::splitmix64(
-                        index ^ sx.to_bits().rotate_left(17) ^ sy.to_bits().rotate_left(41),
-                    );
-                    self.trace(
-                        camera.eye, dir, footprint, element_b, vertex_b, shading, salt,
-                    )
-                };
+                let index = (y * width + x) as u64;
+                let seen = |sx: f64, sy: f64| seen(index, sx, sy);
                 // The grid this pixel gets: n x n, or under adaptive sampling four rays at
                 // the quadrants' centres first and then 2 x 2 (those four), n/2 x n/2 or
                 // n x n as they ask (see `refinement`). A coarser grid's g x g rays each
@@ -329,11 +354,16 @@ impl<'m> Renderer<'m> {
                 let mut grid = n;
                 let mut coarse = None;
                 if let Some(contrast) = adaptive {
-                    let first: [Seen; 4] = std::array::from_fn(|q| {
-                        let (i, j) = ((q % 2) as f64, (q / 2) as f64);
-                        seen(x as f64 + 0.25 + 0.5 * i, y as f64 + 0.25 + 0.5 * j)
-                    });
+                    let first = *first_at(x, y);
+                    let neighbours = (y.saturating_sub(1)..(y + 2).min(around.end))
+                        .flat_map(|ny| {
+                            (x.saturating_sub(1)..(x + 2).min(width)).map(move |nx| (nx, ny))
+                        })
+                        .filter(|&(nx, ny)| (nx, ny) != (x, y))
+                        .map(|(nx, ny)| first_at(nx, ny));
+                    let bright_beside = brighter_beside(&first, neighbours);
                     grid = match refinement(&first, contrast) {
+                        Refine::No | Refine::Contrast if bright_beside => n,
                         Refine::No => 2,
                         Refine::Contrast => (n / 2).max(2),
                         Refine::Silhouette => n,
@@ -946,6 +976,41 @@ mod tests {
             edges > 20 && inside > 300,
             "{edges} edge and {inside} inside pixels"
         );
+    }
+
+    #[test]
+    fn a_bright_edge_between_the_first_rays_is_refined() {
+        // A bright quad (a light, 20 times the wall's radiosity) in front of a dim wall,
+        // its edges at odd fractions of a pixel. Every pixel that the full 8 x 8 grid
+        // finds partly bright but whose four first rays miss the quad has a neighbour
+        // whose first rays see it, so adaptive sampling must give it the full grid (QA
+        // pass 15 of issue #16: the row under the Cornell box's light showed nothing of it,
+        // 8 % of the light's flux in a 32-pixel image).
+        let s = scene(vec![
+            surface("light", 0.0, facing_minus_z(203., 377., 211., 337., 0.)),
+            surface("wall", 0.0, facing_minus_z(0., 556., 0., 548., 10.)),
+        ]);
+        let mesh = mesh_scene(&s, 1e9).unwrap();
+        let eb = vec![[10.0, 10.0, 10.0], [0.5, 0.5, 0.5]];
+        let cam = cornell_camera(32, 24);
+        let adaptive = Renderer::new(&mesh).with_adaptive_sampling(0.02);
+        let film = adaptive.film(&cam, &eb, &[], Shading::Flat, 8, &NoProgress);
+        let full = Renderer::new(&mesh).film(&cam, &eb, &[], Shading::Flat, 8, &NoProgress);
+        let mut grazed = 0;
+        for y in 0..24 {
+            for x in 0..32 {
+                let f = full.pixel(x, y);
+                // The full grid's samples nearest the four first rays (at 0.25 and 0.75).
+                let first = [(2, 2), (6, 2), (2, 6), (6, 6)].map(|(i, j)| f[j * 8 + i][0]);
+                let partly_bright = f.iter().any(|v| v[0] == 10.0) && f.iter().any(|v| v[0] < 10.0);
+                if partly_bright && first.iter().all(|&v| v < 10.0) {
+                    grazed += 1;
+                    assert_eq!(film.pixel(x, y), f, "pixel ({x}, {y})");
+                }
+            }
+        }
+        // The quad's edges were placed to graze some pixels between their first rays.
+        assert!(grazed > 0, "no pixel grazed");
     }
 
     #[test]
