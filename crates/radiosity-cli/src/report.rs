@@ -347,7 +347,8 @@ const LIGHT_LOST_ABSORBED: f64 = 0.01;
 /// A warning when the scene's light reaches none of its surfaces, so every picture is black
 /// (QA of issue #16: an emitter facing out of the room, or lying above the ceiling and
 /// dropped as buried, gave a black render with only notes): the emitting surfaces that the
-/// mesh dropped, or the share that reaches nothing and the likely cause.
+/// mesh dropped, or the share that reaches nothing and the likely cause; where at least the
+/// emitted power lands ([`light_lands`]), the share lost over many reflections instead.
 pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
     let emitters: Vec<usize> = (0..scene.surfaces.len())
         .filter(|&s| scene.surfaces[s].emission.0.iter().any(|&e| e > 0.0))
@@ -417,6 +418,26 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
     {
         return None;
     }
+    // Light reflected many times: the surfaces absorb little because they reflect nearly
+    // all that lands, not because little lands (QA pass 15 of issue #16: a closed box of
+    // reflectance 0.9999 was said to show "only the 0.51 % that lands").
+    let landed = landed_power(scene, solution, band) / b.emitted[band];
+    if landed >= LANDS_OVER {
+        let most = scene
+            .surfaces
+            .iter()
+            .map(|s| s.reflectance.band(band))
+            .fold(0.0, f64::max);
+        return Some(format!(
+            "{:.2} % of the emitted light is lost over many reflections (its surfaces absorb \
+             only {} %: with reflectance up to {most} the light lands {} times its emitted \
+             power, bouncing until it leaves the scene or meets the back of a face; `check` \
+             lists where it goes)",
+            100.0 * (1.0 - absorbed),
+            significant(100.0 * absorbed, 2),
+            significant(landed, 2),
+        ));
+    }
     // What the pictures show: nothing, or the little that lands, which the automatic
     // exposure brightens (QA of issue #16: "so pictures are black" over a lit picture).
     let pictures = if absorbed > 0.0 {
@@ -463,6 +484,38 @@ pub fn light_lost(scene: &Scene, solution: &Solution) -> Option<String> {
          inside furniture, or a room whose faces point out: `check` lists where it goes)",
         100.0 * (1.0 - absorbed),
     ))
+}
+
+/// At least this multiple of the emitted power lands on the elements' fronts where light
+/// that escapes is said to be lost over many reflections, not to reach no surface.
+const LANDS_OVER: f64 = 1.0;
+
+/// Whether at least as much light lands on the elements' fronts as is emitted (in the band
+/// that emits most), so the pictures are lit whatever [`light_lost`] says escapes.
+pub fn light_lands(scene: &Scene, solution: &Solution) -> bool {
+    energy_band(&solution.balance).is_some_and(|band| {
+        landed_power(scene, solution, band) >= LANDS_OVER * solution.balance.emitted[band]
+    })
+}
+
+/// The power arriving at the elements' fronts in `band`, from other elements and point
+/// luminaires: A (B - E) / rho summed over the elements of reflectance rho > 0, with E the
+/// surface's own emission (B - E = rho x irradiance, luminaires' direct light included).
+/// Light reflected many times counts once per landing, so this exceeds the emitted power
+/// where the surfaces reflect nearly all of it.
+fn landed_power(scene: &Scene, solution: &Solution, band: usize) -> f64 {
+    solution
+        .mesh
+        .elements
+        .iter()
+        .zip(&solution.radiosity.0)
+        .filter_map(|(element, b)| {
+            let surface = scene.surfaces.get(element.surface as usize)?;
+            let rho = surface.reflectance.band(band);
+            (rho > 0.0)
+                .then(|| element.area * (b.band(band) - surface.emission.band(band)).max(0.0) / rho)
+        })
+        .sum()
 }
 
 /// Surface `s`'s unit normal, a point of its plane, and 1e-9 of the scene's size (how far

@@ -538,7 +538,9 @@ fn picture_can_be_lit(
     solution: &radiosity::pipeline::Solution,
 ) -> bool {
     crate::report::energy_band(&solution.balance).is_some()
-        && crate::report::light_lost(&prepared.scene, solution).is_none()
+        && (crate::report::light_lost(&prepared.scene, solution).is_none()
+            // QA pass 15 of issue #16: light lost over many reflections lights them.
+            || crate::report::light_lands(&prepared.scene, solution))
 }
 
 /// `render --false-colour`: the illuminance of every element

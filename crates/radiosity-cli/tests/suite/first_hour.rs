@@ -2253,6 +2253,38 @@ fn a_light_that_reaches_no_surface_is_warned_of() {
 }
 
 #[test]
+fn light_lost_over_many_reflections_is_not_said_to_reach_no_surface() {
+    // QA pass 15 of issue #16: a closed box of reflectance 0.9999 with a panel 10 cm under
+    // its ceiling absorbs 0.51 % of the emitted light and loses the rest on the panel's black
+    // back after hundreds of bounces; it was warned of as light that "reaches no surface",
+    // the pictures showing "only the 0.51 % that lands".
+    let dir = scratch_dir("light-lost-bright");
+    std::fs::write(
+        dir.join("hi.scene"),
+        "MAX_PATCH_AREA 0.5\nINTEGRAL_STEPS 2\nSCENEBEGIN\nBOXBEGIN\n#Room\nFACING IN\n\
+         Er 0\nEg 0\nEb 0\nRr 0.9999\nRg 0.9999\nRb 0.9999\nORIGIN 0 0 0\nSIZE 2 2 2\n\
+         BOXEND\nPATCHBEGIN\n#Light\nVERTICES 4\nEr 1\nEg 1\nEb 1\nRr 0.9999\nRg 0.9999\n\
+         Rb 0.9999\nVERTEX0 0.5 1.9 0.5\nVERTEX1 1.5 1.9 0.5\nVERTEX2 1.5 1.9 1.5\n\
+         VERTEX3 0.5 1.9 1.5\nPATCHEND\nSCENEEND\n",
+    )
+    .unwrap();
+    let out = radiosity(&["solve", "hi.scene", "-o", "b.csv", "-q"], &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("% of the emitted light is lost over many reflections (its surfaces absorb only 0.")
+            && err.contains("with reflectance up to 0.9999 the light lands ")
+            && err.contains("times its emitted power, bouncing until it leaves the scene or meets the back of a face"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("reaches no surface") && !err.contains("pictures show only"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn generate_keeps_an_existing_scene_file_unless_forced() {
     // QA of issue #16 (sixth pass): `generate building -o examples/room.scene` replaced the
     // shipped example without a word.
