@@ -239,6 +239,59 @@ pub enum IesProblem {
         /// This angle.
         value: f64,
     },
+    /// An angle list that stops increasing at the first number of a line, in a file that
+    /// holds fewer numbers than its counts need: the declared count is likely larger than
+    /// the angles given, and the list has run onto the next one.
+    #[error(
+        "this line declares {count} {what} angles, but {given_on} {given}: {what} angle \
+         {index} would be the {value} that starts line {value_line}, not above the {previous} \
+         before it, and the file holds fewer numbers than its counts need, so line \
+         {value_line} likely begins the {next} (give the count of angles listed, or the \
+         missing angle)",
+        index = given + 1
+    )]
+    CountTooLarge {
+        /// "vertical", "horizontal" or "tilt".
+        what: &'static str,
+        /// The count declared.
+        count: usize,
+        /// The angles given before the line that breaks the order.
+        given: usize,
+        /// "line 6 gives", or "lines 6 to 8 give".
+        given_on: String,
+        /// The angle after them, which is not above the one before it.
+        value: f64,
+        /// Its line.
+        value_line: usize,
+        /// The last angle given.
+        previous: f64,
+        /// What follows the list in the file: "horizontal angles" and so on.
+        next: &'static str,
+    },
+    /// A lamp or ballast line with more numbers than it takes, found where a later number
+    /// is refused and the file holds exactly that many numbers too many.
+    #[error(
+        "this line has {found} numbers, where the {name} takes {expected} ({names}): {moved}, \
+         and line {then_line} then reads: {then}",
+        moved = match found - expected {
+            1 => "the extra one moves every number after it one place on".to_string(),
+            n => format!("the {n} extra move every number after them {n} places on"),
+        }
+    )]
+    ExtraNumbers {
+        /// "lamp line" or "ballast line".
+        name: &'static str,
+        /// The numbers on the line.
+        found: usize,
+        /// The numbers the line takes.
+        expected: usize,
+        /// What they are.
+        names: &'static str,
+        /// The line of the later problem.
+        then_line: usize,
+        /// The later problem.
+        then: Box<IesProblem>,
+    },
     /// Horizontal angles that state none of the standard's symmetries.
     #[error(
         "the horizontal angles run from {first} to {last} degrees; type C files give one \
@@ -328,6 +381,21 @@ impl<'a> Numbers<'a> {
         }
     }
 
+    /// The numbers on the line of token `start`, where that token is the first on its line
+    /// (`None` where a number before it shares the line, or past the end).
+    fn on_line_from(&self, start: usize) -> Option<usize> {
+        let &(line, _) = self.tokens.get(start)?;
+        if start > 0 && self.tokens[start - 1].0 == line {
+            return None;
+        }
+        Some(
+            self.tokens[start..]
+                .iter()
+                .take_while(|t| t.0 == line)
+                .count(),
+        )
+    }
+
     /// The next number and its line.
     fn number(&mut self, expected: &str) -> Result<(f64, usize), IesError> {
         let Some(&(line, token)) = self.tokens.get(self.next) else {
@@ -394,14 +462,20 @@ impl<'a> Numbers<'a> {
         Ok(value)
     }
 
-    /// `count` increasing angles within `[lo, hi]` degrees.
+    /// `count` increasing angles within `[lo, hi]` degrees. `count_line` is the line that
+    /// declares `count`, `needed` the numbers the file needs from the first angle to its
+    /// end, and `next` what follows the list: an angle that stops the order at the start of
+    /// a line in a file short of numbers is refused as a count too large
+    /// ([`IesProblem::CountTooLarge`]), since lists may wrap across lines.
     fn angles(
         &mut self,
         what: &'static str,
         count: usize,
         lo: f64,
         hi: f64,
+        (count_line, needed, next): (usize, usize, &'static str),
     ) -> Result<Vec<f64>, IesError> {
+        let start = self.next;
         let mut angles: Vec<f64> = Vec::new();
         for index in 1..=count {
             let (value, line) = self.number(&format!("{what} angle {index} of {count}"))?;
@@ -416,6 +490,29 @@ impl<'a> Numbers<'a> {
                 ));
             }
             if let Some(&previous) = angles.last() {
+                let before = self.tokens[self.next - 2].0;
+                let available = self.tokens.len() - start;
+                if value <= previous && before != line && available < needed {
+                    let first = self.tokens[start].0;
+                    let given_on = if first == before {
+                        format!("line {first} gives")
+                    } else {
+                        format!("lines {first} to {before} give")
+                    };
+                    return Err(self.error(
+                        count_line,
+                        IesProblem::CountTooLarge {
+                            what,
+                            count,
+                            given: index - 1,
+                            given_on,
+                            value,
+                            value_line: line,
+                            previous,
+                            next,
+                        },
+                    ));
+                }
                 if value <= previous {
                     return Err(self.error(
                         line,
@@ -503,9 +600,17 @@ impl IesPhotometry {
         } else if tilt_value.eq_ignore_ascii_case("INCLUDE") {
             let (geometry, _) =
                 numbers.whole("the lamp-to-luminaire geometry (1, 2 or 3)", 1..=3)?;
-            let (count, _) = numbers.whole("the number of tilt angles", 1..=u32::MAX)?;
+            let (count, count_line) = numbers.whole("the number of tilt angles", 1..=u32::MAX)?;
             let count = count as usize;
-            let angles_deg = numbers.angles("tilt", count, 0.0, 180.0)?;
+            // The factors, then at least the lamp and ballast lines and a table of 2 x 1.
+            let needed = count.saturating_mul(2).saturating_add(10 + 3 + 5);
+            let angles_deg = numbers.angles(
+                "tilt",
+                count,
+                0.0,
+                180.0,
+                (count_line, needed, "tilt multiplying factors"),
+            )?;
             let mut factors = Vec::new();
             for index in 1..=count {
                 let (value, line) =
@@ -535,6 +640,7 @@ impl IesPhotometry {
         };
 
         // The lamp line
+        let lamp_start = numbers.next;
         let (lamps, _) = numbers.whole("the number of lamps", 1..=u32::MAX)?;
         let (lumens_per_lamp, line) = numbers.number("the lumens per lamp")?;
         if lumens_per_lamp <= 0.0 && lumens_per_lamp != -1.0 {
@@ -549,8 +655,9 @@ impl IesPhotometry {
             ));
         }
         let candela_multiplier = numbers.positive("the candela multiplier")?;
-        let (vertical_count, _) = numbers.whole("the number of vertical angles", 2..=u32::MAX)?;
-        let (horizontal_count, _) =
+        let (vertical_count, counts_line) =
+            numbers.whole("the number of vertical angles", 2..=u32::MAX)?;
+        let (horizontal_count, horizontal_count_line) =
             numbers.whole("the number of horizontal angles", 1..=u32::MAX)?;
         let (photometric_type, line) =
             numbers.whole("the photometric type (1 = C, 2 = B, 3 = A)", 1..=3)?;
@@ -565,6 +672,7 @@ impl IesPhotometry {
         }
 
         // The ballast line
+        let ballast_start = numbers.next;
         let ballast_factor = numbers.positive("the ballast factor")?;
         let (third, line) = numbers.number(match version {
             IesVersion::Lm63_2019 => "the file generation type",
@@ -599,74 +707,157 @@ impl IesPhotometry {
         }
         let (input_watts, _) = numbers.number("the input watts")?;
 
-        // Angles
-        let vertical_deg = numbers.angles("vertical", vertical_count as usize, 0.0, 180.0)?;
-        let horizontal_line = numbers
-            .tokens
-            .get(numbers.next)
-            .map_or(numbers.last_line, |t| t.0);
-        let horizontal_deg = numbers.angles("horizontal", horizontal_count as usize, 0.0, 360.0)?;
-        let near = |a: f64, b: f64| (a - b).abs() <= ANGLE_SLACK_DEG;
-        let first = horizontal_deg[0];
-        let last = *horizontal_deg.last().unwrap_or(&first);
-        let symmetry = if horizontal_deg.len() == 1 {
-            Symmetry::Rotational
-        } else if near(first, 0.0) && near(last, 90.0) {
-            Symmetry::Quadrant
-        } else if near(first, 0.0) && near(last, 180.0) {
-            Symmetry::Bilateral0
-        } else if near(first, 90.0) && near(last, 270.0) {
-            Symmetry::Bilateral90
-        } else if near(first, 0.0) && last > 180.0 {
-            Symmetry::Full
-        } else {
-            return Err(error(
-                horizontal_line,
-                IesProblem::HorizontalRange { first, last },
-            ));
-        };
+        // A lamp or ballast line with as many numbers too many as the file holds blames
+        // what goes wrong later on that line (QA pass 15 of issue #16: a fourth number on
+        // the ballast line was read as the first vertical angle, and the error named the
+        // next line).
+        let rest = numbers.tokens.len() - numbers.next;
+        let needed = (vertical_count as usize)
+            .saturating_mul(horizontal_count as usize)
+            .saturating_add(vertical_count as usize)
+            .saturating_add(horizontal_count as usize);
+        let overlong = [
+            (
+                ballast_start,
+                "ballast line",
+                3,
+                "the ballast factor, the third factor and the input watts",
+            ),
+            (
+                lamp_start,
+                "lamp line",
+                10,
+                "the lamps, lumens, multiplier, two counts, type, units and three dimensions",
+            ),
+        ]
+        .into_iter()
+        .find_map(|(start, name, expected, names)| {
+            let found = numbers.on_line_from(start)?;
+            (rest > needed && found == expected + (rest - needed)).then_some((
+                numbers.tokens[start].0,
+                name,
+                found,
+                expected,
+                names,
+            ))
+        });
+        let table = (|| -> Result<(Vec<f64>, Vec<f64>, Symmetry, Vec<f64>), IesError> {
+            // Angles
+            let (v, h) = (vertical_count as usize, horizontal_count as usize);
+            let values_needed = v.saturating_mul(h);
+            let vertical_deg = numbers.angles(
+                "vertical",
+                v,
+                0.0,
+                180.0,
+                (
+                    counts_line,
+                    values_needed.saturating_add(v).saturating_add(h),
+                    "horizontal angles",
+                ),
+            )?;
+            let horizontal_line = numbers
+                .tokens
+                .get(numbers.next)
+                .map_or(numbers.last_line, |t| t.0);
+            let horizontal_deg = numbers.angles(
+                "horizontal",
+                h,
+                0.0,
+                360.0,
+                (
+                    horizontal_count_line,
+                    values_needed.saturating_add(h),
+                    "candela values",
+                ),
+            )?;
+            let near = |a: f64, b: f64| (a - b).abs() <= ANGLE_SLACK_DEG;
+            let first = horizontal_deg[0];
+            let last = *horizontal_deg.last().unwrap_or(&first);
+            let symmetry = if horizontal_deg.len() == 1 {
+                Symmetry::Rotational
+            } else if near(first, 0.0) && near(last, 90.0) {
+                Symmetry::Quadrant
+            } else if near(first, 0.0) && near(last, 180.0) {
+                Symmetry::Bilateral0
+            } else if near(first, 90.0) && near(last, 270.0) {
+                Symmetry::Bilateral90
+            } else if near(first, 0.0) && last > 180.0 {
+                Symmetry::Full
+            } else {
+                return Err(error(
+                    horizontal_line,
+                    IesProblem::HorizontalRange { first, last },
+                ));
+            };
 
-        // Candela values
-        let mut values = Vec::new();
-        for &horizontal in &horizontal_deg {
-            for &vertical in &vertical_deg {
-                let (value, line) = numbers.number(&format!(
-                    "the candela value at vertical angle {} and horizontal angle {}",
-                    vertical, horizontal
-                ))?;
-                if value < 0.0 {
-                    return Err(error(
-                        line,
-                        IesProblem::OutOfRange {
-                            what: format!(
-                                "the candela value at vertical angle {} and horizontal angle {}",
-                                vertical, horizontal
-                            ),
-                            value,
-                            allowed: "intensities must be 0 or more".to_string(),
-                        },
-                    ));
+            // Candela values
+            let mut values = Vec::new();
+            for &horizontal in &horizontal_deg {
+                for &vertical in &vertical_deg {
+                    let (value, line) = numbers.number(&format!(
+                        "the candela value at vertical angle {} and horizontal angle {}",
+                        vertical, horizontal
+                    ))?;
+                    if value < 0.0 {
+                        return Err(error(
+                            line,
+                            IesProblem::OutOfRange {
+                                what: format!(
+                                    "the candela value at vertical angle {} and horizontal angle {}",
+                                    vertical, horizontal
+                                ),
+                                value,
+                                allowed: "intensities must be 0 or more".to_string(),
+                            },
+                        ));
+                    }
+                    if value * scale > MAX_CANDELA {
+                        return Err(error(
+                            line,
+                            IesProblem::OutOfRange {
+                                what: format!(
+                                    "the candela value at vertical angle {} and horizontal angle {}, \
+                                     times the candela multiplier and ballast factors,",
+                                    vertical, horizontal
+                                ),
+                                value: value * scale,
+                                allowed: format!("at most {MAX_CANDELA:e} cd is accepted"),
+                            },
+                        ));
+                    }
+                    values.push(value);
                 }
-                if value * scale > MAX_CANDELA {
-                    return Err(error(
-                        line,
-                        IesProblem::OutOfRange {
-                            what: format!(
-                                "the candela value at vertical angle {} and horizontal angle {}, \
-                                 times the candela multiplier and ballast factors,",
-                                vertical, horizontal
-                            ),
-                            value: value * scale,
-                            allowed: format!("at most {MAX_CANDELA:e} cd is accepted"),
-                        },
-                    ));
-                }
-                values.push(value);
             }
-        }
-        if let Some(&(line, token)) = numbers.tokens.get(numbers.next) {
-            return Err(error(line, IesProblem::TrailingData(token.to_string())));
-        }
+            if let Some(&(line, token)) = numbers.tokens.get(numbers.next) {
+                return Err(error(line, IesProblem::TrailingData(token.to_string())));
+            }
+            Ok((vertical_deg, horizontal_deg, symmetry, values))
+        })();
+        let (vertical_deg, horizontal_deg, symmetry, values) = match (table, overlong) {
+            (Ok(table), _) => table,
+            (
+                Err(IesError::Invalid {
+                    line: then_line,
+                    problem,
+                    ..
+                }),
+                Some((line, name, found, expected, names)),
+            ) => {
+                return Err(error(
+                    line,
+                    IesProblem::ExtraNumbers {
+                        name,
+                        found,
+                        expected,
+                        names,
+                        then_line,
+                        then: Box::new(problem),
+                    },
+                ))
+            }
+            (Err(e), _) => return Err(e),
+        };
 
         Ok(IesPhotometry {
             path: path.to_path_buf(),

@@ -361,6 +361,116 @@ fn bad_files_are_refused_at_their_line() {
 }
 
 #[test]
+fn a_count_larger_than_its_angles_names_the_count_line() {
+    // QA pass 15 of issue #16: 5 vertical angles declared on line 4 and 4 given on line 6;
+    // the 0 on line 7 (the horizontal angles) was refused as "vertical angle 5 is 0
+    // degrees, not above the one before it (90)" at line 7.
+    let tail = "0\n159 159 159 159\n";
+    let (line, problem) = refused(&format!(
+        "{HEAD}1 1000 1 5 1 1 2 0 0 0\n1 1 10\n0 30 60 90\n{tail}"
+    ));
+    assert_eq!(line, 4, "{problem}");
+    assert_eq!(
+        problem,
+        IesProblem::CountTooLarge {
+            what: "vertical",
+            count: 5,
+            given: 4,
+            given_on: "line 6 gives".to_string(),
+            value: 0.0,
+            value_line: 7,
+            previous: 90.0,
+            next: "horizontal angles",
+        }
+    );
+    assert_eq!(
+        problem.to_string(),
+        "this line declares 5 vertical angles, but line 6 gives 4: vertical angle 5 would be \
+         the 0 that starts line 7, not above the 90 before it, and the file holds fewer \
+         numbers than its counts need, so line 7 likely begins the horizontal angles (give \
+         the count of angles listed, or the missing angle)"
+    );
+    // A list that wraps is named by its lines.
+    let (line, problem) = refused(&format!(
+        "{HEAD}1 1000 1 5 1 1 2 0 0 0\n1 1 10\n0 30\n60 90\n{tail}"
+    ));
+    assert_eq!(line, 4);
+    assert!(
+        matches!(&problem, IesProblem::CountTooLarge { given_on, value_line: 8, .. } if given_on == "lines 6 to 7 give"),
+        "{problem}"
+    );
+    // Wrapping is allowed: the same list over two lines with its count right is read.
+    let ies = IesPhotometry::parse(
+        &format!("{HEAD}1 1000 1 4 1 1 2 0 0 0\n1 1 10\n0 30\n60 90\n{tail}"),
+        Path::new("wrapped.ies"),
+    )
+    .unwrap();
+    assert_eq!(ies.vertical_angles_deg(), [0.0, 30.0, 60.0, 90.0]);
+    // Where the file is not short of numbers, an angle out of order at a line's start is
+    // just that.
+    assert!(matches!(
+        refused(&format!(
+            "{HEAD}1 100 1 2 1 1 2 0 0 0\n1 1 5\n90\n90\n0\n10 10\n"
+        )),
+        (7, IesProblem::NotIncreasing { .. })
+    ));
+}
+
+#[test]
+fn a_stray_number_on_the_lamp_or_ballast_line_is_named_at_its_line() {
+    // QA pass 15 of issue #16: a fourth number on the ballast line (`1 1 10 5`) was read
+    // as vertical angle 1, and the error named the next line's 0 as vertical angle 2.
+    let table = "0 30 60 90\n0\n159 159 159 159\n";
+    let (line, problem) = refused(&format!("{HEAD}1 1000 1 4 1 1 2 0 0 0\n1 1 10 5\n{table}"));
+    assert_eq!(line, 5, "{problem}");
+    assert_eq!(
+        problem,
+        IesProblem::ExtraNumbers {
+            name: "ballast line",
+            found: 4,
+            expected: 3,
+            names: "the ballast factor, the third factor and the input watts",
+            then_line: 6,
+            then: Box::new(IesProblem::NotIncreasing {
+                what: "vertical",
+                index: 2,
+                previous: 5.0,
+                value: 0.0
+            }),
+        }
+    );
+    assert_eq!(
+        problem.to_string(),
+        "this line has 4 numbers, where the ballast line takes 3 (the ballast factor, the \
+         third factor and the input watts): the extra one moves every number after it one \
+         place on, and line 6 then reads: vertical angle 2 is 0 degrees, not above the one \
+         before it (5): angles must increase"
+    );
+    // An eleventh number on the lamp line.
+    let (line, problem) = refused(&format!("{HEAD}1 1000 1 4 1 1 2 0 0 0 7\n1 1 10\n{table}"));
+    assert_eq!(line, 4, "{problem}");
+    assert!(
+        matches!(
+            &problem,
+            IesProblem::ExtraNumbers {
+                name: "lamp line",
+                found: 11,
+                expected: 10,
+                then_line: 6,
+                ..
+            }
+        ),
+        "{problem}"
+    );
+    // The lamp and ballast lines on one line, as some writers give them, are read.
+    assert!(IesPhotometry::parse(
+        &format!("{HEAD}1 1000 1 4 1 1 2 0 0 0 1 1 10\n{table}"),
+        Path::new("one-line.ies"),
+    )
+    .is_ok());
+}
+
+#[test]
 fn messages_name_file_line_and_what_was_expected() {
     let error = IesPhotometry::parse(
         &format!("{HEAD}1 100 1 2 1 1 2 0 0 0\n1 1 5\n0 90\n0\n10 x\n"),
