@@ -316,11 +316,23 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
             Exposure::Auto => tonemap::scale_for(white),
         };
         let shown = report::significant(scale, 4);
+        // QA pass 15 of issue #16: a view whose every pixel shows an emitter printed the
+        // fallback 1 as what its brightest pixels give; all pixels count there now, and a
+        // view with nothing lit says so.
+        let own = match view.auto_exposure_white() {
+            Some(own) => format!(
+                "the view's own brightest 2 % of pixels would give {}",
+                report::significant(tonemap::scale_for(Some(own)), 4)
+            ),
+            None => "the view's own brightest 2 % of pixels give no exposure: no pixel \
+                     shows light"
+                .to_string(),
+        };
         let how = match (args.tone.exposure, white) {
             (Exposure::Auto, Some(white)) => format!(
                 "auto: {}, the mean radiosity of the brightest 2 % of the {}, \
                  is white, as `render` makes it, estimated at {} points by {} paths each; \
-                 the view's own brightest 2 % of pixels would give {}; ",
+                 {own}; ",
                 report::significant(white, 5),
                 // QA of issue #16: said of a scene with no non-emitting area.
                 if scene.surfaces.iter().all(|s| s.emission.max_band() > 0.0) {
@@ -330,7 +342,6 @@ pub fn run(args: PathTraceArgs) -> Result<()> {
                 },
                 radiosity::pathtrace::EXPOSURE_POINTS,
                 radiosity::pathtrace::EXPOSURE_PATHS,
-                report::significant(view.auto_exposure_scale(), 4)
             ),
             // QA of issue #16: the fallback was presented as measured.
             (Exposure::Auto, None) => "auto: nothing is lit (no light reaches the surfaces' \

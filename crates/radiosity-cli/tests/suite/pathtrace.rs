@@ -373,3 +373,46 @@ fn compare_prints_one_exposure_line_and_says_how_its_two_noise_figures_differ() 
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_view_of_emitters_only_measures_its_own_exposure() {
+    // QA pass 15 of issue #16: in a box whose every face emits 1 with reflectance 0.5 (B = 2
+    // everywhere) every pixel shows an emitter, and "the view's own brightest 2 % of pixels
+    // would give 1" printed the fallback, not the 0.5 they give.
+    let dir = scratch_dir("pathtrace-glow");
+    std::fs::write(
+        dir.join("glow.scene"),
+        "MAX_PATCH_AREA 0.25\nINTEGRAL_STEPS 2\nSCENEBEGIN\nBOXBEGIN\n#Glow\nFACING IN\n\
+         Er 1\nEg 1\nEb 1\nRr 0.5\nRg 0.5\nRb 0.5\nORIGIN 0 0 0\nSIZE 2 2 2\nBOXEND\n\
+         SCENEEND\n",
+    )
+    .unwrap();
+    let out = radiosity(
+        &[
+            "pathtrace",
+            "glow.scene",
+            "--width",
+            "16",
+            "--paths",
+            "64",
+            "-o",
+            "g.png",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let key = "the view's own brightest 2 % of pixels would give ";
+    let at = err
+        .find(key)
+        .unwrap_or_else(|| panic!("no `{key}` in:\n{err}"))
+        + key.len();
+    let scale: f64 = err[at..]
+        .split(';')
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number after `{key}` in:\n{err}"));
+    // 1 / 2, less the noise that lifts the brightest pixels (64 paths a pixel).
+    assert!((0.35..0.55).contains(&scale), "{scale}: {err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -271,23 +271,34 @@ impl PathTraced {
     }
 
     /// An exposure for a view without a radiosity solution, by the rule of
-    /// [`crate::render::tonemap::Exposure::Auto`] over the film: the mean of the largest
-    /// band of the brightest [`crate::render::tonemap::AUTO_EXPOSURE_TOP_AREA`] (2 %) of the
-    /// pixels that show no emitter, each of weight one, is white; 1 when that is zero or
-    /// there is no such pixel. It is a statistic of the view (the share of the picture),
-    /// where the radiosity exposure weighs the whole scene's area, so the two differ where
-    /// the view leaves out the brightest surfaces; when a radiosity solution of the scene is
-    /// at hand, its exposure is the one to share. A mean of many noisy pixels is far less
-    /// biased than their largest, which the noise pushes up.
+    /// [`crate::render::tonemap::Exposure::Auto`] over the film: the radiosity that
+    /// [`PathTraced::auto_exposure_white`] gives is white; 1 when there is none. It is a
+    /// statistic of the view (the share of the picture), where the radiosity exposure weighs
+    /// the whole scene's area, so the two differ where the view leaves out the brightest
+    /// surfaces; when a radiosity solution of the scene is at hand, its exposure is the one
+    /// to share. A mean of many noisy pixels is far less biased than their largest, which
+    /// the noise pushes up.
     pub fn auto_exposure_scale(&self) -> f64 {
-        let lit = self
-            .film
-            .samples()
-            .iter()
-            .zip(&self.shows_emitter)
-            .filter(|(_, &emitter)| !emitter)
-            .map(|(s, _)| (Rgb(*s).max_band(), 1.0));
-        scale_for(top_mean(lit, AUTO_EXPOSURE_TOP_AREA))
+        scale_for(self.auto_exposure_white())
+    }
+
+    /// The mean of the largest band of the brightest
+    /// [`crate::render::tonemap::AUTO_EXPOSURE_TOP_AREA`] (2 %) of the pixels that show no
+    /// emitter, each of weight one; of all pixels when every pixel shows an emitter (as the
+    /// radiosity rule counts all area when every surface emits). `None` when the film has
+    /// no pixel or that mean is not above 0 (nothing lit to expose for).
+    pub fn auto_exposure_white(&self) -> Option<f64> {
+        let pixels = |lit_only: bool| {
+            self.film
+                .samples()
+                .iter()
+                .zip(&self.shows_emitter)
+                .filter(move |(_, &emitter)| !(lit_only && emitter))
+                .map(|(s, _)| (Rgb(*s).max_band(), 1.0))
+        };
+        top_mean(pixels(true), AUTO_EXPOSURE_TOP_AREA)
+            .or_else(|| top_mean(pixels(false), AUTO_EXPOSURE_TOP_AREA))
+            .filter(|&white| white > 0.0)
     }
 }
 
@@ -314,8 +325,19 @@ mod tests {
             PathTraced::from_parts(film, vec![Rgb::BLACK; 101], vec![0.0; 101], emitter, 4)
         };
         assert_eq!(view(emitter, film.clone()).auto_exposure_scale(), 0.25);
-        // Every pixel an emitter: nothing to expose for, scale 1.
-        assert_eq!(view(vec![true; 101], film).auto_exposure_scale(), 1.0);
+        // Every pixel an emitter (QA pass 15 of issue #16: a glowing box printed the
+        // fallback 1): all pixels count, as all area does where every surface emits. The
+        // brightest 2 % of 101 pixels are 2.02 of them: 40, 5 and 0.02 of the 3.
+        let white = view(vec![true; 101], film).auto_exposure_white().unwrap();
+        let expected = (40.0 + 5.0 + 0.02 * 3.0) / 2.02;
+        assert!((white - expected).abs() < 1e-12, "{white} vs {expected}");
+        // Nothing lit: no white, scale 1.
+        let dark = Film::new(101, 1, 1, FilmContent::Radiosity);
+        assert_eq!(
+            view(vec![false; 101], dark.clone()).auto_exposure_white(),
+            None
+        );
+        assert_eq!(view(vec![false; 101], dark).auto_exposure_scale(), 1.0);
     }
 
     #[test]
