@@ -828,8 +828,11 @@ pub fn plain_number_reason(value: &str, reason: &str) -> String {
                 .any(|m| hi.parse::<u64>() == Ok(*m));
             // Past the top ("--max-bounces 5000000000" for a u32): "at least 0" would be
             // true of the value given (QA of issue #16), so the top is named.
-            let past_top = match (value.trim().parse::<u128>(), hi.parse::<u128>()) {
+            // A run of digits too long even for a u128 is past any top too.
+            let digits = value.trim().trim_start_matches('+');
+            let past_top = match (digits.parse::<u128>(), hi.parse::<u128>()) {
                 (Ok(v), Ok(h)) => v > h,
+                (Err(_), Ok(_)) => !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()),
                 _ => false,
             };
             return if unbounded && !past_top {

@@ -499,7 +499,7 @@ pub fn light_lands(scene: &Scene, solution: &Solution) -> bool {
 }
 
 /// The power arriving at the elements' fronts in `band`, from other elements and point
-/// luminaires: A (B - E) / rho summed over the elements of reflectance rho > 0, with E the
+/// luminaires: A (B - E) / rho summed over the elements of reflectance rho > 1e-6, with E the
 /// surface's own emission (B - E = rho x irradiance, luminaires' direct light included).
 /// Light reflected many times counts once per landing, so this exceeds the emitted power
 /// where the surfaces reflect nearly all of it.
@@ -512,7 +512,8 @@ fn landed_power(scene: &Scene, solution: &Solution, band: usize) -> f64 {
         .filter_map(|(element, b)| {
             let surface = scene.surfaces.get(element.surface as usize)?;
             let rho = surface.reflectance.band(band);
-            (rho > 0.0)
+            // Reflectance near 0 would magnify the rounding of B - E (review).
+            (rho > 1e-6)
                 .then(|| element.area * (b.band(band) - surface.emission.band(band)).max(0.0) / rho)
         })
         .sum()

@@ -1321,12 +1321,19 @@ pub fn camera(args: &CameraArgs, scene: &Scene) -> Result<Camera> {
     ] {
         // A point the automatic camera chose (QA pass 15 of issue #16: a scene 1e-20 m
         // across was told "--eye ... is out of range" without any --eye given).
+        // The scene file's own camera, where it has one, else the automatic camera
+        // (review: a file's far camera was called automatic).
         if far(point) && !given {
             bail!(
-                "the automatic camera cannot frame this scene: it is {} across, and its {} \
+                "{} cannot frame this scene: it is {} across, and its {} \
                  ({},{},{}) lands farther than 1e9 times that from its centre, where rays \
                  lose their precision; give --eye and --look-at, or --scale to bring the \
                  scene's numbers nearer to 1",
+                if scene.camera.is_some() {
+                    "the scene file's own camera"
+                } else {
+                    "the automatic camera"
+                },
                 crate::report::significant(size, 4),
                 if flag == "--eye" {
                     "eye"

@@ -253,7 +253,9 @@ pub fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 /// (at most [`MAX_PIECE_DEPTH`] times), and each piece's exact solid angle is weighted by the
 /// intensity towards its centroid and by whether the segment from its centroid to the light
 /// is clear (`blocked`). For an isotropic light and no occluder this is exact (the solid
-/// angles add up), so a closed room receives every lumen to rounding; for any other
+/// angles add up), so a closed room receives every lumen to rounding. A piece whose
+/// corners' intensities jump (by [`INTENSITY_JUMP`], where [`JUMP_FLUX`] of the lumens is
+/// at stake) is split further, to [`MIN_PIECE_SOLID_ANGLE`]. For any other
 /// distribution the pieces are small seen from the light, so a surface a few centimetres
 /// from it is not short-changed (QA of issue #16: a COSINE light 5 cm below a ceiling put
 /// only 82 % of its lumens on the default mesh, the pieces above it seen from the light
@@ -272,6 +274,7 @@ pub fn power_onto(
     if normal.dot(p - poly[0]) <= 0.0 {
         return Rgb::BLACK;
     }
+    let flux = light.flux();
     let mut sum = Rgb::BLACK;
     let mut stack: Vec<([DVec3; 3], u32)> = Vec::new();
     for i in 1..poly.len() - 1 {
@@ -289,10 +292,16 @@ pub fn power_onto(
                 // table that ends at 90 degrees: the piece straddling the horizon took all
                 // or nothing from its centroid, and 101.4 % of a light's lumens landed in
                 // a closed room; QA pass 15 of issue #16).
+                // Only where the light at stake counts: the noisy back of a measured table
+                // (0.3, 0, 1.2 cd) or a downlight's dim tail would otherwise split to the
+                // smallest pieces for a fraction of a lumen (review).
                 let jumps = || {
+                    if matches!(light.distribution, Distribution::Isotropic) {
+                        return false;
+                    }
                     let i = s.map(|c| light.candela((c - p).normalize_or_zero()));
                     let (lo, hi) = (i[0].min(i[1]).min(i[2]), i[0].max(i[1]).max(i[2]));
-                    hi - lo > INTENSITY_JUMP * hi
+                    hi - lo > INTENSITY_JUMP * hi && (hi - lo) * omega > JUMP_FLUX * flux
                 };
                 if depth < MAX_PIECE_DEPTH
                     && (omega > MAX_PIECE_SOLID_ANGLE || (omega > MIN_PIECE_SOLID_ANGLE && jumps()))
@@ -328,20 +337,28 @@ pub fn power_onto(
 /// visibility as constant: 0.01 sr is a cone of about 3.2 degrees half-angle, over which a
 /// COSINE light's intensity varies by at most 5.6 % of its axial value (the midpoint rule's
 /// error is second order, far less), and a light's whole sphere holds at most some 1,300
-/// such pieces, so the splitting costs at most a few thousand shadow rays a light.
+/// such pieces, so the splitting costs at most a few thousand shadow rays a light (more
+/// along a cut-off: see [`MIN_PIECE_SOLID_ANGLE`]).
 pub const MAX_PIECE_SOLID_ANGLE: f64 = 0.01;
 
 /// The smallest solid angle (sr) to which [`power_onto`] splits a piece whose corners'
 /// intensities differ by more than [`INTENSITY_JUMP`] of the largest: a cone of 0.32 degrees
 /// half-angle, so that the band of pieces straddling a cut-off (a table ending at 90
-/// degrees) is a hundredth of the width it was.
+/// degrees) is a tenth of the width it was at [`MAX_PIECE_SOLID_ANGLE`].
 pub const MIN_PIECE_SOLID_ANGLE: f64 = 1e-4;
 
 /// How much a piece's corners' intensities may differ, as a fraction of the largest, before
 /// [`power_onto`] splits it further (to [`MIN_PIECE_SOLID_ANGLE`]): a quarter, far above
 /// what a smooth distribution changes across a piece of [`MAX_PIECE_SOLID_ANGLE`] (a
-/// COSINE light's 5.6 %), so only jumps and steep flanks are split.
+/// COSINE light's 5.6 %), so that jumps and steep flanks are split, and only where the
+/// difference times the piece's solid angle is above [`JUMP_FLUX`] of the light's lumens.
 pub const INTENSITY_JUMP: f64 = 0.25;
+
+/// The share of a light's lumens below which a piece's intensity jump is not worth
+/// splitting for ([`INTENSITY_JUMP`]): 1e-5, so a piece straddling a 159 cd horizon (0.6 lm
+/// of 1,000 at 0.004 sr) splits, and the back of a measured table (a candela or so of
+/// noise) does not.
+pub const JUMP_FLUX: f64 = 1e-5;
 
 /// How many times [`power_onto`] may halve a piece's edges (4^7 = 16,384 pieces from one
 /// sub-triangle), so that a surface through the light itself cannot split without end.

@@ -526,7 +526,7 @@ fn a_light_cut_off_at_the_horizon_puts_its_lumens_on_a_closed_room() {
     let flux = l.flux();
     assert!((flux - 2.0 * PI * 159.15).abs() < 1e-6 * flux, "{flux}");
     // Each face cut into 6 x 6 elements (0.44 m^2, as a mesh at MAX_PATCH_AREA 0.5 cuts
-    // it), at heights where the horizon crosses the wall elements anywhere.
+    // it), at heights that put the horizon in the walls' top row (1.33 to 2).
     let elements: Vec<Vec<DVec3>> = cube_faces(2.0)
         .iter()
         .flat_map(|f| {
@@ -544,11 +544,13 @@ fn a_light_cut_off_at_the_horizon_puts_its_lumens_on_a_closed_room() {
             .map(|e| power_onto(&l, e, ELEMENT_SUBDIVISION, clear).luminance())
             .sum();
         // What stays uncertain is the band of pieces that straddle the horizon: split to
-        // MIN_PIECE_SOLID_ANGLE (1e-4 sr, 0.6 degrees across), it holds 2 pi x 159.15 cd x
-        // 0.006 rad, 0.6 % of the flux, each piece misjudged by at most half its light and
-        // the two halves of the band evening out: 0.2 % is the bound.
+        // MIN_PIECE_SOLID_ANGLE (1e-4 sr, about 0.015 rad across), it holds 2 pi x 159.15
+        // cd x 0.015 rad, 1.5 % of the flux, each piece misjudged by part of its light with
+        // either sign, so that most of it cancels: measured 0.19 % at most at these
+        // heights (z = 1.4 and 1.6), 0.75 % before the split; 0.4 % lies between, an
+        // empirical bound, not a proof.
         assert!(
-            (got - flux).abs() < 2e-3 * flux,
+            (got - flux).abs() < 4e-3 * flux,
             "z {z}: {got} lm of {flux}"
         );
     }

@@ -284,9 +284,10 @@ impl PathTraced {
 
     /// The mean of the largest band of the brightest
     /// [`crate::render::tonemap::AUTO_EXPOSURE_TOP_AREA`] (2 %) of the pixels that show no
-    /// emitter, each of weight one; of all pixels when every pixel shows an emitter (as the
-    /// radiosity rule counts all area when every surface emits). `None` when the film has
-    /// no pixel or that mean is not above 0 (nothing lit to expose for).
+    /// emitter, each of weight one; of all pixels when those show nothing lit (every pixel
+    /// shows an emitter, as the radiosity rule counts all area when every surface emits,
+    /// or the rest is black background: a glowing panel against the sky). `None` when the
+    /// film has no pixel or neither mean is above 0 (nothing lit to expose for).
     pub fn auto_exposure_white(&self) -> Option<f64> {
         let pixels = |lit_only: bool| {
             self.film
@@ -297,6 +298,7 @@ impl PathTraced {
                 .map(|(s, _)| (Rgb(*s).max_band(), 1.0))
         };
         top_mean(pixels(true), AUTO_EXPOSURE_TOP_AREA)
+            .filter(|&white| white > 0.0)
             .or_else(|| top_mean(pixels(false), AUTO_EXPOSURE_TOP_AREA))
             .filter(|&white| white > 0.0)
     }
@@ -331,6 +333,18 @@ mod tests {
         let white = view(vec![true; 101], film).auto_exposure_white().unwrap();
         let expected = (40.0 + 5.0 + 0.02 * 3.0) / 2.02;
         assert!((white - expected).abs() < 1e-12, "{white} vs {expected}");
+        // A lit emitter against black background (review: "no pixel shows light" was
+        // printed over a glowing panel): the emitter's pixel counts. The brightest 2 % of
+        // 101 pixels are the 40 and 1.02 black ones.
+        let mut panel = vec![[0.0; 3]; 101];
+        panel[70] = [40.0; 3];
+        let mut lit = Film::new(101, 1, 1, FilmContent::Radiosity);
+        lit.par_rows_mut()
+            .for_each(|(_, row)| row.copy_from_slice(&panel));
+        let mut emitter = vec![false; 101];
+        emitter[70] = true;
+        let white = view(emitter, lit).auto_exposure_white().unwrap();
+        assert!((white - 40.0 / 2.02).abs() < 1e-12, "{white}");
         // Nothing lit: no white, scale 1.
         let dark = Film::new(101, 1, 1, FilmContent::Radiosity);
         assert_eq!(

@@ -225,6 +225,18 @@ impl Reader<'_> {
         });
     }
 
+    /// Refuses an `asset.version` other than 2.x by name.
+    fn check_version(&self, version: &str) -> Result<(), ImportError> {
+        let version = version.trim();
+        if version.split('.').next() == Some("2") {
+            return Ok(());
+        }
+        Err(self.error(format!(
+            "asset.version is \"{version}\": this reader takes glTF 2.0 (a glTF 1.0 file can \
+             be converted to 2.0, for instance by Blender's importer and exporter)"
+        )))
+    }
+
     fn soup(&mut self, bytes: &[u8]) -> Result<(FaceSoup, Format), ImportError> {
         let format = if bytes.starts_with(b"glTF") {
             self.check_glb_header(bytes)?;
@@ -232,6 +244,17 @@ impl Reader<'_> {
         } else {
             Format::Gltf
         };
+        // The version first, from the JSON as text: a glTF 1.0 file keeps its meshes and
+        // accessors in objects keyed by id, which the typed reader below refuses as "not
+        // a valid glTF 2.0 file: invalid type: map" before its version is looked at
+        // (review of QA pass 15 of issue #16).
+        if format == Format::Gltf {
+            if let Ok(value) = serde_json::from_slice::<serde_json::Value>(bytes) {
+                if let Some(version) = value["asset"]["version"].as_str() {
+                    self.check_version(version)?;
+                }
+            }
+        }
         let invalid = |e: gltf::Error| self.error(format!("not a valid glTF 2.0 file: {e}"));
         // Read, then validated in two steps: the `gltf` crate's own validation indexes the
         // accessor list with a primitive's POSITION index unchecked (gltf-json 1.4.1,
@@ -242,13 +265,7 @@ impl Reader<'_> {
         // The `gltf` crate reads any "asset.version" as 2.0; a glTF 1.0 file (materials as
         // shader techniques, other buffer rules) then failed later in puzzling ways or read
         // wrong (QA pass 15 of issue #16).
-        let version = json.asset.version.trim();
-        if version.split('.').next() != Some("2") {
-            return Err(self.error(format!(
-                "asset.version is \"{version}\": this reader takes glTF 2.0 (a glTF 1.0 file \
-                 can be converted to 2.0, for instance by Blender's importer and exporter)"
-            )));
-        }
+        self.check_version(&json.asset.version)?;
         self.check_position_indices(&json)?;
         let document = gltf::Document::from_json(json).map_err(invalid)?;
         let doc = &document;
