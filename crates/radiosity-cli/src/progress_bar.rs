@@ -126,6 +126,41 @@ pub fn progress_line_of(
     )
 }
 
+/// [`progress_line_of`] of `stage` with where it stands ([`Progress::status`]) after it; a
+/// stage of unknown length with a status says that instead of why no time left is given:
+/// "solve: 1208 shots after 10 s, unshot power 19.8 % of the emitted (stops below 1.0 %)".
+pub fn status_line(
+    stage: Stage,
+    done: u64,
+    total: u64,
+    elapsed: Duration,
+    counting: Option<Counting>,
+    status: Option<&str>,
+) -> String {
+    match (status, counting) {
+        (Some(now), Some(c)) if total < 2 => format!(
+            "{}: {done} {} after {:.0} s, {now}",
+            stage.name(),
+            if done == 1 { c.one } else { c.unit },
+            elapsed.as_secs_f64()
+        ),
+        _ => {
+            let line = progress_line_of(
+                stage.name(),
+                stage_unit(stage),
+                done,
+                total,
+                elapsed,
+                counting,
+            );
+            match status {
+                Some(now) => format!("{line}; {now}"),
+                None => line,
+            }
+        }
+    }
+}
+
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use radiosity::progress::{Progress, Stage};
 
@@ -144,6 +179,8 @@ pub struct Reporter {
     quiet: bool,
     /// What the solve stage counts (see [`Reporter::solving_with`]).
     solve_counting: Mutex<Option<Counting>>,
+    /// Where the running stage stands ([`Progress::status`]), shown with its progress.
+    status: Arc<Mutex<Option<String>>>,
 }
 
 impl Reporter {
@@ -160,6 +197,7 @@ impl Reporter {
             purpose: Mutex::new(None),
             quiet,
             solve_counting: Mutex::new(None),
+            status: Arc::new(Mutex::new(None)),
         }
     }
 
@@ -288,6 +326,7 @@ impl Reporter {
             _ => None,
         };
         let started = Instant::now();
+        let status = self.status.clone();
         let spawned = std::thread::Builder::new()
             .name("progress".into())
             .spawn(move || {
@@ -302,13 +341,13 @@ impl Reporter {
                         return;
                     }
                     if timeout.timed_out() {
-                        let line = progress_line_of(
-                            stage.name(),
-                            stage_unit(stage),
+                        let line = status_line(
+                            stage,
                             d.load(Ordering::Relaxed),
                             total,
                             started.elapsed(),
                             counting,
+                            status.lock().unwrap().as_deref(),
                         );
                         errln!("{line}");
                     }
@@ -345,10 +384,34 @@ impl Progress for Reporter {
     }
 
     fn start(&self, stage: Stage, total: u64) {
+        *self.status.lock().unwrap() = None;
         if self.lines_enabled {
             self.start_ticker(stage, total);
         }
-        if !self.bars_enabled || total < 2 {
+        if !self.bars_enabled {
+            return;
+        }
+        if total < 2 {
+            // A solve of unknown length shows a spinner with its count and status (QA pass
+            // 15 of #16: a terminal showed nothing while progressive refinement shot).
+            let counting = match stage {
+                Stage::Solve => *self.solve_counting.lock().unwrap(),
+                _ => None,
+            };
+            if let Some(c) = counting {
+                let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+                let template = format!(
+                    "{{prefix:>13}} {{spinner}} {{pos}} {} {{elapsed_precise}} {{msg}}",
+                    c.unit
+                );
+                bar.set_style(
+                    ProgressStyle::with_template(&template)
+                        .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+                );
+                bar.set_prefix(stage.name());
+                bar.enable_steady_tick(Duration::from_millis(250));
+                *self.bar.lock().unwrap() = Some(bar);
+            }
             return;
         }
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
@@ -394,6 +457,13 @@ impl Progress for Reporter {
 
     fn message(&self, text: &str) {
         self.note(text);
+    }
+
+    fn status(&self, text: &str) {
+        *self.status.lock().unwrap() = Some(text.to_string());
+        if let Some(bar) = self.bar.lock().unwrap().as_ref() {
+            bar.set_message(text.to_string());
+        }
     }
 }
 
@@ -488,6 +558,49 @@ mod tests {
         );
         // LU knows its total: it gets the percentage and the time left instead.
         assert_eq!(Counting::solve(&radiosity::solve::Solver::LU), None);
+    }
+
+    #[test]
+    fn a_status_stands_in_for_why_no_time_left() {
+        // QA pass 15 of #16: progressive refinement's lines counted shots and said nothing
+        // of how far the solve was from its end.
+        let progressive =
+            radiosity::solve::Solver::Progressive(radiosity::solve::ProgressiveSettings {
+                tolerance: 0.01,
+                max_shots: 1000,
+            });
+        let status = "unshot power 19.8 % of the emitted (stops below 1.0 %)";
+        let line = status_line(
+            Stage::Solve,
+            1208,
+            0,
+            Duration::from_secs(10),
+            Counting::solve(&progressive),
+            Some(status),
+        );
+        assert_eq!(line, format!("solve: 1208 shots after 10 s, {status}"));
+        // Without a status, the reason; a stage with a total keeps its time left.
+        let line = status_line(
+            Stage::Solve,
+            1208,
+            0,
+            Duration::from_secs(10),
+            Counting::solve(&progressive),
+            None,
+        );
+        assert!(line.contains("(no time left can be estimated: "), "{line}");
+        let line = status_line(
+            Stage::Solve,
+            5,
+            10,
+            Duration::from_secs(10),
+            None,
+            Some("status"),
+        );
+        assert_eq!(
+            line,
+            "solve: 50.0 % (5 of 10) after 10 s, about 10 s left; status"
+        );
     }
 
     #[test]

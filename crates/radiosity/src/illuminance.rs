@@ -867,6 +867,8 @@ pub struct GridAxes {
     pub step: [f64; 2],
     /// Row 0 drawn at the top, not the bottom ([`GridAxes::as_drawn`]).
     pub rows_down: bool,
+    /// Column 0 drawn at the right, not the left ([`GridAxes::as_drawn`]).
+    pub cols_left: bool,
 }
 
 impl GridAxes {
@@ -883,6 +885,7 @@ impl GridAxes {
                 first: [a[u], a[w]],
                 step: [(b[u] - a[u]).signum() * spacing, 0.0],
                 rows_down: false,
+                cols_left: false,
             });
         }
         let [u, v] = varying[..] else { return None };
@@ -894,6 +897,7 @@ impl GridAxes {
                 (b[v] - a[v]).signum() * spacing,
             ],
             rows_down: false,
+            cols_left: false,
         })
     }
 
@@ -902,11 +906,13 @@ impl GridAxes {
     /// y-up scene (`z_up` false; axes x and z), a plan seen from above with x to the
     /// right, where z grows down the picture (QA of issue #16: it was drawn as seen from
     /// below). A wall's height (y, or z in a z-up scene) runs up when it is the row axis.
-    /// Corners given high to low along the row axis draw the same picture.
+    /// Corners given high to low along either axis draw the same picture (QA passes 14
+    /// and 15 of #16: reversed corners mirrored the columns).
     pub fn as_drawn(self, z_up: bool) -> Self {
         let plan_z_down = !z_up && self.names == ['x', 'z'];
         Self {
             rows_down: plan_z_down != (self.step[1] < 0.0),
+            cols_left: self.step[0] < 0.0,
             ..self
         }
     }
@@ -982,6 +988,9 @@ pub fn grid_picture_with_axes(
     // Where row j is drawn, counted from the top.
     let rows_down = axes.is_some_and(|a| a.rows_down);
     let row_at = |j: usize| if rows_down { j } else { nv - 1 - j };
+    // Where column i is drawn, counted from the left.
+    let cols_left = axes.is_some_and(|a| a.cols_left);
+    let col_at = |i: usize| if cols_left { nu - 1 - i } else { i };
     // Room for the row labels on the left and the column labels below.
     let (left, below) = match &labels {
         Some((_, rows)) => {
@@ -1013,7 +1022,7 @@ pub fn grid_picture_with_axes(
         // reaches further (QA pass 14 of #16: "5200x").
         let mut name_x = margin + gw + 6;
         for (i, label) in cols.iter().enumerate().step_by(every_col) {
-            let centre = margin + i as i64 * cell + cell / 2;
+            let centre = margin + col_at(i) as i64 * cell + cell / 2;
             let x = centre - text_width(label, 2) / 2;
             draw_text(&mut img, x, top + gh + 6, 2, label, [0; 3]);
             name_x = name_x.max(x + text_width(label, 2) + 8);
@@ -1046,7 +1055,10 @@ pub fn grid_picture_with_axes(
         for i in 0..nu {
             let v = values.get(j * nu + i).copied().unwrap_or(0.0);
             let c = false_colour(scale_of(v));
-            let (x0, y0) = (margin + i as i64 * cell, top + row_at(j) as i64 * cell);
+            let (x0, y0) = (
+                margin + col_at(i) as i64 * cell,
+                top + row_at(j) as i64 * cell,
+            );
             for y in y0..y0 + cell {
                 for x in x0..x0 + cell {
                     let edge = x == x0 || y == y0;
@@ -1212,6 +1224,9 @@ pub fn nice_scale(max: f64) -> (f64, usize) {
     best
 }
 
+/// The least height in pixels of a [`false_colour_picture`], for its scale bar's labels.
+pub const FALSE_COLOUR_MIN_HEIGHT: u32 = 200;
+
 /// The width in pixels of the scale bar [`false_colour_picture`] adds on the right.
 pub const SCALE_BAR_WIDTH: u32 = 110;
 
@@ -1230,7 +1245,10 @@ pub fn false_colour_picture(
     ticks: usize,
 ) -> image::RgbImage {
     let total_w = width + SCALE_BAR_WIDTH;
-    let total_h = height.max(160);
+    // Tall enough that a scale of up to 8 steps labels every one: 150 px of bar at 18 px a
+    // label (QA pass 15 of #16: at 160 px, a 64-pixel view's scale of 7 steps left its
+    // sixth unlabelled).
+    let total_h = height.max(FALSE_COLOUR_MIN_HEIGHT);
     let mut img = image::RgbImage::from_pixel(total_w, total_h, image::Rgb([255; 3]));
     for y in 0..height {
         for x in 0..width {

@@ -526,6 +526,42 @@ fn grids_are_drawn_as_plans_and_elevations() {
     assert_ne!(top_left(&down), top_left(&up));
 }
 
+/// QA passes 14 and 15 of #16: a grid whose corners were given high to low drew its
+/// columns mirrored (x growing to the left) though its rows were put right. The same cells
+/// given from either corner, in any order, draw the same picture, pixel for pixel.
+#[test]
+fn a_grid_given_from_any_corner_draws_the_same_picture() {
+    let (lo, hi) = (dvec3(0.0, 0.8, 0.0), dvec3(3.0, 0.8, 2.0));
+    let corners = [
+        (lo, hi),
+        (hi, lo),
+        (dvec3(3.0, 0.8, 0.0), dvec3(0.0, 0.8, 2.0)),
+        (dvec3(0.0, 0.8, 2.0), dvec3(3.0, 0.8, 0.0)),
+    ];
+    let up = DVec3::Y;
+    let pictures: Vec<image::RgbImage> = corners
+        .iter()
+        .map(|&(a, b)| {
+            let (points, dims) = grid(a, b, 1.0, up, 100).unwrap();
+            // A value that differs at every cell, so that any mirroring shows.
+            let values: Vec<f64> = points
+                .iter()
+                .map(|p| 10.0 * p.position.x + p.position.z + 1.0)
+                .collect();
+            let axes = GridAxes::of(a, b, 1.0).unwrap().as_drawn(false);
+            grid_picture_with_axes(&values, dims, Some(axes), "")
+        })
+        .collect();
+    for (k, picture) in pictures.iter().enumerate().skip(1) {
+        assert!(
+            picture == &pictures[0],
+            "corners {:?} draw another picture than {:?}",
+            corners[k],
+            corners[0]
+        );
+    }
+}
+
 #[test]
 fn a_lamp_close_to_a_floor_reflects_what_fine_quadrature_says() {
     // QA of issue #16: the first bounce of a lamp a few cm from a surface was taken at a few
@@ -622,4 +658,30 @@ fn a_short_scale_bar_of_seven_ticks_labels_more_than_its_ends() {
         .filter(|(&now, &before)| now && !before)
         .count();
     assert_eq!(runs, 4, "{inked:?}");
+}
+
+/// QA pass 15 of #16: the false-colour picture of a 64-pixel view labelled its scale of 7
+/// steps 0, 2, 4, 7 (the sixth left out beside the top's). Every scale [`nice_scale`] gives
+/// (4 to 8 steps) has all its labels at the smallest picture.
+#[test]
+fn a_small_false_colour_picture_labels_every_step_of_its_scale() {
+    for ticks in 4..=8 {
+        let max = ticks as f64;
+        let img = false_colour_picture(&[1.0; 64 * 64], &[1.0; 64 * 64], 64, 64, max, ticks);
+        // Runs of rows with ink right of the ticks (the labels start 27 px right of the
+        // bar, which starts 8 px right of the view).
+        let x0 = 64 + 8 + 27;
+        let inked: Vec<bool> = (0..img.height())
+            .map(|y| (x0..img.width()).any(|x| img.get_pixel(x, y).0 == [0; 3]))
+            .collect();
+        // Where each run of inked rows starts: one per label.
+        let starts: Vec<usize> = (0..inked.len())
+            .filter(|&y| inked[y] && (y == 0 || !inked[y - 1]))
+            .collect();
+        assert_eq!(
+            starts.len(),
+            ticks + 1,
+            "{ticks} steps: labels at {starts:?}"
+        );
+    }
 }

@@ -75,6 +75,10 @@ pub trait Progress: Sync {
     fn advance(&self, done: u64);
     /// The current stage ended after `elapsed` wall-clock time.
     fn finish(&self, stage: Stage, elapsed: Duration);
+    /// Where the current stage stands, for a stage whose length is not known in advance:
+    /// "unshot power 3.2 % of the emitted (stops below 1 %)". Replaces the last status;
+    /// shown with the stage's progress, not printed as a message.
+    fn status(&self, _text: &str) {}
     /// An informational message (for example the reciprocity error found).
     fn message(&self, _text: &str) {}
     /// Names the file the stage that just finished read or wrote ("cornell.ff"), for

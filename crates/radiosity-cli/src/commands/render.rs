@@ -79,11 +79,13 @@ pub fn check(args: &RenderArgs) -> Result<Checked> {
         if args.snapshots.is_some() {
             bail!("--false-colour draws the solved scene once; drop --snapshots");
         }
-        if let Some(max) = args.lux_max {
-            if !(max.is_finite() && max > 0.0) {
-                let max = crate::report::typed(max);
-                bail!("--lux-max {max}: give the top of the scale in lux, a number above 0");
-            }
+    }
+    // Refused whether or not --false-colour uses it, as every bad number is (QA pass 15 of
+    // #16: without --false-colour it was only warned about).
+    if let Some(max) = args.lux_max {
+        if !(max.is_finite() && max > 0.0) {
+            let max = crate::report::typed(max);
+            bail!("--lux-max {max}: give the top of the scale in lux, a number above 0");
         }
     }
     if let Some(dir) = &args.snapshots {

@@ -98,9 +98,6 @@ pub fn run(args: ViewArgs) -> Result<()> {
     if kind == SolverKind::Hierarchical {
         let max_area = args.max_area.unwrap_or(options.settings.max_patch_area);
         let min_area = args.min_area.unwrap_or(max_area / 16.0);
-        if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
-            bail!("--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0", args.epsilon);
-        }
         if !(min_area > 0.0 && min_area.is_finite()) {
             let min_area = crate::report::typed(min_area);
             bail!("--min-area {min_area}: give the smallest element area (scene units squared), a number above 0");
@@ -154,6 +151,20 @@ fn check_flags(args: &ViewArgs) -> Result<()> {
                 "warning: {} ignored: without --screenshot the window stays open",
                 given.join(", ")
             );
+        }
+    }
+    // Refused whether or not the solver uses them, as `render` refuses them (QA pass 15 of
+    // #16: `view --epsilon 0` was only warned about without --solver hierarchical).
+    if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
+        bail!(
+            "--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0",
+            crate::report::typed(args.epsilon)
+        );
+    }
+    if let Some(min_area) = args.min_area {
+        if !(min_area > 0.0 && min_area.is_finite()) {
+            let min_area = crate::report::typed(min_area);
+            bail!("--min-area {min_area}: give the smallest element area (scene units squared), a number above 0");
         }
     }
     let hierarchical = args.solver == SolverKind::Hierarchical;

@@ -951,6 +951,17 @@ fn every_command_that_prints_notes_takes_quiet() {
         err.contains("give the points along each axis of an element, a whole number of at least 1"),
         "{err}"
     );
+    // A bad --epsilon is refused as `render` refuses it, whichever solver runs (QA pass 15:
+    // without --solver hierarchical it was only warned about).
+    for solver in ["auto", "hierarchical"] {
+        let out = radiosity(&["view", "-q", "--solver", solver, "--epsilon", "0"], &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{solver}: {err}");
+        assert!(
+            err.contains("--epsilon 0: give hierarchical radiosity's refinement threshold"),
+            "{solver}: {err}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -181,6 +181,8 @@ fn render_false_colour_draws_lux_with_a_scale_bar_and_refuses_what_it_cannot_dra
             vec!["--false-colour", "--lux-max", "0", "-o", "z.png"],
             "--lux-max 0",
         ),
+        // A bad number is refused whether or not the run would use it (QA pass 15).
+        (vec!["--lux-max", "0", "-o", "z.png"], "--lux-max 0"),
     ] {
         let mut full = vec!["render", room_ref()];
         full.extend(args.iter().copied());

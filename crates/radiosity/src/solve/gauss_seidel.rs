@@ -97,6 +97,10 @@ pub(super) fn solve(
         }
         smallest_change = smallest_change.min(estimate);
         residual = estimate;
+        progress.status(&format!(
+            "the last sweep changed B by {estimate:.1e} of the largest emission (stops below \
+             {tolerance:.0e})"
+        ));
         if estimate < tolerance {
             let true_residual = relative_residual(f, light, &b)
                 .into_iter()

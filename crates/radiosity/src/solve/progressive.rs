@@ -242,6 +242,15 @@ pub fn solve_progressive(
             };
             progress.advance(1);
             let now = fraction(power);
+            if shots % 16 == 1 {
+                // QA pass 15 of #16: the progress lines counted shots with no word of how
+                // far the solve was from stopping.
+                progress.status(&format!(
+                    "unshot power {} of the emitted (stops below {})",
+                    percent(now),
+                    percent(tolerance)
+                ));
+            }
             if !now.is_finite() || power.iter().any(|p| !p.is_finite()) {
                 super::finite::check_finite(&b, "progressive refinement", || {
                     format!("shot {shots}")
@@ -307,4 +316,15 @@ pub fn solve_progressive(
         if stopped { " (stopped early)" } else { "" }
     ));
     Ok((Radiosity(b), report))
+}
+
+/// A fraction as a percentage with two significant digits or more: "3.2 %", "0.0041 %".
+fn percent(fraction: f64) -> String {
+    let p = 100.0 * fraction;
+    if !p.is_finite() || p >= 1.0 || p == 0.0 {
+        format!("{p:.1} %")
+    } else {
+        let decimals = (1.0 - p.log10().floor()).clamp(1.0, 12.0) as usize;
+        format!("{p:.decimals$} %")
+    }
 }

@@ -416,3 +416,65 @@ fn refusals() {
     assert_eq!(report.shots, 0);
     assert!(b.0.iter().all(|&x| x == Rgb::BLACK));
 }
+
+/// Records the statuses a solve reports ([`radiosity::progress::Progress::status`]).
+#[derive(Default)]
+struct Statuses(std::sync::Mutex<Vec<String>>);
+
+impl radiosity::progress::Progress for Statuses {
+    fn start(&self, _stage: radiosity::progress::Stage, _total: u64) {}
+    fn advance(&self, _done: u64) {}
+    fn finish(&self, _stage: radiosity::progress::Stage, _elapsed: std::time::Duration) {}
+    fn status(&self, text: &str) {
+        self.0.lock().unwrap().push(text.to_string());
+    }
+}
+
+/// QA pass 15 of #16: progressive refinement's progress lines counted shots and said
+/// nothing of how far the solve was from stopping. Its status gives the unshot power after
+/// shots 1, 17, 33, ..., the fraction the observer is shown after the same shot.
+#[test]
+fn progressive_status_gives_the_unshot_power_the_observer_sees() {
+    let scene = unit_cube(|i| if i == 1 { [1.0, 2.0, 3.0] } else { [0.0; 3] });
+    let s = setup(&scene, 0.05);
+    let statuses = Statuses::default();
+    let mut fractions = Vec::new();
+    solve_progressive(
+        &s.ctx(),
+        FormFactorMethod::AreaIntegral { steps: 1 },
+        &s.light,
+        &ProgressiveSettings {
+            tolerance: 0.01,
+            max_shots: 1_000_000,
+        },
+        &mut |step| {
+            if let Step::Shot(shot) = step {
+                fractions.push(shot.unshot_fraction);
+            }
+            ControlFlow::Continue(())
+        },
+        &statuses,
+    )
+    .unwrap();
+    let statuses = statuses.0.into_inner().unwrap();
+    assert!(fractions.len() > 16, "{} shots", fractions.len());
+    assert_eq!(statuses.len(), fractions.len().div_ceil(16));
+    for (k, status) in statuses.iter().enumerate() {
+        let percent: f64 = status
+            .strip_prefix("unshot power ")
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("{status}"));
+        let expected = 100.0 * fractions[16 * k];
+        // Printed to two significant digits or one decimal: within 5 % of the value.
+        assert!(
+            (percent - expected).abs() <= 0.05 * expected,
+            "after shot {}: {status} against {expected} %",
+            16 * k + 1
+        );
+        assert!(
+            status.ends_with("of the emitted (stops below 1.0 %)"),
+            "{status}"
+        );
+    }
+}

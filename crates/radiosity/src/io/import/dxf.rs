@@ -1105,6 +1105,36 @@ impl Builder<'_> {
                 defined_at: Some((materials_file.to_string(), line)),
             });
         }
+        // Tables no layer with faces takes are checked too, as every glTF material is (QA
+        // pass 15 of #16: an emission of -5 on a misspelt layer passed unremarked).
+        let unused = table
+            .layers
+            .iter()
+            .filter(|(name, _)| !self.layers.contains(name))
+            .map(|(name, m)| (format!("[layers.\"{name}\"]"), m))
+            .chain(
+                table
+                    .default
+                    .as_ref()
+                    .filter(|_| self.layers.iter().all(|l| table.layers.contains_key(l)))
+                    .map(|m| ("[default]".to_string(), m)),
+            );
+        for (name, m) in unused {
+            let reflectance = Rgb(*m.reflectance.get_ref());
+            let emission = Rgb(m.emission.as_ref().map_or([0.0; 3], |e| *e.get_ref()));
+            if let Some((field, message)) = material_problem(reflectance, emission) {
+                let at = match (field, &m.emission) {
+                    (MaterialField::Emission, Some(e)) => e.span().start,
+                    _ => m.reflectance.span().start,
+                };
+                return Err(ImportError::BadMaterial {
+                    file: materials_file.to_string(),
+                    line: table.line_at(at),
+                    name: format!("{name}, used by no layer with faces"),
+                    message,
+                });
+            }
+        }
         for (corners, layer, line) in self.faces {
             soup.faces.push(SoupFace {
                 object: layer,

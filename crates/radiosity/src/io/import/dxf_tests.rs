@@ -396,6 +396,35 @@ fn a_missing_layer_or_materials_file_lists_the_layers_found() {
         e.starts_with("t.materials.toml:5: error: material \"Wall\": the green reflectance"),
         "{e}"
     );
+    // A table no layer takes is checked as well, at the value's line (QA pass 15: an
+    // emission of -5 on a misspelt layer's table passed unremarked), and so is a [default]
+    // that every layer's own table overrides.
+    let e = err(
+        &text,
+        Some(
+            "[layers.Floor]\nreflectance = [0.5, 0.5, 0.5]\n[layers.Wall]\n\
+             reflectance = [0.5, 0.5, 0.5]\n[layers.Lamp]\nreflectance = [0.5, 0.5, 0.5]\n\
+             emission = [-5, 1, 1]\n",
+        ),
+    );
+    assert!(
+        e.starts_with(
+            "t.materials.toml:7: error: material \"[layers.\"Lamp\"], used by no layer with \
+             faces\": the red emission is -5"
+        ),
+        "{e}"
+    );
+    let e = err(
+        &text,
+        Some(
+            "[layers.Floor]\nreflectance = [0.5, 0.5, 0.5]\n[layers.Wall]\n\
+             reflectance = [0.5, 0.5, 0.5]\n[default]\nreflectance = [1.5, 0.5, 0.5]\n",
+        ),
+    );
+    assert!(
+        e.starts_with("t.materials.toml:6: error: material \"[default], used by no layer"),
+        "{e}"
+    );
     // Not TOML, or a misspelt key: the line.
     let e = err(
         &text,
