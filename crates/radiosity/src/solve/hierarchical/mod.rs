@@ -458,9 +458,13 @@ pub fn solve_hierarchical(
     // points as its progress (QA of issue #16: on large scenes it ran for a minute inside
     // the solve stage, whose lines counted refinement rounds that no longer changed).
     let (mut iterations, mut residual) = (iterations, residual);
+    // The sweeps of the refinement rounds, reported apart from the gather's passes (QA of
+    // issue #16: "sweeps" counted both).
+    let (round_sweeps, mut gather_passes) = (iterations, 0);
     let gathered = if settings.final_gather && lit {
         let g = solver.final_gather(emitted, progress)?;
-        iterations += g.sweeps + g.passes;
+        gather_passes = g.sweeps + g.passes;
+        iterations += gather_passes;
         residual = g.residual;
         Some(g.h_of)
     } else {
@@ -499,16 +503,20 @@ pub fn solve_hierarchical(
         gather_points: solver.gathered_at,
         elapsed: start.elapsed(),
     };
+    let passes = match gather_passes {
+        1 => String::from(" (1 pass)"),
+        n => format!(" ({n} passes)"),
+    };
     let gather = match report.gather_points {
         0 => String::from("no final gather"),
-        p if p == report.leaves => String::from("final gather at every leaf"),
-        p => format!("final gather at {p} points (patches of several leaves)"),
+        p if p == report.leaves => format!("final gather at every leaf{passes}"),
+        p => format!("final gather at {p} points (patches of several leaves){passes}"),
     };
     let (shapes_computed, shapes_reused) = solver.near_pairs.counts();
     progress.message(&format!(
         "hierarchical radiosity: {} leaves (the elements of its solution: patches of at most MAX_PATCH_AREA, subdivided where the light varies), {} clusters, {} links ({} initial), {} rounds, {} sweeps, {} rays, {gather}; \
          exact near-pair form factors: {shapes_computed} pair shapes computed, {shapes_reused} pairs of the same shapes reused",
-        report.leaves, report.clusters, report.links, report.initial_links, rounds, iterations, report.rays
+        report.leaves, report.clusters, report.links, report.initial_links, rounds, round_sweeps, report.rays
     ));
     Ok(HierarchicalSolution {
         mesh,
