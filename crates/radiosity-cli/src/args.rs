@@ -655,7 +655,9 @@ pub struct BenchArgs {
     /// Override the scene's INTEGRAL_STEPS.
     #[arg(long, value_name = "K", value_parser = parse_steps)]
     pub steps: Option<u32>,
-    /// Runs per configuration; the table shows the median of each column.
+    /// Runs per configuration; the table shows the median of each column. Runs that would
+    /// take more than an hour at the first run's time are refused after it (see
+    /// --no-work-limit).
     #[arg(long, default_value_t = 5, value_name = "N", value_parser = parse_at_least_1)]
     pub repeat: u32,
     /// Solver for (I - rho F) B = E.
@@ -695,8 +697,9 @@ pub struct BenchArgs {
     /// Time even work estimated at about an hour or more (20 minutes to 2.5 hours by kind,
     /// at rates measured on two cores), refused otherwise before the first run
     /// (as for `render --no-work-limit`: element pairs x INTEGRAL_STEPS^4 point pairs,
-    /// Monte Carlo samples, hemicube resolution, pixels x --supersample^2). Memory limits
-    /// still hold.
+    /// Monte Carlo samples, hemicube resolution, pixels x --supersample^2), and --repeat
+    /// runs of a configuration past an hour at its first run's time, refused otherwise after
+    /// that run. Memory limits still hold.
     #[arg(long)]
     pub no_work_limit: bool,
 }

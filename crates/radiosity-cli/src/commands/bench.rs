@@ -1,17 +1,20 @@
 //! `radiosity bench`: time every stage of the whole pipeline, the median of several runs.
 
+use std::io::IsTerminal;
 use std::path::Path;
+use std::time::Instant;
 
 use anyhow::Result;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use radiosity::pipeline::SolutionReport;
 use radiosity::progress::Stage;
 use radiosity::render::{Camera, RenderSettings};
 use radiosity::shade::Exposure;
 use radiosity::solve::keep_going;
 
-use super::{shade_and_render, solve_scene};
+use super::{bench_time, shade_and_render, solve_scene};
 use crate::args::{BenchArgs, SceneArgs, SolveOptions};
-use crate::progress_bar::Reporter;
+use crate::progress_bar::{Reporter, LINE_EVERY};
 use crate::report::{self, BenchRow};
 use crate::setup::prepare_solve;
 
@@ -71,9 +74,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         args.quiet,
     );
     for max_area in areas {
-        let runs = (0..args.repeat)
-            .map(|_| bench_run(&args, max_area, settings))
-            .collect::<Result<Vec<_>>>()?;
+        let runs = repeat_runs(&args, max_area, settings)?;
         let first = &runs[0];
         if !args.quiet && runs.iter().any(|r| r.rays != first.rays) {
             errln!("note: the ray count differed between runs");
@@ -104,6 +105,56 @@ pub fn run(args: BenchArgs) -> Result<()> {
         report::bench_row(&name, max_area, &row);
     }
     Ok(())
+}
+
+/// The `--repeat` runs of one configuration, refused after the first when the rest would
+/// take longer than [`bench_time::MAX_BENCH_SECONDS`] (unless `--no-work-limit`), with a
+/// progress bar on a terminal or a line every [`LINE_EVERY`] elsewhere unless `--quiet`
+/// (QA pass 16 of #16: `--repeat 1000000` started some 100 hours of runs, silent).
+fn repeat_runs(
+    args: &BenchArgs,
+    max_area: Option<f64>,
+    settings: RenderSettings,
+) -> Result<Vec<BenchRun>> {
+    let start = Instant::now();
+    let first = bench_run(args, max_area, settings)?;
+    if !args.no_work_limit {
+        bench_time::check_repeat_time(start.elapsed(), args.repeat).map_err(anyhow::Error::msg)?;
+    }
+    let terminal = std::io::stderr().is_terminal();
+    let bar = (!args.quiet && terminal && args.repeat > 1).then(|| {
+        let bar =
+            ProgressBar::with_draw_target(Some(args.repeat as u64), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{prefix:>13} [{bar:40}] {percent:>3}% ({pos} of {len} runs) \
+                 {elapsed_precise} eta {eta}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        bar.set_prefix("bench");
+        bar.set_position(1);
+        bar
+    });
+    let mut last_line = Instant::now();
+    let mut runs = vec![first];
+    while runs.len() < args.repeat as usize {
+        runs.push(bench_run(args, max_area, settings)?);
+        if let Some(bar) = &bar {
+            bar.inc(1);
+        } else if !args.quiet && last_line.elapsed() >= LINE_EVERY {
+            last_line = Instant::now();
+            errln!(
+                "{}",
+                bench_time::repeat_progress_line(runs.len() as u32, args.repeat, start.elapsed())
+            );
+        }
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    Ok(runs)
 }
 
 /// One timed run of the whole pipeline.

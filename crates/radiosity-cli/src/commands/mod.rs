@@ -2,6 +2,7 @@
 //! and what several of them share: solving a prepared scene, shading and rendering it.
 
 pub mod bench;
+pub mod bench_time;
 pub mod check;
 pub mod compare;
 pub mod export;

@@ -488,3 +488,37 @@ fn an_objs_material_file_is_never_written_over() {
     assert_eq!(std::fs::read_to_string(dir.join("mat.mtl")).unwrap(), mtl);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_million_bench_repeats_are_refused_after_the_first_run() {
+    // QA pass 16 of #16: `bench --repeat 1000000` started some 100 hours of runs at once.
+    // Any run of the pipeline takes more than 3.6 ms, so a million of them are past the
+    // hour's limit after the first; the refusal says how many fit.
+    let dir = scratch_dir("bench-repeat");
+    let args = [
+        "bench",
+        "--max-area",
+        "20000",
+        "--size",
+        "8",
+        "--supersample",
+        "1",
+        "--repeat",
+        "1000000",
+    ];
+    let start = std::time::Instant::now();
+    let out = radiosity(&args, &dir);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("error: --repeat 1000000 at "), "{err}");
+    assert!(err.contains("more than the limit of 60.0 min"), "{err}");
+    assert!(err.contains("at most --repeat "), "{err}");
+    assert!(err.contains("--no-work-limit"), "{err}");
+    // No row of the table: nothing was timed past the first run.
+    assert!(
+        !crate::fixtures::stdout(&out).contains("| cornell"),
+        "{err}"
+    );
+    assert!(start.elapsed().as_secs() < 120, "{:?}", start.elapsed());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
