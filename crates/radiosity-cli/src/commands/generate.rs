@@ -49,6 +49,13 @@ fn flag_at_fault(e: &BuildingError, args: &BuildingArgs) -> String {
             "--light {}: give the ceiling panels' exitance in lm/m^2, a number of at least 0",
             crate::report::typed(*l)
         ),
+        // QA pass 16 of #16: the file was written and every other command refused it.
+        BuildingError::LightTooBright(l) => format!(
+            "--light {}: give the ceiling panels' exitance in lm/m^2, at most {:e} (the \
+             largest emission the other commands read)",
+            crate::report::typed(*l),
+            scene::MAX_EMISSION
+        ),
         BuildingError::TooManyRooms(n) => format!(
             "--floors {}, --rooms-x {}, --rooms-z {}: they make {n} rooms, more than the \
              limit of {}; give fewer",

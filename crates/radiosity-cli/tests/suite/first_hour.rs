@@ -1380,6 +1380,16 @@ fn generate_refusals_name_the_flag_at_fault() {
             vec!["--light", "-1"],
             "--light -1: give the ceiling panels' exitance",
         ),
+        // QA pass 16 of #16: written, then refused by every other command as above the
+        // largest emission the readers take (1e30).
+        (
+            vec!["--light", "1e31"],
+            "--light 1e31: give the ceiling panels' exitance in lm/m^2, at most 1e30",
+        ),
+        (
+            vec!["--light", "1e300"],
+            "--light 1e300: give the ceiling panels' exitance in lm/m^2, at most 1e30",
+        ),
         (
             vec!["--rooms-x", "1000", "--rooms-z", "1000"],
             "make 2000000 rooms, more than the limit of 100000",

@@ -162,6 +162,14 @@ pub enum BuildingError {
     /// The panels' exitance is negative or not a number.
     #[error("the light panels' exitance must be a number of at least 0, got {0}")]
     Light(f64),
+    /// The panels' exitance is above [`crate::scene::MAX_EMISSION`], which every reader of
+    /// the written scene refuses (QA pass 16 of #16: `--light 1e31` wrote a file no other
+    /// command would read).
+    #[error(
+        "the light panels' exitance {0:e} is above the largest the program supports ({max:e})",
+        max = crate::scene::MAX_EMISSION
+    )]
+    LightTooBright(f64),
     /// More rooms than [`BuildingParams::MAX_ROOMS`].
     #[error("{0} rooms is more than the limit of {max}", max = BuildingParams::MAX_ROOMS)]
     TooManyRooms(u64),
@@ -207,6 +215,10 @@ impl BuildingParams {
         }
         if !(self.light.is_finite() && self.light >= 0.0) {
             return Err(BuildingError::Light(self.light));
+        }
+        // The red band is the exitance itself (green and blue are 0.95 and 0.85 of it).
+        if self.light > crate::scene::MAX_EMISSION {
+            return Err(BuildingError::LightTooBright(self.light));
         }
         let rooms = self.floors as u64 * self.rooms_x as u64 * self.rooms_z as u64;
         if rooms > Self::MAX_ROOMS {

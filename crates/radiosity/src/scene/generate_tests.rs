@@ -312,6 +312,19 @@ fn bad_parameters_are_refused() {
             furniture: true
         })
     );
+    // QA pass 16 of #16: a light past the largest emission the readers take was written.
+    // 1e30 itself is the largest they read, so it passes; the next double up does not.
+    let light = |light: f64| {
+        BuildingParams {
+            light,
+            ..BuildingParams::default()
+        }
+        .check()
+    };
+    assert_eq!(light(1e30), Ok(()));
+    let above = f64::from_bits(1e30_f64.to_bits() + 1);
+    assert_eq!(light(above), Err(BuildingError::LightTooBright(above)));
+    assert_eq!(light(1e300), Err(BuildingError::LightTooBright(1e300)));
     let bare = BuildingParams {
         room_size: 2.5,
         furniture: false,
