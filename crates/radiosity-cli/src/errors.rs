@@ -159,6 +159,15 @@ pub fn hint(err: &(dyn std::error::Error + 'static)) -> Option<String> {
                  malloc arenas of 64 MiB each): raise the limit or free memory"
             )),
             SolveError::HierarchicalTooBig { .. } => Some(": raise --epsilon or --min-area".into()),
+            // QA pass 16 of #16: the area that fits, as the flag to type.
+            SolveError::MinAreaTooSmall { fits, default, .. } => match fits {
+                Some(a) if a < default => Some(format!(
+                    ": --min-area {}",
+                    radiosity::mesh::four_digits_up(*a)
+                )),
+                Some(_) => Some(": leave --min-area out".into()),
+                None => Some(": leave --min-area out, or raise --max-area".into()),
+            },
             // QA of issue #16: a closed box of reflectance 0.97 stopped with "rows summing
             // far above 1?", and the CIE 5.8 cube of 0.95 ran 100,000 sweeps.
             SolveError::HierarchicalGrowing { .. }

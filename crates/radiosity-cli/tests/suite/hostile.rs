@@ -522,3 +522,38 @@ fn a_million_bench_repeats_are_refused_after_the_first_run() {
     assert!(start.elapsed().as_secs() < 120, "{:?}", start.elapsed());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_hierarchical_min_area_past_the_element_budget_is_refused_before_the_solve() {
+    // QA pass 16 of #16: `--min-area 1e-9` was accepted and refined for minutes, memory
+    // growing. The built-in Cornell box has some 2e6 mm^2 of surfaces: cut to 1e-9 mm^2
+    // that is some 2e15 leaves, far past the 8,000,000 elements --max-area is held to.
+    let dir = scratch_dir("min-area-budget");
+    for (command, output) in [
+        ("check", None),
+        ("solve", Some("out.csv")),
+        ("render", Some("out.png")),
+    ] {
+        let mut args = vec![command, "--solver", "hierarchical", "--min-area", "1e-9"];
+        if let Some(output) = output {
+            args.extend(["-o", output]);
+        }
+        let out = radiosity(&args, &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{command}: {err}");
+        assert!(
+            err.contains("a minimum element area of 1e-9 lets hierarchical radiosity cut"),
+            "{command}: {err}"
+        );
+        assert!(
+            err.contains("more than the limit of 8000000 elements"),
+            "{command}: {err}"
+        );
+        assert!(err.contains("--min-area"), "{command}: {err}");
+        assert!(!err.contains("solve: "), "{command}: {err}");
+        if let Some(output) = output {
+            assert!(!dir.join(output).exists(), "{command}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

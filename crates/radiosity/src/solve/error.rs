@@ -25,6 +25,33 @@ pub enum SolveError {
         /// Links held.
         links: usize,
     },
+    /// Hierarchical radiosity's minimum area would let the surfaces be cut into more leaves
+    /// than the element budget ([`crate::solve::check_min_area`]); nothing was refined.
+    #[error(
+        "a minimum element area of {} lets hierarchical radiosity cut the surfaces into up \
+         to {leaves:.3e} leaves, more than the limit of {limit} elements; {}",
+        crate::mesh::compact(*min_area),
+        match fits {
+            Some(a) if *a >= *default => format!(
+                "the default, MAX_PATCH_AREA / 16 = {}, or more fits",
+                crate::mesh::four_digits_up(*default)
+            ),
+            Some(a) => format!("a minimum area of {} or more fits", crate::mesh::four_digits_up(*a)),
+            None => "no minimum area below the default (MAX_PATCH_AREA / 16) fits".to_string(),
+        }
+    )]
+    MinAreaTooSmall {
+        /// The minimum area given (scene units squared).
+        min_area: f64,
+        /// The leaves the surfaces make cut to that area.
+        leaves: f64,
+        /// The element budget ([`crate::mesh::MAX_ELEMENTS`]).
+        limit: u64,
+        /// The smallest minimum area that fits, at most the default; `None` where none does.
+        fits: Option<f64>,
+        /// The default minimum area, `MAX_PATCH_AREA / 16`, never refused.
+        default: f64,
+    },
     /// Gauss-Seidel did not reach the tolerance within the allowed sweeps.
     #[error(
         "Gauss-Seidel did not converge: after {iterations} sweeps the relative residual is \

@@ -36,8 +36,8 @@ pub(crate) mod tests;
 pub use energy::{energy_balance, escaped_by_surface, EnergyBalance};
 pub use error::SolveError;
 pub use hierarchical::{
-    solve_hierarchical, HierarchicalReport, HierarchicalSettings, HierarchicalSolution,
-    DEFAULT_HIERARCHICAL_TOLERANCE, GATHER_POINTS_DEFAULT,
+    check_min_area, solve_hierarchical, HierarchicalReport, HierarchicalSettings,
+    HierarchicalSolution, DEFAULT_HIERARCHICAL_TOLERANCE, GATHER_POINTS_DEFAULT,
 };
 pub use progressive::{
     solve_progressive, ProgressiveReport, ProgressiveState, DEFAULT_PROGRESSIVE_TOLERANCE,

@@ -146,6 +146,7 @@ mod contact;
 mod export;
 mod gather;
 mod link;
+mod min_area;
 mod near_pairs;
 mod oracle;
 mod refine;
@@ -157,6 +158,8 @@ mod visibility;
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
+
+pub use min_area::check_min_area;
 
 use super::{EnergyBalance, Radiosity, SolveError};
 use crate::geometry;
@@ -308,6 +311,9 @@ pub fn solve_hierarchical(
             value: tolerance,
         });
     }
+    // Before any node is made (QA pass 16 of #16: a minimum area of 1e-9 refined for
+    // minutes); the command line checks it sooner, before the scene's other work.
+    check_min_area(scene, max_patch_area, min_area)?;
     for (s, surface) in scene.surfaces.iter().enumerate() {
         crate::light::check_surface(s, surface.reflectance, surface.emission)
             .map_err(crate::light::LightError::from)?;
