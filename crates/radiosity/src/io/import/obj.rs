@@ -342,9 +342,12 @@ impl Reader {
                         self.material = Some(m);
                         Ok(())
                     }
-                    Err(e) => {
+                    Err(problems) => {
                         self.bad_materials.insert(name);
-                        Err(e)
+                        for e in problems {
+                            self.report(e);
+                        }
+                        Ok(())
                     }
                 }
             }
@@ -524,8 +527,10 @@ impl Reader {
         })
     }
 
-    /// The soup's material for `usemtl name` at line `n`: checked on first use.
-    fn use_material(&mut self, name: &str, n: usize) -> Result<u32, ImportError> {
+    /// The soup's material for `usemtl name` at line `n`: checked on first use, every bad
+    /// colour of it reported (QA pass 16 of #16: a `Kd 1 1 1` hid the `Ke -1 0 0` on the
+    /// next line until it was fixed), each at its own line.
+    fn use_material(&mut self, name: &str, n: usize) -> Result<u32, Vec<ImportError>> {
         if let Some(&m) = self.used.get(name) {
             return Ok(m);
         }
@@ -543,10 +548,13 @@ impl Reader {
             name: name.to_string(),
             message,
         };
+        let mut problems = Vec::new();
         let reflectance = entry.kd.map_or(Rgb([DEFAULT_REFLECTANCE; 3]), |(c, _)| c);
+        let mut reflectance_bad = false;
         if let Some((c, line)) = entry.kd {
             if let Some((band, v)) = bands(&c).find(|(_, v)| !(0.0..1.0).contains(v)) {
-                return Err(bad(
+                reflectance_bad = true;
+                problems.push(bad(
                     line,
                     format!(
                         "Kd (the reflectance) is {v} in the {band} band; it must be at least 0 \
@@ -557,22 +565,41 @@ impl Reader {
             }
         }
         let emission = entry.ke.map_or(Rgb([0.0; 3]), |(c, _)| c);
+        let mut emission_bad = false;
         if let Some((c, line)) = entry.ke {
             if let Some((band, v)) = bands(&c).find(|(_, v)| *v < 0.0) {
-                return Err(bad(
+                emission_bad = true;
+                problems.push(bad(
                     line,
                     format!("Ke (the emission) is {v} in the {band} band; it must be at least 0"),
                 ));
             }
         }
         // The soup's own check (an emission past MAX_EMISSION) at the line of the colour it
-        // names, not at `newmtl` (QA pass 13 of #16: "kd.mtl:1" for a Ke on line 3).
-        if let Some((field, message)) = material_problem(reflectance, emission) {
+        // names, not at `newmtl` (QA pass 13 of #16: "kd.mtl:1" for a Ke on line 3); a
+        // colour already refused above stands in as a good one, so it is not said twice and
+        // the other is still checked.
+        let checked = (
+            if reflectance_bad {
+                Rgb([DEFAULT_REFLECTANCE; 3])
+            } else {
+                reflectance
+            },
+            if emission_bad {
+                Rgb([0.0; 3])
+            } else {
+                emission
+            },
+        );
+        if let Some((field, message)) = material_problem(checked.0, checked.1) {
             let line = match field {
                 MaterialField::Reflectance => entry.kd.map(|(_, l)| l),
                 MaterialField::Emission => entry.ke.map(|(_, l)| l),
             };
-            return Err(bad(line.unwrap_or(entry.line), message));
+            problems.push(bad(line.unwrap_or(entry.line), message));
+        }
+        if !problems.is_empty() {
+            return Err(problems);
         }
         self.soup.materials.push(SoupMaterial {
             name: name.to_string(),

@@ -367,6 +367,53 @@ fn texture_maps_are_said_to_be_left_out() {
         .all(|w| !w.to_string().contains("texture")));
 }
 
+/// QA pass 16 of #16: a material's bad Kd hid its bad Ke on the next line until fixed.
+#[test]
+fn every_bad_colour_of_a_material_comes_in_one_run() {
+    let obj = format!("mtllib m.mtl\n{SQUARE}usemtl white\nf 1 2 3 4\n");
+    let mtl = "newmtl white\nKd 1 1 1\nKe -1 0 0\n";
+    let e = read_text(&obj, &[("m.mtl", mtl)]).unwrap_err();
+    let text = e.to_string();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 3, "{text}");
+    assert!(
+        lines[0].starts_with("m.mtl:2: error: material \"white\": Kd (the reflectance) is 1"),
+        "{text}"
+    );
+    assert!(
+        lines[1].starts_with(
+            "m.mtl:3: error: material \"white\": Ke (the emission) is -1 in the red band"
+        ),
+        "{text}"
+    );
+    assert_eq!(lines[2], "2 errors");
+    // A reflectance of 1 beside an emission past the largest supported (1e30): both, each
+    // at its line.
+    let mtl = "newmtl white\nKd 1 1 1\nKe 1e31 0 0\n";
+    let text = read_text(&obj, &[("m.mtl", mtl)]).unwrap_err().to_string();
+    assert!(
+        text.contains("m.mtl:2: error: material \"white\": Kd"),
+        "{text}"
+    );
+    assert!(
+        text.contains("m.mtl:3: error: material \"white\": the red emission is 1e31"),
+        "{text}"
+    );
+    assert!(text.ends_with("2 errors"), "{text}");
+    // Bad colours of many materials are held to the first 20, the rest counted.
+    let mut mtl = String::new();
+    let mut obj = format!("mtllib m.mtl\n{SQUARE}");
+    for k in 0..15 {
+        mtl.push_str(&format!("newmtl m{k}\nKd 2 2 2\nKe -1 -1 -1\n"));
+        obj.push_str(&format!("usemtl m{k}\nf 1 2 3 4\n"));
+    }
+    let e = read_text(&obj, &[("m.mtl", &mtl)]).unwrap_err();
+    let ImportError::Several { errors, more } = &e else {
+        panic!("{e}");
+    };
+    assert_eq!((errors.len(), *more), (20, 10), "{e}");
+}
+
 /// QA pass 14 of #16: four errors in an OBJ and its MTL took four runs, one each.
 #[test]
 fn every_error_of_an_obj_and_its_mtl_comes_in_one_run() {
