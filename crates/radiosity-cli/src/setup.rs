@@ -810,9 +810,13 @@ fn millimetres_perhaps(scene: &radiosity::scene::Scene, unit: &str, scale: f64) 
         "the light does not depend on it here, with no point luminaires or FLUX; only \
          areas and powers in m^2 do"
     };
+    // Three significant digits, as `check`'s areas: no 46 digits of a float for a model
+    // scaled by 1e20 (QA pass 16 of #16: "3082310488436984963922169586038057680706207744
+    // m^2").
     Some(format!(
-        "the largest surface is {largest:.0} m^2 read as metres; if the numbers are \
-         millimetres, --scale 0.001 reads them as metres; {consequence}"
+        "the largest surface is {} m^2 read as metres; if the numbers are millimetres, \
+         --scale 0.001 reads them as metres; {consequence}",
+        crate::report::significant(largest, 3)
     ))
 }
 
@@ -1484,3 +1488,42 @@ pub fn adapt(
 /// bookcases and chairs inherit the area method's over-counted near pairs (rows up to
 /// 1.13), and the whole picture gets brighter. Until that is fixed it is asked for.
 pub const DEFAULT_ADAPT_ROUNDS: u32 = 0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One square of `side` metres, lit.
+    fn square(side: f64) -> Scene {
+        let v = |x: f64, z: f64| glam::DVec3::new(x, 0.0, z);
+        Scene {
+            surfaces: vec![radiosity::scene::Surface {
+                name: "floor".into(),
+                vertices: vec![v(0.0, 0.0), v(side, 0.0), v(side, side), v(0.0, side)],
+                reflectance: radiosity::scene::Rgb([0.5; 3]),
+                emission: radiosity::scene::Rgb([1.0; 3]),
+                photometry: Default::default(),
+            }],
+            camera: None,
+            lights: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_huge_surface_is_noted_in_three_digits_not_fifty() {
+        // QA pass 16 of #16: a glTF scaled by 1e20 was noted as "the largest surface is
+        // 3082310488436984963922169586038057680706207744 m^2". A square of 5.552e22 m has
+        // 3.0825e45 m^2.
+        let note = millimetres_perhaps(&square(5.552e22), "metres", 1.0).unwrap();
+        assert!(
+            note.starts_with("the largest surface is 3.08e45 m^2 read as metres"),
+            "{note}"
+        );
+        // An everyday millimetre model keeps its whole number: 1,000 m square.
+        let note = millimetres_perhaps(&square(1000.0), "metres", 1.0).unwrap();
+        assert!(
+            note.starts_with("the largest surface is 1000000 m^2 read as metres"),
+            "{note}"
+        );
+    }
+}
