@@ -354,7 +354,35 @@ impl Reader {
             "mtllib" => {
                 for name in words {
                     match load_mtl(name) {
-                        Ok((mtl_file, text)) => self.read_mtl(&mtl_file, &text)?,
+                        Ok((mtl_file, text)) => {
+                            let read = self.read_mtl(&mtl_file, &text);
+                            // QA pass 16 of #16: `mtllib /etc/passwd` was read without a
+                            // word, every `usemtl` of it then missing.
+                            if read.materials == 0 {
+                                let what = if read.mtl_lines == 0 {
+                                    "is not an MTL file (no line starts with an MTL \
+                                     keyword such as newmtl, Kd or Ke), so it defines no \
+                                     materials"
+                                        .to_string()
+                                } else {
+                                    "defines no materials (no \"newmtl\" line)".to_string()
+                                };
+                                self.warnings.push(ImportWarning {
+                                    file: self.soup.file.clone(),
+                                    line: n,
+                                    message: format!(
+                                        "the material file \"{name}\"{} {what}; faces \
+                                         whose usemtl names none get the default \
+                                         reflectance {DEFAULT_REFLECTANCE}",
+                                        if mtl_file == name {
+                                            String::new()
+                                        } else {
+                                            format!(" ({mtl_file})")
+                                        }
+                                    ),
+                                });
+                            }
+                        }
                         Err(why) => self.warnings.push(ImportWarning {
                             file: self.soup.file.clone(),
                             line: n,
@@ -613,8 +641,13 @@ impl Reader {
     }
 
     /// Adds the materials of one MTL file to the library (a later definition of a name
-    /// replaces an earlier one, as in the file).
-    fn read_mtl(&mut self, file: &str, text: &str) -> Result<(), ImportError> {
+    /// replaces an earlier one, as in the file); says how many it defined and how many of
+    /// its lines were MTL statements.
+    fn read_mtl(&mut self, file: &str, text: &str) -> MtlRead {
+        let mut read = MtlRead {
+            materials: 0,
+            mtl_lines: 0,
+        };
         let mut current: Option<String> = None;
         // Texture maps, by keyword, with the first line of each: said in one warning, as a
         // material's colour in a map is lost (QA of issue #16: map_Kd went without a word).
@@ -624,6 +657,9 @@ impl Reader {
             let code = raw.split('#').next().unwrap_or("");
             let mut words = code.split_whitespace();
             let Some(key) = words.next() else { continue };
+            if MTL_KEYWORDS.contains(&key) || key.starts_with("map_") {
+                read.mtl_lines += 1;
+            }
             let syntax = |message: String| ImportError::Syntax {
                 file: file.to_string(),
                 line: n,
@@ -631,6 +667,7 @@ impl Reader {
             };
             match key {
                 "newmtl" => {
+                    read.materials += 1;
                     let name = code.trim_start().get(key.len()..).unwrap_or("").trim();
                     self.library.insert(
                         name.to_string(),
@@ -684,9 +721,45 @@ impl Reader {
                 ),
             });
         }
-        Ok(())
+        read
     }
 }
+
+/// What [`Reader::read_mtl`] found in one MTL file.
+struct MtlRead {
+    /// `newmtl` lines.
+    materials: usize,
+    /// Lines that start with an MTL keyword ([`MTL_KEYWORDS`], or a `map_` texture): none
+    /// in a file that is not an MTL file at all.
+    mtl_lines: usize,
+}
+
+/// The statements of the MTL format (Wavefront's, with the common PBR extensions), by
+/// which a file is known to be one.
+const MTL_KEYWORDS: [&str; 22] = [
+    "newmtl",
+    "Ka",
+    "Kd",
+    "Ks",
+    "Ke",
+    "Kt",
+    "Tf",
+    "Ns",
+    "Ni",
+    "d",
+    "Tr",
+    "illum",
+    "sharpness",
+    "bump",
+    "disp",
+    "decal",
+    "refl",
+    "Pr",
+    "Pm",
+    "Ps",
+    "Pc",
+    "aniso",
+];
 
 /// `r g b`, or one value for all three; every number finite.
 fn colour(values: &[&str]) -> Option<Rgb> {

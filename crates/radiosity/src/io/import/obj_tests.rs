@@ -134,6 +134,42 @@ fn materials_give_reflectance_and_emission() {
     assert_eq!(s[1].name, "default.1");
 }
 
+/// QA pass 16 of #16: `mtllib /etc/passwd` was read without a word.
+#[test]
+fn a_material_file_of_no_materials_is_warned_about_at_its_mtllib_line() {
+    let obj = format!("# a square\nmtllib p.mtl e.mtl\n{SQUARE}f 1 2 3 4\n");
+    let passwd = "root:x:0:0:root:/root:/bin/bash\ndaemon:x:1:1::/usr/sbin:/bin/false\n";
+    let empty = "# only a comment\nKd 0.5 0.5 0.5\n";
+    let e = read_text(&obj, &[("p.mtl", passwd), ("e.mtl", empty)]);
+    // The Kd before any newmtl is an error of its own (as before); the file is still an
+    // MTL file that defines nothing.
+    let text = e.unwrap_err().to_string();
+    assert!(
+        text.starts_with("e.mtl:2: error: Kd before any \"newmtl\" line"),
+        "{text}"
+    );
+    let imported = read_text(&obj, &[("p.mtl", passwd), ("e.mtl", "# nothing\nNs 10\n")]).unwrap();
+    let w: Vec<String> = imported.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        w[0],
+        "m.obj:2: warning: the material file \"p.mtl\" is not an MTL file (no line starts \
+         with an MTL keyword such as newmtl, Kd or Ke), so it defines no materials; faces \
+         whose usemtl names none get the default reflectance 0.5"
+    );
+    assert_eq!(
+        w[1],
+        "m.obj:2: warning: the material file \"e.mtl\" defines no materials (no \"newmtl\" \
+         line); faces whose usemtl names none get the default reflectance 0.5"
+    );
+    assert_eq!(w.len(), 2, "{w:?}");
+    // A file of materials says nothing.
+    let imported = read_text(
+        &obj,
+        &[("p.mtl", "newmtl a\nKd 0.2\n"), ("e.mtl", "newmtl b\n")],
+    );
+    assert!(imported.unwrap().warnings.is_empty());
+}
+
 #[test]
 fn missing_material_file_warns_and_gives_grey() {
     let obj = format!("mtllib gone.mtl\n{SQUARE}usemtl red\nf 1 2 3 4\n");
