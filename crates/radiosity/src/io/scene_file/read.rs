@@ -137,6 +137,7 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<SceneFile, SceneErro
         surface_lines: Vec::new(),
         block_line: (0, 0),
         lights: Vec::new(),
+        unknown_line: None,
         folder: Path::new(source_name)
             .parent()
             .map(Path::to_path_buf)
@@ -308,6 +309,11 @@ struct Parser<'a> {
     block_line: (usize, usize),
     /// The `LIGHTBEGIN` blocks read so far.
     lights: Vec<Luminaire>,
+    /// The last line reported as having an unknown keyword: its words are not reported
+    /// again (QA pass 16 of #16: `hello world` was an unknown keyword, then "expected a
+    /// number after \"hello\", found \"world\""), as whatever the line is, it is not
+    /// the line expected there.
+    unknown_line: Option<usize>,
     /// The folder that paths in the file (IES files) are relative to: the source name's.
     folder: std::path::PathBuf,
 }
@@ -372,7 +378,12 @@ impl<'a> Parser<'a> {
         Reported
     }
 
+    /// An error at a word of `line`; none on a line already reported as having an unknown
+    /// keyword ([`Parser::unknown_line`]).
     fn error_at(&mut self, token: Token, line: &Line, message: impl Into<String>) -> Reported {
+        if self.unknown_line == Some(line.number) {
+            return Reported;
+        }
         self.error(line.number, token.column, message)
     }
 
@@ -432,11 +443,13 @@ impl<'a> Parser<'a> {
             return self.error(l, c, format!("expected {wanted}, found end of file"));
         };
         let head = line.head();
-        let msg = if line.keyword() == Keyword::Unknown {
-            format!("unknown keyword \"{}\"; expected {wanted}", head.text)
-        } else {
-            format!("expected {wanted}, found \"{}\"", head.text)
-        };
+        if line.keyword() == Keyword::Unknown {
+            let msg = format!("unknown keyword \"{}\"; expected {wanted}", head.text);
+            let reported = self.error_at(head, &line, msg);
+            self.unknown_line = Some(line.number);
+            return reported;
+        }
+        let msg = format!("expected {wanted}, found \"{}\"", head.text);
         self.error_at(head, &line, msg)
     }
 
@@ -464,6 +477,9 @@ impl<'a> Parser<'a> {
     fn number(&mut self, line: &Line<'a>, index: usize, what: &str) -> Step<(f64, Token<'a>)> {
         let key = line.head().text;
         let Some(token) = line.tokens.get(index).copied() else {
+            if self.unknown_line == Some(line.number) {
+                return Err(Reported);
+            }
             return Err(self.error(
                 line.number,
                 line.end_column,

@@ -217,6 +217,37 @@ fn an_unknown_line_does_not_hide_the_rest_of_its_block() {
     assert_eq!(lines, [13, 14, 16], "{e:#?}");
 }
 
+/// QA pass 16 of #16: `hello world` said that "hello" is not a keyword, then that "world"
+/// is not a number after it; the line is not the one expected there, whatever its words.
+#[test]
+fn an_unknown_keyword_is_reported_alone_not_its_words() {
+    // In place of MAX_PATCH_AREA, of Er (a value line), of VERTEX1 (three numbers), and
+    // with too few words for the line it stands in for.
+    one_error(
+        &with_line(1, "hello world"),
+        1,
+        1,
+        "unknown keyword \"hello\"",
+    );
+    one_error(
+        &with_line(7, "hello world"),
+        7,
+        1,
+        "unknown keyword \"hello\"",
+    );
+    one_error(
+        &with_line(14, "hello big wide world"),
+        14,
+        1,
+        "unknown keyword \"hello\"",
+    );
+    one_error(&with_line(14, "hello"), 14, 1, "unknown keyword \"hello\"");
+    // The file of that one line: the keyword, then what is missing after the line.
+    let e = errors("hello world\n");
+    assert!(e[0].2.contains("unknown keyword \"hello\""), "{e:#?}");
+    assert!(e.iter().all(|e| !e.2.contains("\"world\"")), "{e:#?}");
+}
+
 #[test]
 fn missing_header_lines_give_one_error_each() {
     one_error(
