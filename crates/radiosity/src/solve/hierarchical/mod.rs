@@ -442,6 +442,12 @@ pub fn solve_hierarchical(
                 // A round that refines fewer than 1 in 10,000 links changes the solution
                 // by far less than the oracle's own tolerance: the last one.
                 let links: usize = solver.nodes.iter().map(|n| n.links.len()).sum();
+                // What the progress lines say of how far it is from its end (QA of issue
+                // #16: the heartbeat only counted rounds).
+                progress.status(&format!(
+                    "round {rounds} refined {refined} of {links} links (the rounds end when \
+                     one refines fewer than 1 in 10,000, or after {MAX_ROUNDS})"
+                ));
                 if refined * 10_000 <= links || rounds >= MAX_ROUNDS {
                     // The final gather iterates to the tolerance itself (see
                     // `Solver::final_gather`).
