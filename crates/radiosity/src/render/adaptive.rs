@@ -15,6 +15,18 @@ impl Seen {
     };
 }
 
+/// The four first rays of every pixel of a run of image rows, kept from one strip of rows to
+/// the next: a strip looks at the rows either side of it ([`brighter_beside`]), and the
+/// two rows where strips meet were cast twice (review of QA pass 15 of #16: 3 % more first
+/// rays at 512 x 512 with 8 x 8 supersampling, 50 % at 1920 wide with 16 x 16).
+#[derive(Debug, Default)]
+pub(super) struct FirstRows {
+    /// The image row of `rays`' first row.
+    pub(super) start: usize,
+    /// Row by row, pixel by pixel.
+    pub(super) rays: Vec<[Seen; 4]>,
+}
+
 /// What a pixel's four first rays ask for under adaptive sampling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Refine {

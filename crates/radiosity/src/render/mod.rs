@@ -229,6 +229,7 @@ fn film_strips(
     let n = settings.supersample.max(1) as usize;
     let strip = (STRIP_SAMPLES / (w * n * n)).max(1);
     run_stage(progress, Stage::Render, h as u64, || {
+        let mut carried = adaptive::FirstRows::default();
         for first in (0..h).step_by(strip) {
             let rows = first..(first + strip).min(h);
             let film = renderer.film_rows(
@@ -238,6 +239,7 @@ fn film_strips(
                 vertex_b,
                 settings.shading,
                 n,
+                &mut carried,
                 progress,
             );
             total += film.samples().len() as u64;
@@ -389,6 +391,19 @@ mod tests {
                 Shading::Wireframe => assert_eq!(linear, None),
                 _ => assert_eq!(linear, Some(film.pixel_means()), "{shading:?}"),
             }
+        }
+        // Under adaptive sampling each strip looks at the first rays of the rows either
+        // side; the ones kept from the strip above must be those of the right rows.
+        let adaptive = Renderer::new(&mesh).with_adaptive_sampling(0.1);
+        for shading in [Shading::Smooth, Shading::Flat] {
+            let settings = RenderSettings {
+                shading,
+                supersample: 8,
+                ..RenderSettings::default()
+            };
+            let film = adaptive.film(&cam, &eb, &vb, shading, 8, &NoProgress);
+            let linear = render_linear(&adaptive, &cam, &eb, &vb, &settings, &NoProgress);
+            assert_eq!(linear.unwrap(), Some(film.pixel_means()), "{shading:?}");
         }
     }
 }

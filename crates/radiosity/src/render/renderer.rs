@@ -27,7 +27,7 @@ use std::ops::Range;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::adaptive::{brighter_beside, refinement, Refine, Seen};
+use super::adaptive::{brighter_beside, refinement, FirstRows, Refine, Seen};
 use super::direct::DirectCorrection;
 use super::film::{sample_offset, Film, FilmContent};
 use super::holes::{closest_on_segment, nearest_element, Holes, Uncovered};
@@ -260,7 +260,17 @@ impl<'m> Renderer<'m> {
             return Film::new(w, h, n, film_content(shading));
         }
         run_stage(progress, Stage::Render, h as u64, || {
-            self.film_rows(camera, 0..h, element_b, vertex_b, shading, n, progress)
+            let mut carried = FirstRows::default();
+            self.film_rows(
+                camera,
+                0..h,
+                element_b,
+                vertex_b,
+                shading,
+                n,
+                &mut carried,
+                progress,
+            )
         })
     }
 
@@ -288,7 +298,10 @@ impl<'m> Renderer<'m> {
 
     /// The film of the image rows `rows` of `camera`'s view (film row 0 is image row
     /// `rows.start`), `n` x `n` rays a pixel: the ray loop. Rows are traced in parallel;
-    /// each finished row is reported as `progress.advance(1)`.
+    /// each finished row is reported as `progress.advance(1)`. Under adaptive sampling the
+    /// first rays of the rows `carried` holds are taken from it, not cast again, and it is
+    /// left holding those of the last two rows looked at (the next strip's first row and
+    /// the one above it).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn film_rows(
         &self,
@@ -298,6 +311,7 @@ impl<'m> Renderer<'m> {
         vertex_b: &[[f64; 3]],
         shading: Shading,
         n: usize,
+        carried: &mut FirstRows,
         progress: &dyn Progress,
     ) -> Film {
         let mut film = Film::new(camera.width as usize, rows.len(), n, film_content(shading));
@@ -331,11 +345,27 @@ impl<'m> Renderer<'m> {
         // `brighter_beside`).
         let around = rows.start.saturating_sub(1)..(rows.end + 1).min(camera.height as usize);
         let firsts: Vec<[Seen; 4]> = if adaptive.is_some() {
-            // Pixel by pixel, so that a strip of a few rows still keeps every core busy.
-            (0..around.len() * width)
-                .into_par_iter()
-                .map(|i| first_rays(i % width, around.start + i / width))
-                .collect()
+            // The rows the last strip left that begin this one's, then the rest, pixel by
+            // pixel, so that a strip of a few rows still keeps every core busy.
+            let kept_rows = carried.rays.len() / width.max(1);
+            let mut firsts = if carried.start == around.start && kept_rows <= around.len() {
+                std::mem::take(&mut carried.rays)
+            } else {
+                Vec::new()
+            };
+            let from = around.start + firsts.len() / width.max(1);
+            firsts.par_extend(
+                (0..(around.end - from) * width)
+                    .into_par_iter()
+                    .map(|i| first_rays(i % width, from + i / width)),
+            );
+            // The last two rows for the next strip (rows.end - 1 and rows.end).
+            let keep = around.len().min(2);
+            *carried = FirstRows {
+                start: around.end - keep,
+                rays: firsts[(around.len() - keep) * width..].to_vec(),
+            };
+            firsts
         } else {
             Vec::new()
         };
