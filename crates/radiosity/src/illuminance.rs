@@ -923,6 +923,37 @@ impl GridAxes {
         }
     }
 
+    /// A wall's grid drawn as a person standing before the meters sees it, looking against
+    /// `normal` (the way they face) with the scene's up (z when `z_up`, else y) up the
+    /// picture: its columns mirrored where their axis then runs to the left (QA pass 17 of
+    /// #16: the wall at the far end of a room was drawn as seen from behind it). Plans and
+    /// grids whose rows are not the up axis are left as they are, as is a normal along the
+    /// columns' axis.
+    pub fn seen_from(self, normal: DVec3, z_up: bool) -> Self {
+        let (up, up_name) = if z_up {
+            (DVec3::Z, 'z')
+        } else {
+            (DVec3::Y, 'y')
+        };
+        if self.names[1] != up_name {
+            return self;
+        }
+        let column = match self.names[0] {
+            'x' => DVec3::X,
+            'y' => DVec3::Y,
+            _ => DVec3::Z,
+        };
+        let right = (-normal).cross(up);
+        let along = right.dot(column);
+        if along.abs() <= 1e-9 * right.length() {
+            return self;
+        }
+        Self {
+            cols_left: self.cols_left != (along < 0.0),
+            ..self
+        }
+    }
+
     /// The labels of `n` columns (`axis` 0) or rows (1), with the decimals of the step.
     pub fn labels(&self, axis: usize, n: usize) -> Vec<String> {
         let d = decimals_of(self.step[axis]).max(decimals_of(self.first[axis]));

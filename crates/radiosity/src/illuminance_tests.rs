@@ -526,6 +526,43 @@ fn grids_are_drawn_as_plans_and_elevations() {
     assert_ne!(top_left(&down), top_left(&up));
 }
 
+/// QA pass 17 of #16: the grid of a wall was drawn with x to the right whichever way the
+/// wall faced, so the far wall of a room came out as seen from behind it. Seen from the
+/// side the meters face, with up up: looking along -z (a wall facing +z) x runs right,
+/// looking along +z it runs left (right = forward x up).
+#[test]
+fn a_wall_grid_is_drawn_as_seen_from_the_side_its_meters_face() {
+    let cols_left = |a: DVec3, b: DVec3, normal: DVec3, z_up: bool| {
+        GridAxes::of(a, b, 1.0)
+            .unwrap()
+            .as_drawn(z_up)
+            .seen_from(normal, z_up)
+            .cols_left
+    };
+    // A y-up room's walls at z = 0 (facing +z) and z = 4 (facing -z).
+    let (a, b) = (dvec3(0.5, 0.5, 0.0), dvec3(4.5, 2.5, 0.0));
+    assert!(!cols_left(a, b, DVec3::Z, false));
+    let (a4, b4) = (dvec3(0.5, 0.5, 4.0), dvec3(4.5, 2.5, 4.0));
+    assert!(cols_left(a4, b4, -DVec3::Z, false));
+    // Corners given the other way round draw the same picture: their column 0 is the
+    // other end, so it is drawn on the other side.
+    assert!(!cols_left(b4, a4, -DVec3::Z, false));
+    assert!(cols_left(b, a, DVec3::Z, false));
+    // A z-up room's wall at x = 4 facing -x, columns along y: looking along +x, y runs
+    // left (forward x up = x x z = -y).
+    let (c, d) = (dvec3(4.0, 0.5, 0.5), dvec3(4.0, 3.5, 2.5));
+    assert!(cols_left(c, d, -DVec3::X, true));
+    assert!(!cols_left(c, d, DVec3::X, true));
+    // A z-up room's wall at y = 0 facing +y: looking along -y, x runs left (-y x z = -x).
+    let (e, f) = (dvec3(0.5, 0.0, 0.5), dvec3(4.5, 0.0, 2.5));
+    assert!(cols_left(e, f, DVec3::Y, true));
+    assert!(!cols_left(e, f, -DVec3::Y, true));
+    // Plans are drawn as seen from above, whichever way their meters face.
+    let (g, h) = (dvec3(0.0, 0.8, 0.0), dvec3(2.0, 0.8, 3.0));
+    assert!(!cols_left(g, h, DVec3::Y, false));
+    assert!(!cols_left(g, h, -DVec3::Y, false));
+}
+
 /// QA passes 14 and 15 of #16: a grid whose corners were given high to low drew its
 /// columns mirrored (x growing to the left) though its rows were put right. The same cells
 /// given from either corner, in any order, draw the same picture, pixel for pixel.

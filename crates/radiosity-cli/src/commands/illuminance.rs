@@ -145,7 +145,14 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         let axes = args
             .grid
             .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing))
-            .map(|axes| axes.as_drawn(radiosity::render::z_is_up(&prepared.scene)));
+            .map(|axes| {
+                let z_up = radiosity::render::z_is_up(&prepared.scene);
+                let drawn = axes.as_drawn(z_up);
+                match args.normal {
+                    Some(normal) => drawn.seen_from(normal, z_up),
+                    None => drawn,
+                }
+            });
         let held = args
             .grid
             .map(|(a, b, _)| illuminance::held_coordinates(a, b))
