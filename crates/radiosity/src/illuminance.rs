@@ -923,6 +923,37 @@ impl GridAxes {
         }
     }
 
+    /// The grid of `values` (`dims` = [columns, rows], as [`grid`] makes them) with its
+    /// columns and rows swapped where its columns run along the scene's up axis (z when
+    /// `z_up`, else y) and its rows do not: a wall at constant x in a y-up scene, whose
+    /// axes come as (y, z), so that its height runs up the picture as every other wall's
+    /// does (QA pass 17 of #16: it was drawn lying on its side). Other grids come back as
+    /// they are.
+    pub fn upright(
+        self,
+        values: &[f64],
+        dims: [usize; 2],
+        z_up: bool,
+    ) -> (Vec<f64>, [usize; 2], Self) {
+        let up = if z_up { 'z' } else { 'y' };
+        let [nu, nv] = dims;
+        if self.names[0] != up || self.names[1] == up || nu * nv != values.len() {
+            return (values.to_vec(), dims, self);
+        }
+        // Value (i, j) (column i, row j) becomes (j, i).
+        let swapped: Vec<f64> = (0..nu * nv)
+            .map(|k| values[(k % nv) * nu + k / nv])
+            .collect();
+        let axes = Self {
+            names: [self.names[1], self.names[0]],
+            first: [self.first[1], self.first[0]],
+            step: [self.step[1], self.step[0]],
+            rows_down: self.cols_left,
+            cols_left: self.rows_down,
+        };
+        (swapped, [nv, nu], axes)
+    }
+
     /// A wall's grid drawn as a person standing before the meters sees it, looking against
     /// `normal` (the way they face) with the scene's up (z when `z_up`, else y) up the
     /// picture: its columns mirrored where their axis then runs to the left (QA pass 17 of

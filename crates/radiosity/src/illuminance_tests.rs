@@ -563,6 +563,33 @@ fn a_wall_grid_is_drawn_as_seen_from_the_side_its_meters_face() {
     assert!(!cols_left(g, h, -DVec3::Y, false));
 }
 
+/// QA pass 17 of #16: a wall at constant x in a y-up scene has its axes as (y, z), so its
+/// picture lay on its side, height to the right. Upright, its columns run along z and its
+/// rows up y, each value where it was.
+#[test]
+fn a_wall_whose_columns_run_up_is_turned_upright() {
+    let (a, b) = (dvec3(4.0, 0.5, 0.5), dvec3(4.0, 2.5, 1.5));
+    let axes = GridAxes::of(a, b, 1.0).unwrap();
+    assert_eq!(axes.names, ['y', 'z']);
+    // Three columns (y = 0.5, 1.5, 2.5) of two rows (z = 0.5, 1.5); value 10 i + j.
+    let values: Vec<f64> = (0..6).map(|k| (10 * (k % 3) + k / 3) as f64).collect();
+    let (turned, dims, upright) = axes.upright(&values, [3, 2], false);
+    assert_eq!(dims, [2, 3]);
+    assert_eq!(upright.names, ['z', 'y']);
+    assert_eq!(upright.first, [0.5, 0.5]);
+    for i in 0..3 {
+        for j in 0..2 {
+            // Column j (z), row i (y) of the upright grid.
+            assert_eq!(turned[i * 2 + j], (10 * i + j) as f64, "y {i} z {j}");
+        }
+    }
+    // In a z-up scene the same axes are a floor strip's, and a y-up floor (x, z) or wall
+    // (x, y) is already upright.
+    assert_eq!(axes.upright(&values, [3, 2], true).2, axes);
+    let wall = GridAxes::of(dvec3(0.5, 0.5, 4.0), dvec3(2.5, 1.5, 4.0), 1.0).unwrap();
+    assert_eq!(wall.upright(&values, [3, 2], false).2, wall);
+}
+
 /// QA passes 14 and 15 of #16: a grid whose corners were given high to low drew its
 /// columns mirrored (x growing to the left) though its rows were put right. The same cells
 /// given from either corner, in any order, draw the same picture, pixel for pixel.

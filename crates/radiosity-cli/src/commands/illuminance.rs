@@ -142,17 +142,22 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
     ));
     if let (Some(png), Some(dims)) = (&args.png, dims) {
         let totals: Vec<f64> = lux.iter().map(|l| l.total).collect();
-        let axes = args
+        let z_up = radiosity::render::z_is_up(&prepared.scene);
+        let (totals, dims, axes) = match args
             .grid
             .and_then(|(a, b, spacing)| illuminance::GridAxes::of(a, b, spacing))
-            .map(|axes| {
-                let z_up = radiosity::render::z_is_up(&prepared.scene);
+        {
+            Some(axes) => {
+                let (totals, dims, axes) = axes.upright(&totals, dims, z_up);
                 let drawn = axes.as_drawn(z_up);
-                match args.normal {
+                let drawn = match args.normal {
                     Some(normal) => drawn.seen_from(normal, z_up),
                     None => drawn,
-                }
-            });
+                };
+                (totals, dims, Some(drawn))
+            }
+            None => (totals, dims, None),
+        };
         let held = args
             .grid
             .map(|(a, b, _)| illuminance::held_coordinates(a, b))
