@@ -70,6 +70,17 @@ pub fn progress_line(
     progress_line_of(stage, None, done, total, elapsed, counting)
 }
 
+/// "12.3 s", "5.0 min", "3416.7 h": a duration in the unit that reads best.
+pub fn seconds_text(s: f64) -> String {
+    if s < 120.0 {
+        format!("{s:.1} s")
+    } else if s < 7200.0 {
+        format!("{:.1} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
+}
+
 /// What a stage's known total counts, where that is not plain (QA of issue #16: the path
 /// tracer's progress said "(24 of 64)" of nothing).
 pub fn stage_unit(stage: Stage) -> Option<&'static str> {
@@ -111,10 +122,8 @@ pub fn progress_line_of(
         let s = secs * (1.0 - fraction) / fraction;
         if s < 120.0 {
             format!(", about {s:.0} s left")
-        } else if s < 7200.0 {
-            format!(", about {:.1} min left", s / 60.0)
         } else {
-            format!(", about {:.1} h left", s / 3600.0)
+            format!(", about {} left", seconds_text(s))
         }
     } else {
         String::new()

@@ -271,6 +271,24 @@ pub fn check_scale_and_area(scale: f64, max_area: Option<f64>) -> Result<()> {
     Ok(())
 }
 
+/// Hierarchical radiosity's `--epsilon` and `--min-area`, refused when they are not numbers
+/// above 0, whichever solver runs (`render`, `solve`, `check` and `view` alike).
+pub fn check_hierarchical_flags(epsilon: f64, min_area: Option<f64>) -> Result<()> {
+    if !(epsilon > 0.0 && epsilon.is_finite()) {
+        bail!(
+            "--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0",
+            crate::report::typed(epsilon)
+        );
+    }
+    if let Some(a) = min_area {
+        if !(a > 0.0 && a.is_finite()) {
+            let a = crate::report::typed(a);
+            bail!("--min-area {a}: give the smallest element area (scene units squared), a number above 0");
+        }
+    }
+    Ok(())
+}
+
 /// The numbers of the solver's flags that need no scene, checked before the scene is read
 /// (QA of issue #16: `--epsilon -1` or `--max-shots 0` was refused only after the meshing
 /// and contact refinement). A flag of a solver the run does not use is checked too: a
@@ -298,18 +316,7 @@ pub fn check_solve_flags(options: &SolveOptions) -> Result<()> {
             bail!("--tolerance {t}: give where the solver stops, a number above 0 and below 1 (Gauss-Seidel's relative residual, 1e-9 by default; hierarchical radiosity's changing power, 1e-6)");
         }
     }
-    if !(options.epsilon > 0.0 && options.epsilon.is_finite()) {
-        bail!(
-            "--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0",
-            crate::report::typed(options.epsilon)
-        );
-    }
-    if let Some(a) = options.min_area {
-        if !(a > 0.0 && a.is_finite()) {
-            let a = crate::report::typed(a);
-            bail!("--min-area {a}: give the smallest element area (scene units squared), a number above 0");
-        }
-    }
+    check_hierarchical_flags(options.epsilon, options.min_area)?;
     // --gather-points 0 is refused while parsing (args::parse_gather_points).
     if options.max_shots == 0 {
         bail!("--max-shots 0: give the most shots progressive radiosity takes, at least 1");

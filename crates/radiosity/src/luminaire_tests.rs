@@ -529,16 +529,7 @@ fn a_light_cut_off_at_the_horizon_puts_its_lumens_on_a_closed_room() {
     assert!((flux - 2.0 * PI * 159.15).abs() < 1e-6 * flux, "{flux}");
     // Each face cut into 6 x 6 elements (0.44 m^2, as a mesh at MAX_PATCH_AREA 0.5 cuts
     // it), at heights that put the horizon in the walls' top row (1.33 to 2).
-    let elements: Vec<Vec<DVec3>> = cube_faces(2.0)
-        .iter()
-        .flat_map(|f| {
-            let (o, u, v) = (f[0], (f[1] - f[0]) / 6.0, (f[3] - f[0]) / 6.0);
-            (0..36).map(move |c| {
-                let p = o + u * (c % 6) as f64 + v * (c / 6) as f64;
-                vec![p, p + u, p + u + v, p + v]
-            })
-        })
-        .collect();
+    let elements = cube_elements();
     for z in [1.4, 1.45, 1.5, 1.55, 1.6] {
         l.position = dvec3(0.0, 0.0, z);
         let got: f64 = elements

@@ -9,7 +9,7 @@
 
 use std::time::Duration;
 
-use crate::progress_bar::progress_line_of;
+use crate::progress_bar::{progress_line_of, seconds_text};
 
 /// Seconds the runs of one configuration may take without `--no-work-limit`: an hour, as
 /// the work budget's limits are set at about an hour of the measured rate.
@@ -37,17 +37,6 @@ pub fn check_repeat_time(first_run: Duration, repeat: u32) -> Result<(), String>
         seconds_text(total),
         seconds_text(MAX_BENCH_SECONDS)
     ))
-}
-
-/// "12.3 s", "5.0 min", "3416.7 h": a duration in the unit that reads best.
-fn seconds_text(s: f64) -> String {
-    if s < 120.0 {
-        format!("{s:.1} s")
-    } else if s < 7200.0 {
-        format!("{:.1} min", s / 60.0)
-    } else {
-        format!("{:.1} h", s / 3600.0)
-    }
 }
 
 /// The progress line of the runs so far, as a long stage's: "bench: 25.0 % (250 of 1000

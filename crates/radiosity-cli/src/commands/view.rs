@@ -155,18 +155,7 @@ fn check_flags(args: &ViewArgs) -> Result<()> {
     }
     // Refused whether or not the solver uses them, as `render` refuses them (QA pass 15 of
     // #16: `view --epsilon 0` was only warned about without --solver hierarchical).
-    if !(args.epsilon > 0.0 && args.epsilon.is_finite()) {
-        bail!(
-            "--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0",
-            crate::report::typed(args.epsilon)
-        );
-    }
-    if let Some(min_area) = args.min_area {
-        if !(min_area > 0.0 && min_area.is_finite()) {
-            let min_area = crate::report::typed(min_area);
-            bail!("--min-area {min_area}: give the smallest element area (scene units squared), a number above 0");
-        }
-    }
+    crate::setup::check_hierarchical_flags(args.epsilon, args.min_area)?;
     let hierarchical = args.solver == SolverKind::Hierarchical;
     let given = crate::setup::flags_given(&[
         ("--epsilon", !hierarchical && args.epsilon != 0.05),
