@@ -572,7 +572,10 @@ fn faces_nothing(scene: &Scene, s: usize) -> bool {
 
 /// What an escaped share (percent of the emitted power) means, for the energy notes.
 fn escaped_meaning(percent: f64, report: &SolutionReport) -> String {
-    if percent < 0.0 && matches!(report, SolutionReport::Hierarchical(_)) {
+    if percent < 0.0 && rounds_to_zero(percent) {
+        // Below 0 by rounding where the scene is closed (QA pass 17 of #16).
+        String::from("none: below 0 by rounding")
+    } else if percent < 0.0 && matches!(report, SolutionReport::Hierarchical(_)) {
         // QA of issue #16: hierarchical radiosity has no rows to blame.
         format!("negative: {COUNTED_TWICE_LINKS}")
     } else if percent < 0.0 {
@@ -580,6 +583,12 @@ fn escaped_meaning(percent: f64, report: &SolutionReport) -> String {
     } else {
         format!("light that reached no element: {ESCAPED}")
     }
+}
+
+/// Whether a share in per cent prints as 0.00 at two decimals (a closed scene's escaped
+/// power is 0 up to rounding, which can leave it a hair below).
+fn rounds_to_zero(percent: f64) -> bool {
+    percent.abs() < 0.005
 }
 
 /// Where light that reaches no element goes: one wording for the energy note, `check`'s
@@ -972,7 +981,14 @@ pub fn check(
                 report.initial_links,
                 report.memory_bytes as f64 / (1024.0 * 1024.0),
                 count(report.rounds as u64, "round"),
-                count(report.iterations as u64, "sweep"),
+                match report.gather_passes {
+                    0 => count(report.iterations as u64, "sweep"),
+                    g => format!(
+                        "{} and the final gather's {}",
+                        count((report.iterations - g) as u64, "sweep"),
+                        count(g as u64, "pass")
+                    ),
+                },
                 report.residual,
                 report.rays,
                 report.elapsed.as_secs_f64()
@@ -1029,7 +1045,7 @@ pub fn check(
     // A closed scene's escaped power is 0 up to rounding, which can leave it a hair below
     // (QA pass 17 of #16: "escaped -1.307053e-5 (-0.00 %)").
     let escaped_share = match band {
-        Some(_) if b.escaped[k] < 0.0 && -b.escaped[k] <= 1e-6 * b.emitted[k].abs() => {
+        Some(_) if b.escaped[k] < 0.0 && rounds_to_zero(100.0 * b.escaped[k] / b.emitted[k]) => {
             String::from(" (0.00 %: below 0 by rounding)")
         }
         _ => share(b.escaped[k]),

@@ -122,6 +122,8 @@ pub fn illuminance_with_progress(
         })
         .collect();
     let occluders = &prepared.occluders;
+    // Each light's lumens, once: an IES table's is a sum over the table.
+    let fluxes: Vec<f64> = scene.lights.iter().map(|l| l.flux()).collect();
     points
         .par_iter()
         .enumerate()
@@ -155,6 +157,7 @@ pub fn illuminance_with_progress(
                         n,
                         normal,
                         lights: &scene.lights,
+                        fluxes: &fluxes,
                         occluders,
                     };
                     if let Some(mean) = sampler.mean(&r.corners) {
@@ -246,6 +249,8 @@ struct FirstBounce<'a> {
     /// The element's unit normal.
     normal: DVec3,
     lights: &'a [crate::luminaire::Luminaire],
+    /// Each light's lumens.
+    fluxes: &'a [f64],
     occluders: &'a crate::visibility::PolygonBvh,
 }
 
@@ -294,18 +299,27 @@ impl FirstBounce<'_> {
         // mostly at its near end, not round its centroid where the kernel is taken (a floor
         // 5 cm under a lamp read 1.4 % low with the solid angle alone, 1.2 % at a ratio of
         // 1.5; the README's downlight grid took 0.95 s against 0.91 s at 1.1).
-        // And one across which a light's intensity jumps (a cut-off), as the elements' own
-        // first bounce splits it ([`crate::luminaire::power_onto`]), so that the two agree
-        // on elements the cut-off crosses (review of QA pass 15 of #16).
-        let wide = depth < FIRST_BOUNCE_MAX_SOLID_DEPTH
-            && self.lights.iter().any(|l| {
-                let d = t.map(|c| c.distance(l.position));
-                let (near, far) = (d[0].min(d[1]).min(d[2]), d[0].max(d[1]).max(d[2]));
-                let omega = Self::solid_angle_from(l.position, &t);
-                omega > FIRST_BOUNCE_MAX_SOLID_ANGLE
-                    || far > FIRST_BOUNCE_MAX_DISTANCE_RATIO * near
-                    || crate::luminaire::intensity_jumps(l, &t, omega, || l.flux())
-            });
+        // And one across which a light's intensity jumps (a cut-off), by the elements' own
+        // first bounce's test ([`crate::luminaire::intensity_jumps`]) but to this depth and
+        // without its 1e-4 sr floor, so that the two agree on elements the cut-off crosses
+        // (review of QA pass 15 of #16).
+        // A piece seen wider than FIRST_BOUNCE_MAX_SOLID_ANGLE splits as far as the
+        // elements' own ([`crate::luminaire::MAX_WIDE_PIECE_DEPTH`]), so that a light a hair
+        // from a surface is followed to its foot (review: at 9 halvings a COSINE light 0.1
+        // mm from a ceiling gave half its reflected lux); the other reasons stop at 9.
+        let wide = self.lights.iter().zip(self.fluxes).any(|(l, &flux)| {
+            let omega = Self::solid_angle_from(l.position, &t);
+            if omega > FIRST_BOUNCE_MAX_SOLID_ANGLE
+                && depth < crate::luminaire::MAX_WIDE_PIECE_DEPTH
+            {
+                return true;
+            }
+            let d = t.map(|c| c.distance(l.position));
+            let (near, far) = (d[0].min(d[1]).min(d[2]), d[0].max(d[1]).max(d[2]));
+            depth < FIRST_BOUNCE_MAX_SOLID_DEPTH
+                && (far > FIRST_BOUNCE_MAX_DISTANCE_RATIO * near
+                    || crate::luminaire::intensity_jumps(l, &t, omega, || flux))
+        });
         if depth < FIRST_BOUNCE_MIN_DEPTH || (!uniform && depth < FIRST_BOUNCE_MAX_DEPTH) || wide {
             let m = [
                 0.5 * (t[0] + t[1]),

@@ -375,8 +375,9 @@ pub(crate) fn mean_intensity(light: &Luminaire, d: [DVec3; 3]) -> Rgb {
 
 /// The largest solid angle (sr) over which [`power_onto`] takes a light's intensity and
 /// visibility as constant: 0.01 sr is a cone of about 3.2 degrees half-angle, over which a
-/// COSINE light's intensity varies by at most 5.6 % of its axial value (the midpoint rule's
-/// error is second order, far less), and a light's whole sphere holds at most some 1,300
+/// COSINE light's intensity varies by at most 5.6 % of its axial value (the mean at the
+/// piece's edges' midpoints, [`mean_intensity`], is exact for a quadratic: its error is
+/// fourth order, far less), and a light's whole sphere holds at most some 1,300
 /// such pieces, so the splitting costs at most a few thousand shadow rays a light (more
 /// along a cut-off: see [`MIN_PIECE_SOLID_ANGLE`]).
 pub const MAX_PIECE_SOLID_ANGLE: f64 = 0.01;
@@ -408,9 +409,11 @@ pub const MAX_PIECE_DEPTH: u32 = 7;
 /// [`MAX_PIECE_SOLID_ANGLE`], so that a surface through the light itself cannot split
 /// without end. Only the pieces at the foot of a light stay wide as they shrink (a piece of
 /// size s at a distance D >= s from the foot of a light h above its plane subtends about
-/// s^2 h / D^3 sr), a handful a level, so a light h above a surface splits about log2(s / h)
-/// levels there: 40 levels reach a trillionth of a sub-triangle's size, a light 1e-12 of
-/// it from the surface, for some hundreds of pieces.
+/// s^2 h / D^3 sr), a handful a level, so a light h above a surface splits about
+/// log2(10 s / h) levels there (until the foot's piece is a tenth of h across): 40 levels
+/// reach a trillionth of a sub-triangle's size, a light 1e-11 of it from the surface. The
+/// wide pieces of one level subtend 2 pi sr at most, so no more than about 630 split at any
+/// level; a light near a surface makes some thousands of pieces on the element at its foot.
 pub const MAX_WIDE_PIECE_DEPTH: u32 = 40;
 
 /// The sub-triangles per fan triangle edge used for elements' first bounce

@@ -492,8 +492,9 @@ fn an_objs_material_file_is_never_written_over() {
 #[test]
 fn a_million_bench_repeats_are_refused_after_the_first_run() {
     // QA pass 16 of #16: `bench --repeat 1000000` started some 100 hours of runs at once.
-    // Any run of the pipeline takes more than 3.6 ms, so a million of them are past the
-    // hour's limit after the first; the refusal says how many fit.
+    // Any run of the pipeline takes more than 0.84 us, so 4294967295 of them are past the
+    // hour's limit after the first (a million would fit on a machine where a run takes
+    // under 3.6 ms, and the test would run an hour); the refusal says how many fit.
     let dir = scratch_dir("bench-repeat");
     let args = [
         "bench",
@@ -504,13 +505,13 @@ fn a_million_bench_repeats_are_refused_after_the_first_run() {
         "--supersample",
         "1",
         "--repeat",
-        "1000000",
+        "4294967295",
     ];
     let start = std::time::Instant::now();
     let out = radiosity(&args, &dir);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("error: --repeat 1000000 at "), "{err}");
+    assert!(err.contains("error: --repeat 4294967295 at "), "{err}");
     assert!(err.contains("more than the limit of 60.0 min"), "{err}");
     assert!(err.contains("at most --repeat "), "{err}");
     assert!(err.contains("--no-work-limit"), "{err}");

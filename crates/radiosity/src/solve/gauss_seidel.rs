@@ -98,8 +98,8 @@ pub(super) fn solve(
         smallest_change = smallest_change.min(estimate);
         residual = estimate;
         progress.status(&format!(
-            "the last sweep changed B by {estimate:.1e} of the largest emission (stops below \
-             {tolerance:.0e})"
+            "the last sweep changed B by {estimate:.1e} of the largest emission (it stops \
+             once the relative residual is below {tolerance:e})"
         ));
         if estimate < tolerance {
             let true_residual = relative_residual(f, light, &b)

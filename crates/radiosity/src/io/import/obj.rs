@@ -372,7 +372,7 @@ impl Reader {
                                     line: n,
                                     message: format!(
                                         "the material file \"{name}\"{} {what}; faces \
-                                         whose usemtl names none get the default \
+                                         whose material is not defined get the default \
                                          reflectance {DEFAULT_REFLECTANCE}",
                                         if mtl_file == name {
                                             String::new()

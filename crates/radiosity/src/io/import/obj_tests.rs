@@ -154,12 +154,12 @@ fn a_material_file_of_no_materials_is_warned_about_at_its_mtllib_line() {
         w[0],
         "m.obj:2: warning: the material file \"p.mtl\" is not an MTL file (no line starts \
          with an MTL keyword such as newmtl, Kd or Ke), so it defines no materials; faces \
-         whose usemtl names none get the default reflectance 0.5"
+         whose material is not defined get the default reflectance 0.5"
     );
     assert_eq!(
         w[1],
         "m.obj:2: warning: the material file \"e.mtl\" defines no materials (no \"newmtl\" \
-         line); faces whose usemtl names none get the default reflectance 0.5"
+         line); faces whose material is not defined get the default reflectance 0.5"
     );
     assert_eq!(w.len(), 2, "{w:?}");
     // A file of materials says nothing.

@@ -236,6 +236,9 @@ pub struct HierarchicalReport {
     /// Gather / push-pull sweeps made in all, the final gather's passes over its terms
     /// included.
     pub iterations: usize,
+    /// Of [`HierarchicalReport::iterations`], the final gather's sweeps and passes (0
+    /// without a final gather).
+    pub gather_passes: usize,
     /// Power that still changed in the last sweep (or the final gather's last pass), as a
     /// fraction of the emitted power (the largest band): the analogue of the unshot
     /// fraction.
@@ -446,7 +449,7 @@ pub fn solve_hierarchical(
                 // #16: the heartbeat only counted rounds).
                 progress.status(&format!(
                     "round {rounds} refined {refined} of {links} links (the rounds end when \
-                     one refines fewer than 1 in 10,000, or after {MAX_ROUNDS})"
+                     one refines at most 1 in 10,000, or after {MAX_ROUNDS})"
                 ));
                 if refined * 10_000 <= links || rounds >= MAX_ROUNDS {
                     // The final gather iterates to the tolerance itself (see
@@ -505,6 +508,7 @@ pub fn solve_hierarchical(
         initial_links,
         rounds,
         iterations,
+        gather_passes,
         residual,
         rays: solver.rays,
         memory_bytes,
