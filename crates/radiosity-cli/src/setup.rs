@@ -253,20 +253,29 @@ pub fn check_scene_flags(args: &SceneArgs) -> Result<()> {
 /// `--scale` and `--max-area`, checked before the scene is read ([`check_scene_flags`],
 /// and `view`'s own flags).
 pub fn check_scale_and_area(scale: f64, max_area: Option<f64>) -> Result<()> {
-    if !(scale > 0.0 && scale.is_finite()) {
-        bail!(
-            "--scale {}: give the factor every coordinate is multiplied by, a number above 0",
-            crate::report::typed(scale)
-        );
-    }
+    positive(
+        "--scale",
+        scale,
+        "the factor every coordinate is multiplied by",
+    )?;
     if let Some(a) = max_area {
-        if !(a > 0.0 && a.is_finite()) {
-            let a = crate::report::typed(a);
-            bail!(
-                "--max-area {a}: give the largest element area (scene units squared), a \
-                 number above 0"
-            );
-        }
+        positive(
+            "--max-area",
+            a,
+            "the largest element area (scene units squared)",
+        )?;
+    }
+    Ok(())
+}
+
+/// Refuses `value` of `flag` unless it is a finite number above 0: "--scale 0: give
+/// `what`, a number above 0".
+fn positive(flag: &str, value: f64, what: &str) -> Result<()> {
+    if !(value > 0.0 && value.is_finite()) {
+        bail!(
+            "{flag} {}: give {what}, a number above 0",
+            crate::report::typed(value)
+        );
     }
     Ok(())
 }
@@ -274,17 +283,17 @@ pub fn check_scale_and_area(scale: f64, max_area: Option<f64>) -> Result<()> {
 /// Hierarchical radiosity's `--epsilon` and `--min-area`, refused when they are not numbers
 /// above 0, whichever solver runs (`render`, `solve`, `check` and `view` alike).
 pub fn check_hierarchical_flags(epsilon: f64, min_area: Option<f64>) -> Result<()> {
-    if !(epsilon > 0.0 && epsilon.is_finite()) {
-        bail!(
-            "--epsilon {}: give hierarchical radiosity's refinement threshold, a number above 0",
-            crate::report::typed(epsilon)
-        );
-    }
+    positive(
+        "--epsilon",
+        epsilon,
+        "hierarchical radiosity's refinement threshold",
+    )?;
     if let Some(a) = min_area {
-        if !(a > 0.0 && a.is_finite()) {
-            let a = crate::report::typed(a);
-            bail!("--min-area {a}: give the smallest element area (scene units squared), a number above 0");
-        }
+        positive(
+            "--min-area",
+            a,
+            "the smallest element area (scene units squared)",
+        )?;
     }
     Ok(())
 }
