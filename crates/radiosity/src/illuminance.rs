@@ -862,6 +862,64 @@ pub fn tick_labels(max: f64, ticks: usize) -> Vec<String> {
         .collect()
 }
 
+/// The values and labels of a scale bar from 0 to `max`: `ticks` equal steps
+/// ([`tick_labels`]) where their labels are plain numbers or `max` is a round number of
+/// round steps ([`nice_scale`]); else, for a top such as a user's `--lux-max 123456`, the
+/// round steps below it (0, 25000, ..., 100000) and the top itself, so that every label but
+/// perhaps the top's reads at a glance (QA pass 17 of #16: the fifths of 123456 read
+/// "2.47E4", "4.94E4", ...).
+pub fn scale_ticks(max: f64, ticks: usize) -> Vec<(f64, String)> {
+    let equal = |max: f64, ticks: usize| -> Vec<(f64, String)> {
+        let n = ticks.max(1);
+        tick_labels(max, n)
+            .into_iter()
+            .enumerate()
+            .map(|(k, l)| (max * k as f64 / n as f64, l))
+            .collect()
+    };
+    let labels = tick_labels(max, ticks);
+    let round_top = (nice_scale(max).0 - max).abs() <= 1e-9 * max;
+    if !(max.is_finite() && max > 0.0) || round_top || labels.iter().all(|l| !l.contains('E')) {
+        return equal(max, ticks);
+    }
+    // The largest round step (1, 2, 2.5 or 5 times a power of ten) of which 4 to 8 fit
+    // below the top.
+    let e = max.log10().floor() as i32;
+    let Some((step, n)) = (e - 2..=e)
+        .rev()
+        .flat_map(|k| [5.0, 2.5, 2.0, 1.0].map(|m| m * 10f64.powi(k)))
+        .map(|step| (step, (max / step * (1.0 + 1e-12)).floor() as usize))
+        .find(|&(_, n)| (4..=8).contains(&n))
+    else {
+        return equal(max, ticks);
+    };
+    let mut out = equal(step * n as f64, n);
+    out.push((max, top_label(max)));
+    out
+}
+
+/// A scale's top that is not a round number: plain where it fits the bar's 6 characters
+/// exactly (123456) or to three significant digits (0.123), else with an exponent
+/// (1.23E6), as [`tick_labels`] writes.
+fn top_label(max: f64) -> String {
+    if let Some(d) = exact_decimals(max) {
+        let plain = format!("{max:.d$}");
+        if plain.len() <= 6 {
+            return plain;
+        }
+    }
+    let decimals = (2 - max.log10().floor() as i32).max(0) as usize;
+    let plain = format!("{max:.decimals$}");
+    if plain.len() <= 6 && max >= 1e-3 {
+        return plain;
+    }
+    [2, 1, 0]
+        .iter()
+        .map(|&d| format!("{max:.d$E}"))
+        .find(|l| l.len() <= 6)
+        .unwrap_or_else(|| format!("{max:.0E}"))
+}
+
 /// The fewest decimals (up to 4) that write every multiple of `step` exactly.
 fn decimals_of(step: f64) -> usize {
     exact_decimals(step).unwrap_or(4)
@@ -1187,23 +1245,30 @@ fn draw_scale_bar(img: &mut image::RgbImage, bx: i64, y: i64, bottom: i64, max: 
             img.put_pixel(x as u32, y as u32, image::Rgb(false_colour(t)));
         }
     }
-    let labels = tick_labels(max, ticks);
-    let ticks = labels.len() - 1;
+    let scale = scale_ticks(max, ticks);
+    let last = scale.len() - 1;
+    let length = (by1 - by0 - 1) as f64;
     // Every tick is drawn, but only every `stride`-th labelled where the bar is too short
     // for all the labels to stand apart (QA of issue #16: at the smallest picture, 160
-    // pixels tall, eight labels ran into each other), and the top always; the stride-th
-    // label nearest the top is left out where it would touch the top's. (A stride that
-    // had to divide the ticks labelled only the ends of a bar of 7 ticks: QA pass 12.)
-    let spacing = (by1 - by0 - 1) as f64 / ticks.max(1) as f64;
+    // pixels tall, eight labels ran into each other), and the top always; a label is left
+    // out where it would touch the top's. (A stride that had to divide the ticks labelled
+    // only the ends of a bar of 7 ticks: QA pass 12.)
+    // Where each tick stands on the bar, 0 at the bottom and 1 at the top.
+    let at = |k: usize| {
+        if max > 0.0 {
+            scale[k].0 / max
+        } else {
+            k as f64 / last.max(1) as f64
+        }
+    };
+    let spacing = length * at(1.min(last));
     let need = (5 * LEGEND_FONT + 3) as f64;
-    let stride = (1..=ticks.max(1))
+    let stride = (1..=last.max(1))
         .find(|&s| spacing * s as f64 >= need)
-        .unwrap_or(ticks.max(1));
-    let labelled =
-        |k: usize| k == ticks || (k % stride == 0 && (ticks - k) as f64 * spacing >= need);
-    for (k, label) in labels.iter().enumerate() {
-        let t = k as f64 / ticks as f64;
-        let y = by1 - 1 - ((by1 - by0 - 1) as f64 * t).round() as i64;
+        .unwrap_or(last.max(1));
+    let labelled = |k: usize| k == last || (k % stride == 0 && (1.0 - at(k)) * length >= need);
+    for (k, (_, label)) in scale.iter().enumerate() {
+        let y = by1 - 1 - (length * at(k)).round() as i64;
         // A short tick, then a gap of 6 px, so that it does not read as a minus sign.
         for x in bx + 18..bx + 21 {
             for dy in 0..2 {

@@ -839,3 +839,33 @@ fn a_light_a_hair_from_a_ceiling_reflects_all_its_lumens_to_a_meter() {
         );
     }
 }
+
+#[test]
+fn an_odd_top_is_labelled_in_round_steps_below_it_and_itself() {
+    // `--lux-max 123456`: the largest round step of which 4 to 8 fit below the top, 25000,
+    // then the top (QA pass 17 of #16: its fifths read 2.47E4, 4.94E4, ...).
+    let scale = scale_ticks(123_456.0, 5);
+    let labels: Vec<&str> = scale.iter().map(|(_, l)| l.as_str()).collect();
+    assert_eq!(labels, ["0", "25000", "50000", "75000", "100000", "123456"]);
+    assert_eq!(scale.last().unwrap().0, 123_456.0);
+    assert_eq!(scale[1].0, 25_000.0);
+    // A top past the bar's 6 characters keeps three digits and an exponent; one that is a
+    // round number of round steps, or whose fifths read plainly, keeps its equal steps.
+    assert_eq!(scale_ticks(1_234_567.0, 5).last().unwrap().1, "1.23E6");
+    // (Its round steps up to 1000000 pass the 6 characters: exponents, as tick_labels.)
+    assert_eq!(scale_ticks(1_234_567.0, 5)[1].1, "2.50E5");
+    assert_eq!(scale_ticks(0.123_456, 5).last().unwrap().1, "0.123");
+    assert_eq!(scale_ticks(0.123_456, 5)[1].1, "0.025");
+    assert_eq!(scale_ticks(160.0, 8).len(), 9);
+    assert_eq!(scale_ticks(300.0, 5)[1], (60.0, "60".to_string()));
+    assert_eq!(scale_ticks(1.25e6, 5).last().unwrap().1, "1.25E6");
+    // Every label fits beside the bar.
+    for max in [123_456.0, 1_234_567.0, 0.123_456, 7.777_7e29, 3.3e-7] {
+        for (_, label) in scale_ticks(max, 5) {
+            assert!(
+                27 + text_width(&label, LEGEND_FONT) <= SCALE_BAR_WIDTH as i64 - 8,
+                "{max}: {label}"
+            );
+        }
+    }
+}
