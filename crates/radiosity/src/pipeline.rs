@@ -464,7 +464,7 @@ impl Prepared {
             rays: rays.get(),
             candidates: rays.candidates(),
             seconds,
-            row_sums: matrix.row_sums(),
+            row_sums: matrix.row_sums(&self.areas()),
             reciprocity: matrix.reciprocity(&self.areas()),
         };
         Ok((matrix, stats))
@@ -813,7 +813,7 @@ fn solve_adaptive(
         rays,
         candidates,
         seconds,
-        row_sums: f.row_sums(),
+        row_sums: f.row_sums(&areas),
         reciprocity: f.reciprocity(&areas),
     };
     Ok(Solution {

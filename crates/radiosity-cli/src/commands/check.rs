@@ -87,7 +87,7 @@ pub fn run(args: CheckArgs) -> Result<()> {
                     rays: 0,
                     candidates: 0,
                     seconds: 0.0,
-                    row_sums: f.row_sums(),
+                    row_sums: f.row_sums(&prepared.areas()),
                     reciprocity: f.reciprocity(&prepared.areas()),
                 };
                 (f, stats)

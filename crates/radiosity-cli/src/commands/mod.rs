@@ -93,7 +93,12 @@ pub fn solve_scene(
         // rows that see nothing or sum above 1 went unsaid with --form-factors).
         (FormFactors::File(path), None) if solver.needs_matrix() => {
             let f = prepared.load_form_factors(path, reporter)?;
-            report::row_sum_notes(prepared, &prepared.mesh, &f.row_sums(), reporter);
+            report::row_sum_notes(
+                prepared,
+                &prepared.mesh,
+                &f.row_sums(&prepared.areas()),
+                reporter,
+            );
             Some((f, None))
         }
         _ => None,

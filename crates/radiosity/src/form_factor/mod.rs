@@ -202,6 +202,9 @@ pub struct RowSums {
     /// Rows that sum above [`ROW_SUM_OVER`]: elements that send out more light than leaves
     /// them (over-counted near pairs).
     pub over: usize,
+    /// The area of those elements (scene units squared): many small ones along a contact
+    /// weigh little (the slivers cut along a box's foot), one large wall much.
+    pub over_area: f64,
 }
 
 /// The row sum above which a row counts as over-counted in [`RowSums::over`]: 1 % above
@@ -274,8 +277,9 @@ impl FormFactorMatrix {
         self.row(i).iter().map(|&f| f as f64).sum()
     }
 
-    /// Minimum, mean and maximum row sum.
-    pub fn row_sums(&self) -> RowSums {
+    /// Minimum, mean and maximum row sum; `areas` are the elements' (for
+    /// [`RowSums::over_area`]).
+    pub fn row_sums(&self, areas: &[f64]) -> RowSums {
         let sums: Vec<f64> = (0..self.n).map(|i| self.row_sum(i)).collect();
         let (mut min_row, mut max_row) = (0, 0);
         for (i, &s) in sums.iter().enumerate() {
@@ -294,6 +298,12 @@ impl FormFactorMatrix {
             max_row,
             zero: sums.iter().filter(|&&s| s == 0.0).count(),
             over: sums.iter().filter(|&&s| s > ROW_SUM_OVER).count(),
+            over_area: sums
+                .iter()
+                .zip(areas)
+                .filter(|(&s, _)| s > ROW_SUM_OVER)
+                .map(|(_, &a)| a)
+                .sum(),
         }
     }
 

@@ -17,6 +17,7 @@
 mod adapt;
 mod conforming;
 mod contact;
+mod outline_cut;
 
 pub use adapt::{
     mark_steps, split_marked, AdaptSettings, Origin, DEFAULT_CONTRAST, DEFAULT_FLOOR,
@@ -26,8 +27,8 @@ pub use adapt::{
 pub(crate) use conforming::split_corner_mesh;
 pub use conforming::{DisplayPolygons, DisplayTriangle};
 pub use contact::{
-    refine_contacts, ContactReport, CONTACT_DEPTH, CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS,
-    PROBE_SLACK,
+    refine_contacts, refine_contacts_as_quadtrees, ContactReport, CONTACT_DEPTH,
+    CONTACT_MAX_ELEMENTS, PROBE_DIRECTIONS, PROBE_SLACK,
 };
 pub(crate) use contact::{Cover, Probe};
 

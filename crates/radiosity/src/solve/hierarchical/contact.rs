@@ -121,10 +121,18 @@ impl Solver<'_> {
                         return Verdict::Split(0);
                     }
                     match probe.cover(node.surface, corners, normal) {
-                        Cover::Open => Verdict::Keep,
+                        // Its patches cannot be cut along an outline: a rim between the
+                        // samples of a buried patch is refined as a straddling one, an open
+                        // patch crossed by one is kept as its samples judge it.
+                        Cover::Open | Cover::Crossed { buried: false } => Verdict::Keep,
                         Cover::Buried => Verdict::Bury,
-                        Cover::Partly if level >= CONTACT_DEPTH => Verdict::Keep,
-                        Cover::Partly => Verdict::Split(level + 1),
+                        Cover::Partly | Cover::Crossed { buried: true } => {
+                            if level >= CONTACT_DEPTH {
+                                Verdict::Keep
+                            } else {
+                                Verdict::Split(level + 1)
+                            }
+                        }
                     }
                 })
                 .collect();
