@@ -368,7 +368,8 @@ pub struct CameraArgs {
     /// as for --eye).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
     pub look_at: Option<DVec3>,
-    /// Up direction "x,y,z" (default: the scene's camera's, or +y).
+    /// Up direction "x,y,z" (default: the scene's camera's, or +y unless the scene reads as
+    /// z-up, by its extent and its lights: README, `render` options; the camera is printed).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_vec3)]
     pub up: Option<DVec3>,
     /// Vertical field of view in degrees (default: the scene's camera's, or one that

@@ -1598,12 +1598,17 @@ pub fn path_traced(view: &PathTraced, settings: &PathTraceSettings) {
 /// difference of pixel luminance, and the path tracer's own noise on the same scale, all
 /// relative to the path-traced view's RMS luminance.
 pub fn path_trace_comparison(c: &FilmComparison, elements: usize) {
+    // QA pass 18 of #16: a room of emitting walls read "0 showing an emitter left out".
+    let left_out = if c.all_emitters {
+        "every one showing an emitter: none left out, the emitters compared".to_string()
+    } else {
+        format!("{} showing an emitter left out", c.excluded)
+    };
     outln!(
         "compared          the radiosity render ({elements} elements) with the path-traced \
-         view on luminance: {} pixels ({} showing an emitter left out), relative to the \
-         path tracer's RMS luminance {}",
+         view on luminance: {} pixels ({left_out}), relative to the path tracer's RMS \
+         luminance {}",
         c.pixels,
-        c.excluded,
         significant(c.reference_rms_luminance, 4)
     );
     outln!("rms               {:.2} %", 100.0 * c.rms);

@@ -27,6 +27,9 @@ pub struct FilmComparison {
     pub pixels: usize,
     /// Pixels left out (by the mask).
     pub excluded: usize,
+    /// True where every pixel showed an emitter in one view or the other, so none was left
+    /// out ([`PathTraced::compare_excluding`]): the emitters themselves are compared.
+    pub all_emitters: bool,
     /// The reference's RMS luminance over the compared pixels (the scene's units): the
     /// normaliser of every relative number here.
     pub reference_rms_luminance: f64,
@@ -232,6 +235,7 @@ pub fn compare_films(
     Ok(FilmComparison {
         pixels: compared,
         excluded: pixels - compared,
+        all_emitters: false,
         reference_rms_luminance: rms_y,
         rms: (squares / k).sqrt(),
         bias: sum / k,
@@ -278,12 +282,14 @@ impl PathTraced {
             .collect();
         // Where the two views leave out every pixel between them, every pixel shows an
         // emitter in one: the emitters themselves are compared.
-        let mask = if mask.iter().all(|&m| m) {
+        let all_emitters = mask.iter().all(|&m| m);
+        let mask = if all_emitters {
             vec![false; mask.len()]
         } else {
             mask
         };
         let mut c = compare_films(self.film(), other, &mask)?;
+        c.all_emitters = all_emitters;
         let squares: f64 = self
             .luminance_standard_errors()
             .iter()

@@ -541,6 +541,11 @@ fn the_renderers_emitter_pixels_are_left_out_too() {
     let c = view.compare_excluding(view.film(), &mask).unwrap();
     assert_eq!((c.excluded, c.pixels), (own + 1, 63 - own));
     assert_eq!(view.compare(view.film()).unwrap().excluded, own);
+    assert!(!c.all_emitters);
+    // Every pixel left out between the two masks: every pixel is compared, and the
+    // comparison says so (QA pass 18 of #16: "0 showing an emitter left out").
+    let c = view.compare_excluding(view.film(), &[true; 64]).unwrap();
+    assert!(c.all_emitters && c.excluded == 0 && c.pixels == 64, "{c:?}");
     assert!(matches!(
         view.compare_excluding(view.film(), &mask[..10]),
         Err(FilmCompareError::Mask {
