@@ -465,10 +465,12 @@ fn every_error_of_an_obj_and_its_mtl_comes_in_one_run() {
     let lines: Vec<&str> = text.lines().collect();
     // The MTL's syntax error as it is read (line 1 of the OBJ), the reflectance of 1 at the
     // first `usemtl white` (not again at the second), the NaN, and the index 9 past the
-    // 7 vertices (the NaN's stand-in keeps the count, so `f 2 6 7 3` is fine).
+    // 7 vertices (the NaN's stand-in keeps the count, so `f 2 6 7 3` is fine). File by
+    // file, line by line (QA pass 18 of #16: the MTL's line 4 came before its line 2, as
+    // found).
     assert_eq!(errors.len(), 4, "{text}");
-    assert!(lines[0].starts_with("m.mtl:4: error:"), "{text}");
-    assert!(lines[1].starts_with("m.mtl:2: error:"), "{text}");
+    assert!(lines[0].starts_with("m.mtl:2: error:"), "{text}");
+    assert!(lines[1].starts_with("m.mtl:4: error:"), "{text}");
     assert!(lines[2].starts_with("m.obj:7: error:"), "{text}");
     assert!(lines[3].starts_with("m.obj:12: error:"), "{text}");
     assert!(lines[3].contains("face 3 of object"), "{text}");
