@@ -902,7 +902,8 @@ pub fn scale_ticks(max: f64, ticks: usize) -> Vec<(f64, String)> {
 /// exactly (123456) or to three significant digits (0.123), else with an exponent
 /// (1.23E6), as [`tick_labels`] writes.
 fn top_label(max: f64) -> String {
-    if let Some(d) = exact_decimals(max) {
+    // Below 1e-4 four decimals write nothing of it (review of #16: 3.3e-7 read "0").
+    if let Some(d) = exact_decimals(max).filter(|_| max >= 1e-4) {
         let plain = format!("{max:.d$}");
         if plain.len() <= 6 {
             return plain;

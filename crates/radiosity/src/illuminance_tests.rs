@@ -859,6 +859,8 @@ fn an_odd_top_is_labelled_in_round_steps_below_it_and_itself() {
     assert_eq!(scale_ticks(160.0, 8).len(), 9);
     assert_eq!(scale_ticks(300.0, 5)[1], (60.0, "60".to_string()));
     assert_eq!(scale_ticks(1.25e6, 5).last().unwrap().1, "1.25E6");
+    // A tiny top keeps its digits (it read "0").
+    assert_eq!(scale_ticks(3.3e-7, 5).last().unwrap().1, "3.3E-7");
     // Every label fits beside the bar.
     for max in [123_456.0, 1_234_567.0, 0.123_456, 7.777_7e29, 3.3e-7] {
         for (_, label) in scale_ticks(max, 5) {

@@ -280,6 +280,7 @@ impl FormFactorMatrix {
     /// Minimum, mean and maximum row sum; `areas` are the elements' (for
     /// [`RowSums::over_area`]).
     pub fn row_sums(&self, areas: &[f64]) -> RowSums {
+        debug_assert_eq!(areas.len(), self.n, "one area per row");
         let sums: Vec<f64> = (0..self.n).map(|i| self.row_sum(i)).collect();
         let (mut min_row, mut max_row) = (0, 0);
         for (i, &s) in sums.iter().enumerate() {

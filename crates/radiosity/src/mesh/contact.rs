@@ -155,20 +155,25 @@ fn refine(
             if !probe.has_cover_nearby(el.surface, &corners, el.normal) {
                 return None;
             }
+            let mut pieces = Vec::new();
             match probe.cover(el.surface, &corners, el.normal) {
-                Cover::Open => None,
-                Cover::Buried => Some(Vec::new()),
-                Cover::Partly => {
-                    let mut pieces = Vec::new();
-                    probe.split_into(el.surface, corners, el.normal, 1, &mut pieces);
-                    Some(pieces)
+                Cover::Open => return None,
+                Cover::Buried => {}
+                Cover::Crossed { .. } if probe.cut_outlines => {
+                    probe.cut_along_outlines(el.surface, corners.clone(), el.normal, &mut pieces)
                 }
-                Cover::Crossed { .. } => {
-                    let mut pieces = Vec::new();
-                    probe.cut_along_outlines(el.surface, corners, el.normal, &mut pieces);
-                    Some(pieces)
+                // As the quadtrees: an open patch crossed by an outline is kept as its
+                // samples judge it, a buried one refined as a straddling one.
+                Cover::Crossed { buried: false } => return None,
+                Cover::Partly | Cover::Crossed { buried: true } => {
+                    probe.split_into(el.surface, corners.clone(), el.normal, 1, &mut pieces)
                 }
             }
+            // Cut into parts of which none was buried: the element as it was.
+            if pieces.len() == 1 && pieces[0] == corners {
+                return None;
+            }
+            Some(pieces)
         })
         .collect();
 
@@ -387,13 +392,11 @@ impl<'a> Probe<'a> {
         // round what stands on it (QA pass 18 of #16: the 2 cm of a bed's frame round its
         // mattress was dropped whole, a black line round every bed), or a buried foot (of a
         // leg, of books on a shelf) whose share of the piece would send and take light.
-        if self.cut_outlines
-            && crosses(
-                corners,
-                normal,
-                &self.outline_edges(surface, corners, normal),
-            )
-        {
+        if crosses(
+            corners,
+            normal,
+            &self.outline_edges(surface, corners, normal),
+        ) {
             Cover::Crossed { buried }
         } else if buried {
             Cover::Buried
@@ -419,20 +422,35 @@ impl<'a> Probe<'a> {
                 Cover::Buried => {}
                 // Cut along the outline where it crosses a child between its samples, or
                 // where the quadtree stops.
-                Cover::Crossed { .. } => self.cut_along_outlines(surface, child, normal, out),
-                Cover::Partly if level >= CONTACT_DEPTH && !self.cut_outlines => out.push(child),
-                Cover::Partly if level >= CONTACT_DEPTH => {
+                Cover::Crossed { .. } if self.cut_outlines => {
                     self.cut_along_outlines(surface, child, normal, out)
                 }
-                Cover::Partly => self.split_into(surface, child, normal, level + 1, out),
+                Cover::Partly if level >= CONTACT_DEPTH && self.cut_outlines => {
+                    self.cut_along_outlines(surface, child, normal, out)
+                }
+                // As the quadtrees (`solve/hierarchical/contact.rs`): an open child crossed
+                // by an outline kept, a straddling one kept at the last level, a buried one
+                // crossed by an outline kept there where some part of it is open.
+                Cover::Crossed { buried: false } => out.push(child),
+                Cover::Partly if level >= CONTACT_DEPTH => out.push(child),
+                Cover::Crossed { buried: true } if level >= CONTACT_DEPTH => {
+                    if self.has_open_part(surface, &child, normal) {
+                        out.push(child)
+                    }
+                }
+                Cover::Partly | Cover::Crossed { buried: true } => {
+                    self.split_into(surface, child, normal, level + 1, out)
+                }
             }
         }
     }
 }
 
 impl Probe<'_> {
-    /// A piece still partly buried at [`CONTACT_DEPTH`], cut along the outlines that cross
-    /// it ([`super::outline_cut`]); appends to `out` the parts not buried. A part that is
+    /// A piece still partly buried at [`CONTACT_DEPTH`], or crossed by an outline between
+    /// its samples, cut along the outlines that cross it ([`super::outline_cut`]); appends
+    /// to `out` the parts not buried, or the piece whole where no part is buried (a cut that
+    /// buries nothing only makes elements: a panel standing on the floor). A part that is
     /// still partly buried (an outline no surface edge gives, such as a sofa's curved foot)
     /// is kept, as the whole piece was before.
     fn cut_along_outlines(
@@ -442,18 +460,41 @@ impl Probe<'_> {
         normal: DVec3,
         out: &mut Vec<Vec<DVec3>>,
     ) {
-        let edges = self.outline_edges(surface, &piece, normal);
-        if edges.is_empty() {
-            out.push(piece);
-            return;
+        match self.open_parts(surface, &piece, normal) {
+            None => out.push(piece),
+            Some(parts) => out.extend(parts),
         }
-        for part in cut_along(&piece, normal, &edges) {
-            if !matches!(
-                self.cover(surface, &part, normal),
-                Cover::Buried | Cover::Crossed { buried: true }
-            ) {
-                out.push(part);
-            }
+    }
+
+    /// The parts of `piece` not buried once it is cut along the outlines that cross it, or
+    /// `None` where none is buried (or nothing crosses it).
+    fn open_parts(&self, surface: u32, piece: &[DVec3], normal: DVec3) -> Option<Vec<Vec<DVec3>>> {
+        let edges = self.outline_edges(surface, piece, normal);
+        let parts = cut_along(piece, normal, &edges);
+        if parts.len() < 2 {
+            return None;
+        }
+        let count = parts.len();
+        let open: Vec<Vec<DVec3>> = parts
+            .into_iter()
+            .filter(|part| {
+                !matches!(
+                    self.cover(surface, part, normal),
+                    Cover::Buried | Cover::Crossed { buried: true }
+                )
+            })
+            .collect();
+        (open.len() < count).then_some(open)
+    }
+
+    /// Whether some part of a piece whose samples are all buried, cut along the outlines
+    /// that cross it, is open (hierarchical radiosity keeps such a patch at its last level
+    /// and buries it otherwise: it cannot cut it).
+    pub(crate) fn has_open_part(&self, surface: u32, piece: &[DVec3], normal: DVec3) -> bool {
+        match self.open_parts(surface, piece, normal) {
+            Some(open) => !open.is_empty(),
+            // Nothing buried once cut: its samples said otherwise; keep it.
+            None => true,
         }
     }
 
@@ -481,8 +522,20 @@ impl Probe<'_> {
                 }
             }
         };
+        // The covers whose box (projected, so their gap above the plane is no matter)
+        // reaches the piece's: a floor under many rugs asks only the near ones.
         for &t in &self.covers[surface as usize] {
-            push_edges(self.polygons[t as usize], false);
+            let cover = self.polygons[t as usize];
+            let (mut clo, mut chi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for &v in cover {
+                let v = onto(v);
+                clo = clo.min(v);
+                chi = chi.max(v);
+            }
+            let reach = DVec3::splat(self.lift);
+            if (clo - reach).cmple(hi).all() && (chi + reach).cmpge(lo).all() {
+                push_edges(cover, false);
+            }
         }
         let mut candidates = Vec::new();
         let reach = DVec3::splat(self.lift);

@@ -28,9 +28,16 @@ use glam::{DVec2, DVec3};
 pub(crate) type OutlineEdge = (DVec3, DVec3);
 
 /// Distances below this fraction of the piece's size (the square root of its area) count as
-/// on the cut line: far above rounding (1e-16), far below any gap anyone models. Corners of
-/// the piece that close to a line are kept on both sides, so no sliver of zero width is made.
-const ON_LINE: f64 = 1e-9;
+/// on the cut line: 1e-4, far above rounding (1e-16) and the probe's lift (1e-7 of the
+/// scene), below anything a picture shows. Corners of the piece that close to a line are
+/// kept on both sides, so no sliver thinner than this is made (at 1e-9 a cut 2e-9 from an
+/// edge made a part of aspect 5e8, whose probe verdict was rounding: review of #11).
+const ON_LINE: f64 = 1e-4;
+
+/// Parts of less than this fraction of the piece's area are left out: only those with
+/// every corner on the line (zero area to rounding). A small part is kept, so the parts
+/// tile the piece without a hole.
+const DEGENERATE: f64 = 1e-12;
 
 /// The convex polygon `piece` (counter-clockwise about `normal`, planar) cut along every
 /// edge in `edges` whose segment passes through its inside, as convex polygons of 3 or 4
@@ -58,7 +65,9 @@ pub(crate) fn cut_along(piece: &[DVec3], normal: DVec3, edges: &[OutlineEdge]) -
             }
             let (left, right) = split(&part, &side, eps);
             for half in [left, right] {
-                if half.len() >= 3 && crate::geometry::polygon_area(&half) > eps * size {
+                if half.len() >= 3
+                    && crate::geometry::polygon_area(&half) > DEGENERATE * size * size
+                {
                     next.push(half);
                 }
             }
@@ -284,24 +293,38 @@ mod tests {
 
     #[test]
     fn neighbours_cut_by_one_line_share_the_corner_bit_for_bit() {
-        // Two squares sharing the edge x = 1, cut by a slanted line: the point where it
+        // Two squares sharing the edge x = 1, cut by slanted lines: the point where each
         // crosses the shared edge is computed from the edge's ends in one order by both.
-        let line = (dvec3(-0.1, 0., 0.123_456_789), dvec3(2.1, 0., 0.876_543_21));
-        let a = cut_along(&square(0., 0., 1.), DVec3::Y, &[line]);
-        let b = cut_along(&square(1., 0., 1.), DVec3::Y, &[line]);
-        let on_edge = |parts: &[Vec<DVec3>]| -> Vec<DVec3> {
-            let mut v: Vec<DVec3> = parts
-                .iter()
-                .flatten()
-                .copied()
-                .filter(|p| p.x == 1.0 && p.z > 0.0 && p.z < 1.0)
-                .collect();
-            v.dedup();
-            v
+        // (Taken in each piece's own order, about half of such lines gave corners a bit
+        // apart: review of #11.) 200 lines of a fixed sequence.
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let (ea, eb) = (on_edge(&a), on_edge(&b));
-        assert_eq!(ea.len(), 1, "{a:?}");
-        assert_eq!(ea, eb);
+        for _ in 0..200 {
+            let line = (
+                dvec3(-0.1, 0., 0.05 + 0.9 * next()),
+                dvec3(2.1, 0., 0.05 + 0.9 * next()),
+            );
+            let a = cut_along(&square(0., 0., 1.), DVec3::Y, &[line]);
+            let b = cut_along(&square(1., 0., 1.), DVec3::Y, &[line]);
+            let on_edge = |parts: &[Vec<DVec3>]| -> Vec<DVec3> {
+                let mut v: Vec<DVec3> = parts
+                    .iter()
+                    .flatten()
+                    .copied()
+                    .filter(|p| p.x == 1.0 && p.z > 0.0 && p.z < 1.0)
+                    .collect();
+                v.dedup();
+                v
+            };
+            let (ea, eb) = (on_edge(&a), on_edge(&b));
+            assert_eq!(ea.len(), 1, "{line:?}: {a:?}");
+            assert_eq!(ea, eb, "{line:?}");
+        }
     }
 
     #[test]

@@ -314,6 +314,19 @@ impl Reader<'_> {
                     describe_node(&node)
                 )));
             }
+            // A rotation must be a unit quaternion (glTF 2.0, 5.25); [0, 0, 0, 0] turned into
+            // no rotation at all, silently (QA pass 18 of #16). A small drift, as exporters
+            // round, is normalised by the matrix formula's use of the unit form.
+            if let gltf::scene::Transform::Decomposed { rotation, .. } = node.transform() {
+                let length = rotation.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt();
+                if !((length - 1.0).abs() <= 1e-3) {
+                    return Err(self.error(format!(
+                        "node {} has rotation {rotation:?}, which is not a unit quaternion \
+                         (its length is {length:.4}; glTF requires 1)",
+                        describe_node(&node)
+                    )));
+                }
+            }
             let local =
                 DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
             let global = parent * local;

@@ -618,6 +618,20 @@ fn node_transforms_compose_parent_first() {
 }
 
 #[test]
+fn a_rotation_that_is_not_a_unit_quaternion_is_refused() {
+    // QA pass 18 of #16: [0, 0, 0, 0] was read as no rotation, silently. glTF requires a
+    // unit quaternion; [0, 0, 0.5, 0.5] (length 0.71) is as wrong.
+    for rotation in [json!([0, 0, 0, 0]), json!([0, 0, 0.5, 0.5])] {
+        let nodes = json!([{ "name": "turned", "mesh": 0, "rotation": rotation }]);
+        let e = read_doc(&square_doc(nodes, grey(), None))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("is not a unit quaternion"), "{e}");
+        assert!(e.contains("turned"), "{e}");
+    }
+}
+
+#[test]
 fn a_mirroring_node_keeps_the_front_as_the_author_saw_it() {
     // A column-major matrix mirroring x. glTF says a negative determinant turns the
     // winding, so the square still faces +z.

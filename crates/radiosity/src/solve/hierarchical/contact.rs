@@ -122,16 +122,23 @@ impl Solver<'_> {
                     }
                     match probe.cover(node.surface, corners, normal) {
                         // Its patches cannot be cut along an outline: a rim between the
-                        // samples of a buried patch is refined as a straddling one, an open
-                        // patch crossed by one is kept as its samples judge it.
+                        // samples of a buried patch is refined as a straddling one, and
+                        // kept at the last level where some part of it is open (a seam
+                        // between two boxes standing side by side crosses a patch wholly
+                        // under them: buried); an open patch crossed by one is kept as its
+                        // samples judge it.
                         Cover::Open | Cover::Crossed { buried: false } => Verdict::Keep,
                         Cover::Buried => Verdict::Bury,
-                        Cover::Partly | Cover::Crossed { buried: true } => {
-                            if level >= CONTACT_DEPTH {
+                        Cover::Partly if level >= CONTACT_DEPTH => Verdict::Keep,
+                        Cover::Crossed { buried: true } if level >= CONTACT_DEPTH => {
+                            if probe.has_open_part(node.surface, corners, normal) {
                                 Verdict::Keep
                             } else {
-                                Verdict::Split(level + 1)
+                                Verdict::Bury
                             }
+                        }
+                        Cover::Partly | Cover::Crossed { buried: true } => {
+                            Verdict::Split(level + 1)
                         }
                     }
                 })
