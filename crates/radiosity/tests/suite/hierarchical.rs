@@ -566,12 +566,17 @@ fn cornell_box_element_by_element_against_an_exact_dense_solve() {
     )[..] else {
         unreachable!()
     };
-    // 2,500 elements since the contact probes decide alike at any scale (2,484 before;
-    // issue #16): the figures above were measured at 2,484.
-    assert_eq!(c.elements, 2500);
+    // 2,590 elements since a piece whose probe points are all buried while a block's foot
+    // crosses it (a rim outside the foot) is refined as a straddling one, by the hierarchy
+    // and this mesh alike (2,500 before; 2,484 before the contact probes decided alike at
+    // any scale, issue #16): the figures above were measured at 2,484; at 2,590 (review of
+    // #11) RMS 0.50 %, largest 34 %, mean -0.03 % here, 0.98 %, 45 % and +0.05 % at the
+    // defaults below; coarse 8.4 %, 88 %, -0.44 %.
+    assert_eq!(c.elements, 2590);
     assert!(c.rms < 0.01, "{c:?}");
     assert!(c.bias.abs() < 0.004, "{c:?}");
-    assert!(c.max < 0.35, "{c:?}");
+    // The largest: 1.4x the 34 % measured at 2,590 elements (24.8 % at 2,484).
+    assert!(c.max < 0.48, "{c:?}");
     // The CLI's default epsilon, 0.05: measured RMS 8.4 %, largest 87 %, mean -0.86 %
     // (8.8 %, 89 % and -0.15 % on the plain grid before contacts were refined). Before a
     // cluster's oracle counted the directions its members see the other node from,
@@ -601,9 +606,13 @@ fn default_settings_within_two_percent_of_an_exact_dense_solve() {
     else {
         unreachable!()
     };
-    // 2,500 elements since the contact probes decide alike at any scale (2,484 before;
-    // issue #16): the figures above were measured at 2,484.
-    assert_eq!(c.elements, 2500);
+    // 2,590 elements since a piece whose probe points are all buried while a block's foot
+    // crosses it (a rim outside the foot) is refined as a straddling one, by the hierarchy
+    // and this mesh alike (2,500 before; 2,484 before the contact probes decided alike at
+    // any scale, issue #16): the figures above were measured at 2,484; at 2,590 (review of
+    // #11) RMS 0.50 %, largest 34 %, mean -0.03 % here, 0.98 %, 45 % and +0.05 % at the
+    // defaults below; coarse 8.4 %, 88 %, -0.44 %.
+    assert_eq!(c.elements, 2590);
     assert!(c.rms < 0.02, "{c:?}");
     assert!(c.max < 0.6, "{c:?}");
     assert!(c.bias.abs() < 0.01, "{c:?}");

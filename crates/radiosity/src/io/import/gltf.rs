@@ -315,20 +315,34 @@ impl Reader<'_> {
                 )));
             }
             // A rotation must be a unit quaternion (glTF 2.0, 5.25); [0, 0, 0, 0] turned into
-            // no rotation at all, silently (QA pass 18 of #16). A small drift, as exporters
-            // round, is normalised by the matrix formula's use of the unit form.
-            if let gltf::scene::Transform::Decomposed { rotation, .. } = node.transform() {
-                let length = rotation.iter().map(|&c| (c as f64).powi(2)).sum::<f64>().sqrt();
-                if !((length - 1.0).abs() <= 1e-3) {
-                    return Err(self.error(format!(
-                        "node {} has rotation {rotation:?}, which is not a unit quaternion \
-                         (its length is {length:.4}; glTF requires 1)",
-                        describe_node(&node)
-                    )));
+            // no rotation at all, silently (QA pass 18 of #16). A drift within 1e-3, as
+            // exporters' rounding gives, is normalised (unnormalised, the rotation matrix
+            // would scale the node).
+            let local = match node.transform() {
+                gltf::scene::Transform::Decomposed {
+                    translation,
+                    rotation,
+                    scale,
+                } => {
+                    let q = glam::DQuat::from_array(rotation.map(f64::from));
+                    let length = q.length();
+                    if !((length - 1.0).abs() <= 1e-3) {
+                        return Err(self.error(format!(
+                            "node {} has rotation {rotation:?}, which is not a unit quaternion \
+                             (its length is {length:.4}; glTF requires 1)",
+                            describe_node(&node)
+                        )));
+                    }
+                    DMat4::from_scale_rotation_translation(
+                        glam::DVec3::from_array(scale.map(f64::from)),
+                        q / length,
+                        glam::DVec3::from_array(translation.map(f64::from)),
+                    )
                 }
-            }
-            let local =
-                DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+                transform => {
+                    DMat4::from_cols_array_2d(&transform.matrix().map(|c| c.map(f64::from)))
+                }
+            };
             let global = parent * local;
             if let (None, Some(camera)) = (self.camera, node.camera()) {
                 self.camera = self.camera(&camera, &node, &global);
@@ -571,8 +585,15 @@ impl Reader<'_> {
             gltf::buffer::Source::Uri(uri) => self.uri_bytes(&what, uri, length)?,
         };
         if data.len() < length {
+            // Where the bytes came from (QA pass 18 of #16: a file's was not named).
+            let from = match buffer.source() {
+                gltf::buffer::Source::Uri(uri) if !uri.starts_with("data:") => {
+                    format!(" (read from \"{uri}\")")
+                }
+                _ => String::new(),
+            };
             return Err(self.error(format!(
-                "{what} should hold {length} bytes (its byteLength) but has {}: truncated",
+                "{what}{from} should hold {length} bytes (its byteLength) but has {}: truncated",
                 data.len()
             )));
         }

@@ -1187,6 +1187,26 @@ fn exported_glb_reads_back_as_the_scene_it_was_baked_from() {
     assert_eq!(prepared.mesh.len(), want_prepared.mesh.len());
 }
 
+/// A buffer file shorter than its byteLength is named in the error (QA pass 18 of #16:
+/// "buffer 0 should hold 1392 bytes ... but has 1221" did not say which file it read).
+#[test]
+fn a_short_buffer_file_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let ex = export_cornell_box(dir.path());
+    let doc: Value = serde_json::from_slice(&std::fs::read(&ex.gltf).unwrap()).unwrap();
+    let uri = doc["buffers"][0]["uri"].as_str().unwrap().to_string();
+    let bin = dir.path().join(&uri);
+    let bytes = std::fs::read(&bin).unwrap();
+    std::fs::write(&bin, &bytes[..bytes.len() / 2]).unwrap();
+    let e = read_any_scene(&ex.gltf, &ImportOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!("buffer 0 (read from \"{uri}\") should hold")),
+        "{e}"
+    );
+}
+
 /// A polygon that is not one falls back to the triangles, with a warning naming the mesh.
 #[test]
 fn a_malformed_exported_polygon_reads_the_triangles_instead() {
