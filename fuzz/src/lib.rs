@@ -241,7 +241,7 @@ fn read_and_solve(data: &[u8]) {
         assert!(refused.is_err(), "a matrix of another size was loaded");
         return;
     }
-    let _ = matrix.row_sums();
+    let _ = matrix.row_sums(&prepared.areas());
     let _ = matrix.reciprocity(&prepared.areas());
     let mut request = SolveRequest::new(Solver::DEFAULT_GAUSS_SEIDEL);
     request.form_factors = pipeline::FormFactors::Matrix(&matrix);
