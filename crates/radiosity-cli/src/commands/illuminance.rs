@@ -133,6 +133,9 @@ pub fn run(args: IlluminanceArgs) -> Result<()> {
         // Printed even with --quiet: figures that are surely not what was meant.
         errln!("warning: {w}");
     }
+    if let Some(w) = points_at_lights(&prepared.scene, &points) {
+        errln!("warning: {w}");
+    }
     reporter.note(&format!(
         "wrote {} ({}; {}; the scene's unit: {})",
         args.output.display(),
@@ -211,6 +214,37 @@ fn grid_short_of_corner(a: glam::DVec3, b: glam::DVec3, spacing: f64) -> Option<
             short.join("; ")
         )
     })
+}
+
+/// A warning when points lie at a point light (within 1e-9 of the scene's size): its
+/// direct light there, I / d^2 at d = 0, has no value and is counted 0 (QA pass 17 of #16:
+/// a point exactly at a lamp read 0 direct lux from it without a word).
+fn points_at_lights(scene: &radiosity::scene::Scene, points: &[CalcPoint]) -> Option<String> {
+    let (lo, hi) = scene.bounds();
+    let near = 1e-9 * (hi - lo).length().max(f64::MIN_POSITIVE);
+    let at: Vec<(&CalcPoint, &str)> = points
+        .iter()
+        .filter_map(|p| {
+            scene
+                .lights
+                .iter()
+                .find(|l| (l.position - p.position).length() <= near)
+                .map(|l| (p, l.name.as_str()))
+        })
+        .collect();
+    let (p, light) = at.first()?;
+    Some(format!(
+        "{} at a point light (the first: \"{}\" at the light \"{light}\"): a point \
+         light's illuminance at its own position has no value (I / d^2 at d = 0) and is \
+         counted 0 there; move the {} off it",
+        if at.len() == 1 {
+            "1 point lies".to_string()
+        } else {
+            format!("{} points lie", at.len())
+        },
+        p.name,
+        if at.len() == 1 { "point" } else { "points" },
+    ))
 }
 
 /// A warning when some points get no light at all (QA of issue #16: points inside the

@@ -112,6 +112,38 @@ fn illuminance_at_points_and_on_a_grid() {
 }
 
 #[test]
+fn a_point_at_a_point_light_is_warned_of() {
+    // QA pass 17 of #16: a point exactly at the lamp read 0 direct lux from it without a
+    // word. The downlight is at (2, 2, 2.9); the point a meter below it is not warned of.
+    let dir = scratch_dir("illuminance-at-lamp");
+    std::fs::write(
+        dir.join("p.csv"),
+        "name,x,y,z,nx,ny,nz\nlamp,2,2,2.9,0,0,-1\nbelow,2,2,1.9,0,0,1\n",
+    )
+    .unwrap();
+    let out = radiosity(
+        &[
+            "illuminance",
+            &room(),
+            "--points",
+            "p.csv",
+            "-o",
+            "o.csv",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("warning: 1 point lies at a point light (the first: \"lamp\" at the light"),
+        "{err}"
+    );
+    assert!(err.contains("has no value (I / d^2 at d = 0)"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn auto_takes_hierarchical_radiosity_for_a_large_scene_with_point_lights() {
     // Above 20,000 elements `auto` picks hierarchical radiosity, which takes the point
     // luminaires' first bounce at its leaves (before, it refused them and `auto` fell back
