@@ -26,6 +26,21 @@ pub fn area_vector(vertices: &[DVec3]) -> DVec3 {
     0.5 * sum
 }
 
+/// The smallest axis-aligned box holding `points`, as (min, max); (+inf, -inf) for none.
+pub fn bounds(points: impl IntoIterator<Item = DVec3>) -> (DVec3, DVec3) {
+    points.into_iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
+}
+
+/// Whether the boxes (lo, hi) and (other_lo, other_hi) come within `reach` of each other
+/// along every axis.
+pub fn boxes_meet(lo: DVec3, hi: DVec3, other_lo: DVec3, other_hi: DVec3, reach: f64) -> bool {
+    (other_lo - DVec3::splat(reach)).cmple(hi).all()
+        && (other_hi + DVec3::splat(reach)).cmpge(lo).all()
+}
+
 /// The area of a planar polygon (scene units squared).
 pub fn polygon_area(vertices: &[DVec3]) -> f64 {
     area_vector(vertices).length()
@@ -86,7 +101,7 @@ pub fn diameter(vertices: &[DVec3]) -> f64 {
         return brute_force_diameter(vertices);
     }
     let normal = polygon_normal(vertices).unwrap_or_else(|| {
-        let (lo, hi) = bounds(vertices);
+        let (lo, hi) = bounds(vertices.iter().copied());
         let extent = hi - lo;
         if extent.x <= extent.y && extent.x <= extent.z {
             DVec3::X
@@ -168,14 +183,6 @@ fn convex_hull(mut points: Vec<(f64, f64, usize)>) -> Vec<(f64, f64, usize)> {
         hull.pop();
     }
     hull
-}
-
-/// The smallest axis-aligned box holding the corners, as (min, max).
-fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
-    vertices.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
-    )
 }
 
 /// Moves every corner onto the best-fit plane (Newell normal through the corner mean).
@@ -433,7 +440,7 @@ fn repeated_corner(vertices: &[DVec3], diameter: f64) -> Option<(usize, usize)> 
                 .map(|j| (i, j))
         });
     }
-    let (lo, _) = bounds(vertices);
+    let (lo, _) = bounds(vertices.iter().copied());
     let cell = |v: DVec3| ((v - lo) / limit).floor().as_i64vec3().to_array();
     let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> =
         std::collections::HashMap::with_capacity(vertices.len());

@@ -261,11 +261,7 @@ impl<'a> Probe<'a> {
     pub(crate) fn has_cover_nearby(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> bool {
         let size = geometry::polygon_area(corners).sqrt();
         let reach = COVER_REACH * size + self.lift;
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for &c in corners {
-            lo = lo.min(c);
-            hi = hi.max(c);
-        }
+        let (lo, hi) = geometry::bounds(corners.iter().copied());
         let mut candidates = Vec::new();
         self.occluders.overlapping(
             lo - DVec3::splat(reach),
@@ -274,13 +270,8 @@ impl<'a> Probe<'a> {
         );
         // A surface lying on this one, whose box reaches the element's.
         let covered = self.covers[surface as usize].iter().any(|&t| {
-            let (mut clo, mut chi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-            for &v in self.polygons[t as usize] {
-                clo = clo.min(v);
-                chi = chi.max(v);
-            }
-            (clo - DVec3::splat(reach)).cmple(hi).all()
-                && (chi + DVec3::splat(reach)).cmpge(lo).all()
+            let (clo, chi) = geometry::bounds(self.polygons[t as usize].iter().copied());
+            geometry::boxes_meet(lo, hi, clo, chi, reach)
         });
         if covered {
             return true;
@@ -505,11 +496,7 @@ impl Probe<'_> {
     fn outline_edges(&self, surface: u32, piece: &[DVec3], normal: DVec3) -> Vec<OutlineEdge> {
         let origin = piece[0];
         let onto = |p: DVec3| p - (p - origin).dot(normal) * normal;
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for &c in piece {
-            lo = lo.min(c);
-            hi = hi.max(c);
-        }
+        let (lo, hi) = geometry::bounds(piece.iter().copied());
         let mut edges = Vec::new();
         let mut push_edges = |polygon: &[DVec3], in_plane_only: bool| {
             let k = polygon.len();
@@ -526,14 +513,8 @@ impl Probe<'_> {
         // reaches the piece's: a floor under many rugs asks only the near ones.
         for &t in &self.covers[surface as usize] {
             let cover = self.polygons[t as usize];
-            let (mut clo, mut chi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-            for &v in cover {
-                let v = onto(v);
-                clo = clo.min(v);
-                chi = chi.max(v);
-            }
-            let reach = DVec3::splat(self.lift);
-            if (clo - reach).cmple(hi).all() && (chi + reach).cmpge(lo).all() {
+            let (clo, chi) = geometry::bounds(cover.iter().map(|&v| onto(v)));
+            if geometry::boxes_meet(lo, hi, clo, chi, self.lift) {
                 push_edges(cover, false);
             }
         }

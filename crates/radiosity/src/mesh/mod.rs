@@ -505,9 +505,10 @@ impl Mesh {
     /// This mesh with some elements replaced: `pieces[e]` is `None` where element e stays
     /// as it is, else the polygons it becomes (3 or 4 corners each, wound as e; none drops
     /// it). Surfaces keep their order and each element's pieces take its place, so the new
-    /// elements come in the order of the old ones they came from. Vertices are shared by
-    /// exact position within a surface, so pieces conform with each other and with the
-    /// elements left whole wherever their corners coincide (T-junctions remain where a
+    /// elements come in the order of the old ones they came from. Vertices are shared
+    /// within a surface where corners coincide to 1e-9 of its size ([`VertexWeld`]), so
+    /// pieces conform with each other and with the elements left whole wherever their
+    /// corners coincide (T-junctions remain where a
     /// split element meets one that was not). `surfaces` is the scene's surface count.
     pub(crate) fn with_pieces(&self, surfaces: usize, pieces: &[Option<Vec<Vec<DVec3>>>]) -> Mesh {
         let surfaces = (0..surfaces)
@@ -602,11 +603,7 @@ impl Mesh {
     /// The length of the diagonal of the box round surface `s`'s vertices (0 for none).
     fn surface_size(&self, s: usize) -> f64 {
         let range = self.surface_vertices.get(s).cloned().unwrap_or(0..0);
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for v in range {
-            lo = lo.min(self.vertices[v as usize]);
-            hi = hi.max(self.vertices[v as usize]);
-        }
+        let (lo, hi) = geometry::bounds(range.map(|v| self.vertices[v as usize]));
         if lo.x <= hi.x {
             (hi - lo).length()
         } else {

@@ -16,7 +16,9 @@
 //! fanned into triangles and quadrilaterals (what a [`super::Mesh`] holds), and the caller
 //! decides which are buried. Where a cut line meets an edge of the piece, the point is
 //! computed from the edge's two ends taken in a fixed order, so the neighbouring piece that
-//! shares the edge and is cut by the same line computes the bit-identical corner.
+//! shares the edge and is cut by the same line computes the bit-identical corner (where
+//! the two compute it otherwise, from pieces of different levels or cuts in another order,
+//! `Mesh::with_pieces` welds corners within 1e-9 of the surface's size).
 //!
 //! Written by hand: convex polygon splitting by a line is a dozen lines (Sutherland and
 //! Hodgman 1974, one half-plane at a time), and the geometry crates at hand clip in 2D

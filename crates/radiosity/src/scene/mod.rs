@@ -117,13 +117,11 @@ pub struct CameraHint {
 impl Scene {
     /// The smallest axis-aligned box holding every vertex, as (min, max).
     pub fn bounds(&self) -> (DVec3, DVec3) {
-        let mut lo = DVec3::splat(f64::INFINITY);
-        let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for v in self.surfaces.iter().flat_map(|s| s.vertices.iter()) {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
-        (lo, hi)
+        crate::geometry::bounds(
+            self.surfaces
+                .iter()
+                .flat_map(|s| s.vertices.iter().copied()),
+        )
     }
 
     /// The total area of all surfaces (scene units squared).
