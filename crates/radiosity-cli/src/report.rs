@@ -895,8 +895,9 @@ pub fn check(
     } else {
         // One wording with hierarchical radiosity's "leaf contacts" below (QA of issue #16).
         outln!(
-            "contacts          {} split, {} dropped whole; buried and left out: {} {area_unit} (of the grid's elements)",
+            "contacts          {} split ({} of them only along a face hanging just in front), {} dropped whole; buried and left out: {} {area_unit} (of the grid's elements)",
             count(contacts.split as u64, "element"),
+            contacts.shaded_split,
             contacts.dropped,
             significant(contacts.buried_area, 4)
         );

@@ -22,6 +22,12 @@
 //! hair above it, [`crate::scene::lying_on`]) covers it: the rays start above the plane and
 //! cannot see such a cover.
 //!
+//! On the dense mesh the same step follows the faces hanging just in front of a surface (the
+//! back of a sofa 5 cm before a wall, a bookcase's bottom shelf above the floor): a point
+//! whose normal meets such a face within the surface's near gap ([`near_gaps`]) is in its
+//! shade, and the elements where shade and light meet, inside them or along their edges,
+//! are split and cut along the face's projected outline as above, every part kept.
+//!
 //! A point is buried when all but [`PROBE_SLACK`] of [`PROBE_DIRECTIONS`] rays from it (the
 //! normal and six directions 60 degrees from it) first hit the back of a face. Only elements with another
 //! surface nearby in front of them are probed (a box query), so the cost is the contacts',
@@ -30,7 +36,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::outline_cut::{crosses, cut_along, OutlineEdge};
+use super::outline_cut::{crosses, cut_along, runs_along, OutlineEdge};
 use super::{bilinear, for_each_subtriangle, Mesh};
 use crate::geometry;
 use crate::scene::Scene;
@@ -81,6 +87,9 @@ pub struct ContactReport {
     pub split: usize,
     /// Elements of the input mesh that lay wholly buried and were dropped.
     pub dropped: usize,
+    /// Of the `split` elements, those of which nothing was buried: split only along the
+    /// outline of a face hanging just in front of them ([`Probe`]'s near faces).
+    pub shaded_split: usize,
     /// Area removed as buried (scene units squared), whole elements and pieces.
     pub buried_area: f64,
     /// Elements in the refined mesh.
@@ -102,6 +111,11 @@ pub(crate) enum Cover {
     Crossed {
         buried: bool,
     },
+    /// Nothing buried, but the light changes inside the piece or across one of its edges
+    /// where a near face's outline runs ([`Probe`]'s near faces; never for the quadtrees):
+    /// split towards the outline as a straddling piece, and cut along it at
+    /// [`CONTACT_DEPTH`], every part kept.
+    Shade,
 }
 
 /// Splits the elements of `mesh` (cut from `scene`) that lie partly buried under or inside
@@ -144,6 +158,13 @@ fn refine(
     }
     let probe = Probe {
         cut_outlines,
+        // Only the dense mesh follows near faces: hierarchical radiosity's quadtrees (and
+        // the mesh refined as they are) refine their own leaves where the light changes.
+        near_gaps: if cut_outlines {
+            near_gaps(mesh, scene.surfaces.len())
+        } else {
+            Vec::new()
+        },
         ..Probe::new(scene, occluders)
     };
     // Per element: None where it stays as it is, else the pieces it becomes.
@@ -165,7 +186,7 @@ fn refine(
                 // As the quadtrees: an open patch crossed by an outline is kept as its
                 // samples judge it, a buried one refined as a straddling one.
                 Cover::Crossed { buried: false } => return None,
-                Cover::Partly | Cover::Crossed { buried: true } => {
+                Cover::Partly | Cover::Shade | Cover::Crossed { buried: true } => {
                     probe.split_into(el.surface, corners.clone(), el.normal, 1, &mut pieces)
                 }
             }
@@ -181,11 +202,16 @@ fn refine(
     for (e, r) in refined.iter().enumerate() {
         if let Some(pieces) = r {
             let kept: f64 = pieces.iter().map(|p| geometry::polygon_area(p)).sum();
-            report.buried_area += mesh.elements[e].area - kept;
+            let buried = mesh.elements[e].area - kept;
+            report.buried_area += buried;
             if pieces.is_empty() {
                 report.dropped += 1;
             } else {
                 report.split += 1;
+                // Pieces tile what is kept to rounding (the cuts' and quarters' corners).
+                if buried <= 1e-9 * mesh.elements[e].area {
+                    report.shaded_split += 1;
+                }
             }
         }
     }
@@ -216,6 +242,88 @@ pub(crate) struct Probe<'a> {
     /// Whether pieces are cut along the outlines that cross them ([`Cover::Crossed`]; at
     /// [`CONTACT_DEPTH`]): true but for [`refine_contacts_as_quadtrees`].
     cut_outlines: bool,
+    /// Per surface, how near in front of it a face shades it ([`near_gaps`]): a point whose
+    /// normal meets a face within this distance is in its shade, and pieces are split and cut
+    /// along such faces' outlines as along buried ones, keeping every part. Empty for the
+    /// quadtrees and their comparison mesh (no near faces followed).
+    near_gaps: Vec<f64>,
+    /// Every surface's size, the square root of its area.
+    face_sizes: Vec<f64>,
+}
+
+/// Surfaces whose elements are smaller than this fraction of the mesh's largest (in size,
+/// the square root of the area) follow no near faces: 1/4. Their elements are already small
+/// beside the walls' and floors', and the books of a generated bookcase, standing 1 cm
+/// apart, were cut into 30 to 50 pieces each, doubling building_small's elements (3,466 to
+/// 7,005) for faces a picture shows a few pixels wide.
+const NEAR_MIN_SIZE: f64 = 0.25;
+
+/// Near faces further in front than this fraction of their own size are not followed:
+/// 1/4. Their shade is shallow and its edge soft (a chair's seat 45 cm above the floor,
+/// 45 cm across), so an outline would cut the surface where the light does not step.
+const NEAR_SHARP: f64 = 0.25;
+
+/// Near faces smaller than this fraction of a surface's elements (in size) are not followed
+/// on it: 1/3. The light they take is a small part of the element's, and the books standing
+/// 2 cm beside a generated bookcase's side cut it into 200 pieces, three fifths of what near
+/// faces added to building_small (a book's side is 0.28 of the bookcase side's size; a
+/// bookcase's bottom shelf 0.41 of the floor's 1.4 m elements, the sofa's back 1.9 of the
+/// room's wall elements).
+const NEAR_FACE_MIN: f64 = 1.0 / 3.0;
+
+/// How far in front of a surface, in its elements' size, a face is followed ([`near_gaps`]):
+/// half an element. At 0.15 (as [`COVER_REACH`]) the sofa's back 5 cm before the wall of
+/// examples/room.scene was followed at the default 0.5 m elements but not at `--max-area
+/// 0.1` (0.32 m), where the smoothed wall above it came back 18 % too dark over 30 cm (QA
+/// pass 20 of issue #16: a finer mesh made it worse); at a half it is followed down to
+/// 0.1 m elements.
+pub const NEAR_REACH: f64 = 0.5;
+
+/// Per surface of `mesh`, the gap below which a face standing parallel in front of it is
+/// followed: [`NEAR_REACH`] of its largest element's size (25 cm for the 0.5 m elements of
+/// examples/room.scene, where the sofa's back stands 5 cm from the wall and the cupboard 2
+/// cm), and no more than [`NEAR_SHARP`] of the face's own size (checked per face).
+///
+/// The light under a face hanging a gap g in front of a surface falls off over about g at
+/// its outline (the penumbra of the light from the room, seen past the face's edge), so an
+/// element much larger than g that straddles the outline averages a dark and a lit part: the
+/// wall above the sofa's back rendered 7-16 % too dark over 30 cm in smooth shading, the floor
+/// under a bookcase's bottom shelf (5 cm) twice too bright (QA pass 18 of issue #16). This is
+/// discontinuity meshing along the outlines of near occluders (Lischinski, Tampieri and
+/// Greenberg 1992, "Discontinuity meshing for accurate radiosity"), for the faces near
+/// enough that the outline is the discontinuity; the umbrae of far occluders are left to
+/// the grid.
+fn near_gaps(mesh: &Mesh, surfaces: usize) -> Vec<f64> {
+    let largest = mesh
+        .elements
+        .iter()
+        .map(|e| e.area)
+        .fold(0.0, f64::max)
+        .sqrt();
+    let mut gaps = vec![0.0f64; surfaces];
+    for el in &mesh.elements {
+        let size = el.area.sqrt();
+        if size >= NEAR_MIN_SIZE * largest {
+            let gap = &mut gaps[el.surface as usize];
+            *gap = gap.max(NEAR_REACH * size);
+        }
+    }
+    gaps
+}
+
+/// Which states the sample points of a piece take: under a cover, in the shade of a near
+/// face, in the open.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct States {
+    buried: bool,
+    shaded: bool,
+    open: bool,
+}
+
+impl States {
+    fn mixed(self) -> bool {
+        (self.buried as u8 + self.shaded as u8 + self.open as u8) > 1
+    }
 }
 
 impl<'a> Probe<'a> {
@@ -241,7 +349,35 @@ impl<'a> Probe<'a> {
                 covers
             },
             cut_outlines: true,
+            near_gaps: Vec::new(),
+            face_sizes: scene
+                .surfaces
+                .iter()
+                .map(|s| geometry::polygon_area(&s.vertices).sqrt())
+                .collect(),
         }
+    }
+
+    /// Whether `surface` follows the outline of the near face `face`: not its twin, and not
+    /// much smaller than its elements ([`NEAR_FACE_MIN`]).
+    fn follows(&self, surface: u32, face: u32) -> bool {
+        let element = self.near_gaps[surface as usize] / NEAR_REACH;
+        self.face_sizes[face as usize] >= NEAR_FACE_MIN * element && !self.twins(face, surface)
+    }
+
+    /// Whether the point `p` of `surface` (front normal `n`), not buried, is in the shade of
+    /// a face within the surface's near gap in front of it ([`near_gaps`]).
+    fn shaded(&self, surface: u32, p: DVec3, n: DVec3) -> bool {
+        let gap = self.near_gaps.get(surface as usize).copied().unwrap_or(0.0);
+        gap > 0.0
+            && self
+                .occluders
+                .closest_hit(p + self.lift * n, n, 0.0, gap)
+                .is_some_and(|hit| {
+                    hit.t <= gap
+                        && hit.t <= NEAR_SHARP * self.face_sizes[hit.id as usize]
+                        && self.follows(surface, hit.id)
+                })
     }
 
     /// True when a surface lying on `surface` covers the point `p` of it.
@@ -260,7 +396,8 @@ impl<'a> Probe<'a> {
     /// faces.)
     pub(crate) fn has_cover_nearby(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> bool {
         let size = geometry::polygon_area(corners).sqrt();
-        let reach = COVER_REACH * size + self.lift;
+        let near = self.near_gaps.get(surface as usize).copied().unwrap_or(0.0);
+        let reach = (COVER_REACH * size).max(near) + self.lift;
         let (lo, hi) = geometry::bounds(corners.iter().copied());
         let mut candidates = Vec::new();
         self.occluders.overlapping(
@@ -348,37 +485,16 @@ impl<'a> Probe<'a> {
     /// How much of the piece `corners` (3 or 4 corners) of `surface` is buried, judged at
     /// its 4 x 4 sample points: under a surface lying on it, or by the probe rays.
     pub(crate) fn cover(&self, surface: u32, corners: &[DVec3], normal: DVec3) -> Cover {
-        let k = PROBE_GRID;
-        let mut points = Vec::with_capacity((k * k) as usize);
-        if corners.len() == 4 {
-            for j in 0..k {
-                for i in 0..k {
-                    let (u, v) = (
-                        (i as f64 + 0.5 + PROBE_OFFSET[0]) / k as f64,
-                        (j as f64 + 0.5 + PROBE_OFFSET[1]) / k as f64,
-                    );
-                    points.push(bilinear(corners, u, v));
-                }
-            }
-        } else {
-            let [a, b] = PROBE_OFFSET;
-            for_each_subtriangle([corners[0], corners[1], corners[2]], k, |t| {
-                points.push(
-                    (1.0 / 3.0 + a) * t[0] + (1.0 / 3.0 + b) * t[1] + (1.0 / 3.0 - a - b) * t[2],
-                )
-            });
-        }
-        let (mut buried, mut open) = (false, false);
-        for p in points {
-            if self.under_cover(surface, p) || self.buried(p, normal) {
-                buried = true;
+        let points = sample_points(corners);
+        let states = self.states(surface, &points, normal);
+        if states.mixed() {
+            return if states.buried {
+                Cover::Partly
             } else {
-                open = true;
-            }
-            if buried && open {
-                return Cover::Partly;
-            }
+                Cover::Shade
+            };
         }
+        let buried = states.buried;
         // The samples agree, but an outline may cross the piece between them: an open rim
         // round what stands on it (QA pass 18 of #16: the 2 cm of a bed's frame round its
         // mattress was dropped whole, a black line round every bed), or a buried foot (of a
@@ -391,9 +507,64 @@ impl<'a> Probe<'a> {
             Cover::Crossed { buried }
         } else if buried {
             Cover::Buried
+        } else if self.shade_changes_along(surface, corners, normal, states.shaded) {
+            Cover::Shade
         } else {
             Cover::Open
         }
+    }
+
+    /// Whether a near face's outline runs along an edge of the piece (not buried; in the
+    /// shade of near faces where `shaded`) with the light changing across it: the point
+    /// 1/16 of the piece's size beyond the stretch's middle, on the surface, is shaded where
+    /// the piece is not or the other way round. Such a piece is split towards the outline as
+    /// one it crosses, so that smooth shading, which shares a vertex's value between the
+    /// elements round it, blends the two sides over a narrow row of pieces, not over whole
+    /// elements (the wall above the sofa's back in examples/room.scene, 7-16 % too dark over
+    /// 30 cm: QA pass 18 of issue #16).
+    fn shade_changes_along(
+        &self,
+        surface: u32,
+        corners: &[DVec3],
+        normal: DVec3,
+        shaded: bool,
+    ) -> bool {
+        if self.near_gaps.is_empty() {
+            return false;
+        }
+        let edges = self.near_edges(surface, corners, normal);
+        if edges.is_empty() {
+            return false;
+        }
+        let step = geometry::polygon_area(corners).sqrt() / 16.0;
+        let polygon = self.polygons[surface as usize];
+        runs_along(corners, normal, &edges)
+            .into_iter()
+            .any(|(middle, outward)| {
+                let beyond = middle + step * outward;
+                crate::scene::overlap::covers(polygon, normal, beyond)
+                    && !self.under_cover(surface, beyond)
+                    && !self.buried(beyond, normal)
+                    && self.shaded(surface, beyond, normal) != shaded
+            })
+    }
+
+    /// The states `points` of `surface` take, stopping at the second.
+    fn states(&self, surface: u32, points: &[DVec3], normal: DVec3) -> States {
+        let mut states = States::default();
+        for &p in points {
+            if self.under_cover(surface, p) || self.buried(p, normal) {
+                states.buried = true;
+            } else if self.shaded(surface, p, normal) {
+                states.shaded = true;
+            } else {
+                states.open = true;
+            }
+            if states.mixed() {
+                break;
+            }
+        }
+        states
     }
 
     /// Splits a partly buried piece in four, at `level` (1 for the element's children), and
@@ -416,20 +587,20 @@ impl<'a> Probe<'a> {
                 Cover::Crossed { .. } if self.cut_outlines => {
                     self.cut_along_outlines(surface, child, normal, out)
                 }
-                Cover::Partly if level >= CONTACT_DEPTH && self.cut_outlines => {
+                Cover::Partly | Cover::Shade if level >= CONTACT_DEPTH && self.cut_outlines => {
                     self.cut_along_outlines(surface, child, normal, out)
                 }
                 // As the quadtrees (`solve/hierarchical/contact.rs`): an open child crossed
                 // by an outline kept, a straddling one kept at the last level, a buried one
                 // crossed by an outline kept there where some part of it is open.
                 Cover::Crossed { buried: false } => out.push(child),
-                Cover::Partly if level >= CONTACT_DEPTH => out.push(child),
+                Cover::Partly | Cover::Shade if level >= CONTACT_DEPTH => out.push(child),
                 Cover::Crossed { buried: true } if level >= CONTACT_DEPTH => {
                     if self.has_open_part(surface, &child, normal) {
                         out.push(child)
                     }
                 }
-                Cover::Partly | Cover::Crossed { buried: true } => {
+                Cover::Partly | Cover::Shade | Cover::Crossed { buried: true } => {
                     self.split_into(surface, child, normal, level + 1, out)
                 }
             }
@@ -475,7 +646,20 @@ impl Probe<'_> {
                 )
             })
             .collect();
-        (open.len() < count).then_some(open)
+        if open.len() < count {
+            return Some(open);
+        }
+        // Nothing buried: the cut is kept where it parts shade from light under a near face
+        // (the parts' samples differ), the piece whole otherwise.
+        if self.near_gaps.is_empty() {
+            return None;
+        }
+        let states: Vec<States> = open
+            .iter()
+            .map(|part| self.states(surface, &sample_points(part), normal))
+            .collect();
+        let apart = states.iter().any(|s| s.mixed() || *s != states[0]);
+        apart.then_some(open)
     }
 
     /// Whether some part of a piece whose samples are all buried, cut along the outlines
@@ -534,8 +718,77 @@ impl Probe<'_> {
                 push_edges(self.polygons[s as usize], true);
             }
         }
+        edges.extend(self.near_edges(surface, piece, normal));
         edges
     }
+
+    /// The edges of faces hanging within `surface`'s near gap in front of the plane of
+    /// `piece` (both ends between the lift and the gap), projected onto it: the outlines of
+    /// their shade ([`near_gaps`]). None where near faces are not followed.
+    fn near_edges(&self, surface: u32, piece: &[DVec3], normal: DVec3) -> Vec<OutlineEdge> {
+        let origin = piece[0];
+        let onto = |p: DVec3| p - (p - origin).dot(normal) * normal;
+        let (lo, hi) = geometry::bounds(piece.iter().copied());
+        let mut edges = Vec::new();
+        let gap = self.near_gaps.get(surface as usize).copied().unwrap_or(0.0);
+        if gap > 0.0 {
+            let mut candidates = Vec::new();
+            let reach = DVec3::splat(gap);
+            self.occluders
+                .overlapping(lo - reach, hi + reach, &mut candidates);
+            let mut near: Vec<u32> = candidates
+                .into_iter()
+                .map(|k| self.occluders.id_of(k))
+                .filter(|&s| s != surface)
+                .collect();
+            near.sort_unstable();
+            near.dedup();
+            let within = |p: DVec3, sharp: f64| {
+                let h = (p - origin).dot(normal);
+                h > self.lift && h <= gap && h <= sharp
+            };
+            for s in near {
+                if !self.follows(surface, s) {
+                    continue;
+                }
+                let polygon = self.polygons[s as usize];
+                let sharp = NEAR_SHARP * self.face_sizes[s as usize];
+                let k = polygon.len();
+                for i in 0..k {
+                    let (a, b) = (polygon[i], polygon[(i + 1) % k]);
+                    if within(a, sharp) && within(b, sharp) {
+                        edges.push((onto(a), onto(b)));
+                    }
+                }
+            }
+        }
+        edges
+    }
+}
+
+/// The 4 x 4 sample points of a piece (3 or 4 corners): the centres of the cells of its
+/// bilinear grid, or of its 16 subtriangles, moved by [`PROBE_OFFSET`].
+fn sample_points(corners: &[DVec3]) -> Vec<DVec3> {
+    let k = PROBE_GRID;
+    let mut points = Vec::with_capacity((k * k) as usize);
+    if corners.len() == 4 {
+        for j in 0..k {
+            for i in 0..k {
+                let (u, v) = (
+                    (i as f64 + 0.5 + PROBE_OFFSET[0]) / k as f64,
+                    (j as f64 + 0.5 + PROBE_OFFSET[1]) / k as f64,
+                );
+                points.push(bilinear(corners, u, v));
+            }
+        }
+    } else {
+        let [a, b] = PROBE_OFFSET;
+        for_each_subtriangle([corners[0], corners[1], corners[2]], k, |t| {
+            points
+                .push((1.0 / 3.0 + a) * t[0] + (1.0 / 3.0 + b) * t[1] + (1.0 / 3.0 - a - b) * t[2])
+        });
+    }
+    points
 }
 
 /// The four children of a quadrilateral (at its bilinear midpoints) or a triangle (at its
@@ -764,12 +1017,106 @@ mod tests {
     }
 
     #[test]
-    fn nothing_buried_leaves_the_mesh_as_it_was() {
-        // A box hovering 0.1 above the floor buries nothing: light passes under it.
+    fn a_shelf_just_above_the_floor_cuts_it_along_its_outline_and_buries_nothing() {
+        // A box hovering 5 cm above the floor (a bookcase's bottom shelf), its footprint
+        // [0.3, 2.3] x [0.3, 1.3] off the grid's dyadic lines: within the near gap of the
+        // 1 x 1 elements (0.15), so the floor is split and cut along the outline, and
+        // nothing is dropped (light reaches under it through the gap).
+        let mut scene = floor_with_box(0.3, 2.3, 0.3, 1.3);
+        for s in &mut scene.surfaces[1..] {
+            for v in &mut s.vertices {
+                v.y += 0.05;
+            }
+        }
+        let (mesh, report) = refine(&scene);
+        assert_eq!(report.dropped, 0, "{report:?}");
+        assert!(
+            report.split > 0 && report.shaded_split == report.split,
+            "{report:?}"
+        );
+        // The pieces tile the floor: its 16 m^2 to rounding.
+        assert!(
+            (floor_area(&mesh) - 16.0).abs() < 1e-9,
+            "{}",
+            floor_area(&mesh)
+        );
+        // No floor element straddles the outline: an element whose centroid lies under the
+        // footprint has every corner in it (closed, to 1e-9: the cut's corners are computed
+        // on the lines), any other has none strictly inside it.
+        let within = |p: DVec3, eps: f64| {
+            p.x > 0.3 + eps && p.x < 2.3 - eps && p.z > 0.3 + eps && p.z < 1.3 - eps
+        };
+        for e in mesh.surface_elements[0].clone() {
+            let corners: Vec<DVec3> = mesh.corner_positions(e as usize).collect();
+            let under = within(mesh.elements[e as usize].centroid, 0.0);
+            let straddles = if under {
+                corners.iter().any(|&p| !within(p, -1e-9))
+            } else {
+                corners.iter().any(|&p| within(p, 1e-9))
+            };
+            assert!(!straddles, "element {e} straddles the outline: {corners:?}");
+        }
+        // The hierarchy's comparison mesh follows no near faces.
+        let grid = mesh_scene(&scene, 1.0).unwrap();
+        let bvh = PolygonBvh::over_surfaces(&scene);
+        let (quadtrees, report) = refine_contacts_as_quadtrees(&grid, &scene, &bvh);
+        assert_eq!((report.split, report.dropped), (0, 0), "{report:?}");
+        assert_eq!(quadtrees.elements, grid.elements);
+    }
+
+    #[test]
+    fn a_shelf_outline_on_the_grid_lines_refines_the_elements_along_it() {
+        // The shelf's footprint [1, 3] x [1, 2], 5 cm up, on the grid's lines: no element
+        // straddles it, but the light changes across it, so the elements on both sides are
+        // split towards it and those touching it are 1/8 of an element across (smooth
+        // shading blends the two sides over them only).
+        let mut scene = floor_with_box(1., 3., 1., 2.);
+        for s in &mut scene.surfaces[1..] {
+            for v in &mut s.vertices {
+                v.y += 0.05;
+            }
+        }
+        let (mesh, report) = refine(&scene);
+        assert_eq!(report.dropped, 0, "{report:?}");
+        assert!(report.split > 0, "{report:?}");
+        assert!(
+            (floor_area(&mesh) - 16.0).abs() < 1e-9,
+            "{}",
+            floor_area(&mesh)
+        );
+        let on_outline = |p: DVec3| {
+            let (x, z) = (p.x, p.z);
+            let on = |a: f64, b: f64| (a - b).abs() < 1e-9;
+            ((on(x, 1.) || on(x, 3.)) && (1.0..=2.0).contains(&z))
+                || ((on(z, 1.) || on(z, 2.)) && (1.0..=3.0).contains(&x))
+        };
+        let mut touching = 0;
+        for e in mesh.surface_elements[0].clone() {
+            let el = &mesh.elements[e as usize];
+            if mesh
+                .corner_positions(e as usize)
+                .filter(|&p| on_outline(p))
+                .count()
+                >= 2
+            {
+                touching += 1;
+                assert!(el.area <= 1.0 / 64.0 + 1e-12, "element {e}: {}", el.area);
+            }
+        }
+        // 6 m of outline, 8 pieces a metre on each side: 48 outside, 48 inside less the 4
+        // inside corners' pieces, which touch two sides.
+        assert_eq!(touching, 92);
+    }
+
+    #[test]
+    fn nothing_buried_or_near_leaves_the_mesh_as_it_was() {
+        // A box hovering 0.6 above the floor buries nothing (light passes under it) and
+        // stands beyond the near gap of the floor's 1 x 1 elements (NEAR_REACH, 0.5) and a
+        // quarter of its base's size (NEAR_SHARP: 0.35).
         let mut scene = floor_with_box(0.5, 2.5, 0.5, 1.5);
         for s in &mut scene.surfaces[1..] {
             for v in &mut s.vertices {
-                v.y += 0.1;
+                v.y += 0.6;
             }
         }
         let grid = mesh_scene(&scene, 1.0).unwrap();

@@ -507,7 +507,7 @@ fn against_exact_dense(
     // leaves (`refine_contacts_as_quadtrees`: the pieces still straddling a block's foot at
     // the quadtrees' last level kept whole, as the hierarchy keeps its leaves, not cut
     // along the foot as `refine_contacts` cuts them), so the two match piece for piece.
-    // Against the cut mesh (2,682 elements) the hierarchy's leaves along the feet hold
+    // Against the cut mesh (2,678 elements) the hierarchy's leaves along the feet hold
     // the mean of a lit and a buried part where the dense pieces hold the lit part's:
     // RMS 1.25 % and largest 191 % without the gather, 1.51 % and 193 % at the defaults.
     let prepared = prepared_cornell(max_area, None);

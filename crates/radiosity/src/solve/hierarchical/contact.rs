@@ -127,7 +127,10 @@ impl Solver<'_> {
                         // between two boxes standing side by side crosses a patch wholly
                         // under them: buried); an open patch crossed by one is kept as its
                         // samples judge it.
-                        Cover::Open | Cover::Crossed { buried: false } => Verdict::Keep,
+                        // (`Shade` only where near faces are followed: not here.)
+                        Cover::Open | Cover::Crossed { buried: false } | Cover::Shade => {
+                            Verdict::Keep
+                        }
                         Cover::Buried => Verdict::Bury,
                         Cover::Partly if level >= CONTACT_DEPTH => Verdict::Keep,
                         Cover::Crossed { buried: true } if level >= CONTACT_DEPTH => {
