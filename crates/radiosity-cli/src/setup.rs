@@ -272,9 +272,12 @@ pub fn check_scale_and_area(scale: f64, max_area: Option<f64>) -> Result<()> {
 /// `what`, a number above 0".
 fn positive(flag: &str, value: f64, what: &str) -> Result<()> {
     if !(value > 0.0 && value.is_finite()) {
+        // "a finite number" where the value is infinite (QA pass 20 of #16: `--max-area inf`
+        // was told to give "a number above 0").
         bail!(
-            "{flag} {}: give {what}, a number above 0",
-            crate::report::typed(value)
+            "{flag} {}: give {what}, a {}number above 0",
+            crate::report::typed(value),
+            if value.is_infinite() { "finite " } else { "" }
         );
     }
     Ok(())

@@ -295,7 +295,7 @@ fn dark_points(
         ));
     }
     Some(format!(
-        "{} of {} {} no light at all, 0 lx: {}{}",
+        "{} of {} {} no light at all (0 lx): {}{}",
         crate::report::count(dark.len() as u64, "point"),
         points.len(),
         if dark.len() == 1 { "gets" } else { "get" },
