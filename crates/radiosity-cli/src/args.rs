@@ -98,7 +98,7 @@ pub struct BuildingArgs {
     /// Seed of door positions, window widths, furniture placement and colours.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// The scene's MAX_PATCH_AREA (m^2): 1 gives 92,920 elements for the default
+    /// The scene's MAX_PATCH_AREA (m^2): 1 gives 92,946 elements for the default
     /// building (33,279 on the grid, split along furniture contacts and the faces just in front), 0.0125 about 990,000
     /// on the grid (the count is printed when the file is written).
     #[arg(long, default_value_t = 1.0, value_name = "AREA")]

@@ -894,12 +894,21 @@ pub fn check(
         );
     } else {
         // One wording with hierarchical radiosity's "leaf contacts" below (QA of issue #16).
+        // The elements split for a near face's shade alone, where there are any.
+        let shaded = match contacts.shaded_split {
+            0 => String::new(),
+            n if n == contacts.split => format!(
+                " ({} only along a face hanging just in front)",
+                if n == 1 { "it" } else { "all" }
+            ),
+            n => format!(" ({n} of them only along a face hanging just in front)"),
+        };
         outln!(
-            "contacts          {} split ({} of them only along a face hanging just in front), {} dropped whole; buried and left out: {} {area_unit} (of the grid's elements)",
+            "contacts          {} of the grid's {} split{shaded}, {} dropped whole; buried and left out: {} {area_unit} (of the grid's elements)",
             count(contacts.split as u64, "element"),
-            contacts.shaded_split,
+            contacts.input_elements,
             contacts.dropped,
-            significant(contacts.buried_area, 4)
+            significant(contacts.buried_area, 4),
         );
     }
     lying_on(prepared);

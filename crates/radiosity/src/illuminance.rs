@@ -193,21 +193,27 @@ pub fn illuminance_with_progress(
                 }
                 // All points behind the meter's plane while Lambert sees a sliver: the share
                 // of the element's corners in front of it (nudged a millionth towards the
-                // centre, off the edges they share) that the point sees. Counting the sliver
-                // seen without a ray let light through the closed cupboard of
-                // examples/room_downlights.scene (up to 0.003 lx inside it, QA pass 20 of
+                // centre, off the edges they share; the element's own surface ignored, as
+                // the rays may run along it) that the point sees. Counting the sliver seen
+                // without a ray let light through the closed cupboard of
+                // examples/room_downlights.scene (up to 0.009 lx inside it, QA pass 20 of
                 // #16), from the small pieces of the wall behind it whose tops rose past the
                 // meter's plane.
                 let fraction = if total > 0.0 {
                     seen / total
                 } else {
-                    let centre = mesh.elements[r.element].centroid;
+                    let element = &mesh.elements[r.element];
+                    let centre = element.centroid;
                     let (mut front, mut clear) = (0u32, 0u32);
                     for &c in &r.corners {
                         let y = c + 1e-6 * (centre - c);
                         if n.dot(y - p.position) > 0.0 {
                             front += 1;
-                            clear += u32::from(!occluders.segment_blocked(p.position, y));
+                            clear += u32::from(!occluders.segment_blocked_except(
+                                p.position,
+                                y,
+                                element.surface,
+                            ));
                         }
                     }
                     if front > 0 {

@@ -322,6 +322,7 @@ impl Prepared {
         self.light = ElementLight::of_mesh(&mesh, &self.scene)?;
         self.contacts = ContactReport {
             elements: mesh.len(),
+            input_elements: mesh.len(),
             ..ContactReport::default()
         };
         self.mesh = Arc::new(mesh);

@@ -94,6 +94,8 @@ pub struct ContactReport {
     pub buried_area: f64,
     /// Elements in the refined mesh.
     pub elements: usize,
+    /// Elements of the input mesh (the grid).
+    pub input_elements: usize,
     /// True when the mesh was too large to refine ([`CONTACT_MAX_ELEMENTS`]).
     pub skipped: bool,
 }
@@ -104,7 +106,8 @@ pub(crate) enum Cover {
     Open,
     Partly,
     Buried,
-    /// The sample points agree (all buried, or all open), but an outline crosses the piece
+    /// The sample points agree (all buried, all open or all in a near face's shade), but an
+    /// outline crosses the piece
     /// between them (a rim left round what stands on it, the foot of a leg or of books
     /// standing on it): cut it along the outline ([`super::outline_cut`]) and judge the
     /// parts.
@@ -151,6 +154,7 @@ fn refine(
     if mesh.len() > CONTACT_MAX_ELEMENTS {
         let report = ContactReport {
             elements: mesh.len(),
+            input_elements: mesh.len(),
             skipped: true,
             ..ContactReport::default()
         };
@@ -167,38 +171,45 @@ fn refine(
         },
         ..Probe::new(scene, occluders)
     };
-    // Per element: None where it stays as it is, else the pieces it becomes.
-    let refined: Vec<Option<Vec<Vec<DVec3>>>> = (0..mesh.len())
+    // Per element: None where it stays as it is, else the pieces it becomes; and whether
+    // it was split for the light of a near face alone (its verdict `Shade`, or crossed by
+    // an outline with its samples open).
+    let (refined, for_shade): (Vec<Option<Vec<Vec<DVec3>>>>, Vec<bool>) = (0..mesh.len())
         .into_par_iter()
         .map(|e| {
             let corners: Vec<DVec3> = mesh.corner_positions(e).collect();
             let el = &mesh.elements[e];
             if !probe.has_cover_nearby(el.surface, &corners, el.normal) {
-                return None;
+                return (None, false);
             }
             let mut pieces = Vec::new();
-            match probe.cover(el.surface, &corners, el.normal) {
-                Cover::Open => return None,
+            let verdict = probe.cover(el.surface, &corners, el.normal);
+            let for_shade = matches!(verdict, Cover::Shade | Cover::Crossed { buried: false });
+            match verdict {
+                Cover::Open => return (None, false),
                 Cover::Buried => {}
                 Cover::Crossed { .. } if probe.cut_outlines => {
                     probe.cut_along_outlines(el.surface, corners.clone(), el.normal, &mut pieces)
                 }
                 // As the quadtrees: an open patch crossed by an outline is kept as its
                 // samples judge it, a buried one refined as a straddling one.
-                Cover::Crossed { buried: false } => return None,
+                Cover::Crossed { buried: false } => return (None, false),
                 Cover::Partly | Cover::Shade | Cover::Crossed { buried: true } => {
                     probe.split_into(el.surface, corners.clone(), el.normal, 1, &mut pieces)
                 }
             }
             // Cut into parts of which none was buried: the element as it was.
             if pieces.len() == 1 && pieces[0] == corners {
-                return None;
+                return (None, false);
             }
-            Some(pieces)
+            (Some(pieces), for_shade)
         })
-        .collect();
+        .unzip();
 
-    let mut report = ContactReport::default();
+    let mut report = ContactReport {
+        input_elements: mesh.len(),
+        ..ContactReport::default()
+    };
     for (e, r) in refined.iter().enumerate() {
         if let Some(pieces) = r {
             let kept: f64 = pieces.iter().map(|p| geometry::polygon_area(p)).sum();
@@ -209,7 +220,7 @@ fn refine(
             } else {
                 report.split += 1;
                 // Pieces tile what is kept to rounding (the cuts' and quarters' corners).
-                if buried <= 1e-9 * mesh.elements[e].area {
+                if for_shade[e] && buried <= 1e-9 * mesh.elements[e].area {
                     report.shaded_split += 1;
                 }
             }
@@ -262,6 +273,12 @@ const NEAR_MIN_SIZE: f64 = 0.25;
 /// 1/4. Their shade is shallow and its edge soft (a chair's seat 45 cm above the floor,
 /// 45 cm across), so an outline would cut the surface where the light does not step.
 const NEAR_SHARP: f64 = 0.25;
+
+/// How parallel to a surface a near face must be for its shade to be followed: the cosine
+/// of the angle between them at least 0.95 (18 degrees). Its outline is taken from the edges
+/// that lie wholly within the gap; a face tilted across the gap has no such outline, and its
+/// shade ends where the gap does, not where the light steps.
+const NEAR_PARALLEL: f64 = 0.95;
 
 /// Near faces smaller than this fraction of a surface's elements (in size) are not followed
 /// on it: 1/3. The light they take is a small part of the element's, and the books standing
@@ -361,7 +378,7 @@ impl<'a> Probe<'a> {
     /// Whether `surface` follows the outline of the near face `face`: not its twin, and not
     /// much smaller than its elements ([`NEAR_FACE_MIN`]).
     fn follows(&self, surface: u32, face: u32) -> bool {
-        let element = self.near_gaps[surface as usize] / NEAR_REACH;
+        let element = self.near_gaps.get(surface as usize).copied().unwrap_or(0.0) / NEAR_REACH;
         self.face_sizes[face as usize] >= NEAR_FACE_MIN * element && !self.twins(face, surface)
     }
 
@@ -376,6 +393,7 @@ impl<'a> Probe<'a> {
                 .is_some_and(|hit| {
                     hit.t <= gap
                         && hit.t <= NEAR_SHARP * self.face_sizes[hit.id as usize]
+                        && self.normals[hit.id as usize].dot(n).abs() >= NEAR_PARALLEL
                         && self.follows(surface, hit.id)
                 })
     }
@@ -389,7 +407,8 @@ impl<'a> Probe<'a> {
     }
 
     /// True when another surface reaches within [`COVER_REACH`] of the element's size of
-    /// it and has some part in front of its plane, or is pressed against it face to face:
+    /// it (or the surface's near gap, [`near_gaps`], where that is wider) and has some part
+    /// in front of its plane, or is pressed against it face to face:
     /// only then can part of it be buried. (A surface wholly behind the plane, or lying in
     /// it, cannot cover it; a cover standing further off, such as the top of a bottomless
     /// box whose sides are far from this element, is missed: the scenes' boxes have all six
@@ -567,9 +586,10 @@ impl<'a> Probe<'a> {
         states
     }
 
-    /// Splits a partly buried piece in four, at `level` (1 for the element's children), and
-    /// appends to `out` the pieces not buried: a child is split again while it is partly
-    /// buried and `level` is below [`CONTACT_DEPTH`].
+    /// Splits a partly buried piece (or one a near face's shade parts, [`Cover::Shade`]) in
+    /// four, at `level` (1 for the element's children), and appends to `out` the pieces not
+    /// buried: a child is split again while it is partly buried or parted by the shade and
+    /// `level` is below [`CONTACT_DEPTH`].
     fn split_into(
         &self,
         surface: u32,
@@ -611,8 +631,9 @@ impl<'a> Probe<'a> {
 impl Probe<'_> {
     /// A piece still partly buried at [`CONTACT_DEPTH`], or crossed by an outline between
     /// its samples, cut along the outlines that cross it ([`super::outline_cut`]); appends
-    /// to `out` the parts not buried, or the piece whole where no part is buried (a cut that
-    /// buries nothing only makes elements: a panel standing on the floor). A part that is
+    /// to `out` the parts not buried, or the piece whole where no part is buried and no near
+    /// face's shade parts them (a cut that buries nothing only makes elements: a panel
+    /// standing on the floor). A part that is
     /// still partly buried (an outline no surface edge gives, such as a sofa's curved foot)
     /// is kept, as the whole piece was before.
     fn cut_along_outlines(
@@ -629,7 +650,8 @@ impl Probe<'_> {
     }
 
     /// The parts of `piece` not buried once it is cut along the outlines that cross it, or
-    /// `None` where none is buried (or nothing crosses it).
+    /// `None` where none is buried and the parts not buried all lie alike in a near face's
+    /// shade or out of it (or nothing crosses it).
     fn open_parts(&self, surface: u32, piece: &[DVec3], normal: DVec3) -> Option<Vec<Vec<DVec3>>> {
         let edges = self.outline_edges(surface, piece, normal);
         let parts = cut_along(piece, normal, &edges);
@@ -654,11 +676,16 @@ impl Probe<'_> {
         if self.near_gaps.is_empty() {
             return None;
         }
-        let states: Vec<States> = open
+        // Parts still partly buried (an outline no edge gives) are no matter here: before
+        // near faces were followed such a cut was undone, and it still is.
+        let lit: Vec<States> = open
             .iter()
             .map(|part| self.states(surface, &sample_points(part), normal))
+            .filter(|s| !s.buried)
             .collect();
-        let apart = states.iter().any(|s| s.mixed() || *s != states[0]);
+        let apart = lit
+            .iter()
+            .any(|s| (s.shaded && s.open) || s.shaded != lit[0].shaded);
         apart.then_some(open)
     }
 
@@ -932,9 +959,18 @@ mod tests {
         // floor kept is the exact 14 m^2 (to rounding; before the cut it was up to one row of
         // such pieces along the 6 m outline more).
         let scene = floor_with_box(0.3, 2.3, 0.3, 1.3);
-        let (mesh, _) = refine(&scene);
+        let (mesh, report) = refine(&scene);
         let kept = floor_area(&mesh);
         assert!((kept - 14.0).abs() < 1e-9, "{kept}");
+        // Split for the box standing on it, none for a near face's shade alone (review:
+        // elements whose straddling pieces were all kept counted as such), on the cut mesh
+        // and on the quadtrees' comparison mesh.
+        assert!(report.split > 0 && report.shaded_split == 0, "{report:?}");
+        let grid = mesh_scene(&scene, 1.0).unwrap();
+        let bvh = PolygonBvh::over_surfaces(&scene);
+        let (_, report) = refine_contacts_as_quadtrees(&grid, &scene, &bvh);
+        assert!(report.split > 0 && report.shaded_split == 0, "{report:?}");
+        assert_eq!(report.input_elements, grid.len());
     }
 
     #[test]
@@ -1111,8 +1147,8 @@ mod tests {
     #[test]
     fn nothing_buried_or_near_leaves_the_mesh_as_it_was() {
         // A box hovering 0.6 above the floor buries nothing (light passes under it) and
-        // stands beyond the near gap of the floor's 1 x 1 elements (NEAR_REACH, 0.5) and a
-        // quarter of its base's size (NEAR_SHARP: 0.35).
+        // stands beyond the near gap of the floor's 1 x 1 elements (NEAR_REACH: 0.5; not
+        // COVER_REACH, 0.15) and a quarter of its base's size (NEAR_SHARP: 0.35).
         let mut scene = floor_with_box(0.5, 2.5, 0.5, 1.5);
         for s in &mut scene.surfaces[1..] {
             for v in &mut s.vertices {
